@@ -1,0 +1,106 @@
+#include "io/volume.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace vox::io {
+
+std::size_t scalar_size(ScalarType t)
+{
+    switch (t) {
+    case ScalarType::u8:
+    case ScalarType::i8: return 1;
+    case ScalarType::u16:
+    case ScalarType::i16: return 2;
+    case ScalarType::u32:
+    case ScalarType::i32:
+    case ScalarType::f32: return 4;
+    case ScalarType::f64: return 8;
+    }
+    return 1;
+}
+
+const char* scalar_name(ScalarType t)
+{
+    switch (t) {
+    case ScalarType::u8: return "uint8";
+    case ScalarType::i8: return "int8";
+    case ScalarType::u16: return "uint16";
+    case ScalarType::i16: return "int16";
+    case ScalarType::u32: return "uint32";
+    case ScalarType::i32: return "int32";
+    case ScalarType::f32: return "float32";
+    case ScalarType::f64: return "float64";
+    }
+    return "?";
+}
+
+bool is_integer(ScalarType t) { return t != ScalarType::f32 && t != ScalarType::f64; }
+
+namespace {
+template <class T> double load(const std::byte* p)
+{
+    T v;
+    std::memcpy(&v, p, sizeof(T));
+    return static_cast<double>(v);
+}
+} // namespace
+
+double Volume::stored(std::int64_t n) const
+{
+    const std::byte* p = data.data() + static_cast<std::size_t>(n) * scalar_size(type);
+    switch (type) {
+    case ScalarType::u8: return load<std::uint8_t>(p);
+    case ScalarType::i8: return load<std::int8_t>(p);
+    case ScalarType::u16: return load<std::uint16_t>(p);
+    case ScalarType::i16: return load<std::int16_t>(p);
+    case ScalarType::u32: return load<std::uint32_t>(p);
+    case ScalarType::i32: return load<std::int32_t>(p);
+    case ScalarType::f32: return load<float>(p);
+    case ScalarType::f64: return load<double>(p);
+    }
+    return 0.0;
+}
+
+Eigen::Vector3d Volume::spacing() const { return index_to_world.topLeftCorner<3, 3>().colwise().norm().transpose(); }
+
+void validate(const Volume& v)
+{
+    for (int a = 0; a < 3; ++a)
+        if (v.dims[a] <= 0)
+            throw file_error(v.source, "dimension " + std::to_string(a) + " is " + std::to_string(v.dims[a]) +
+                                           " (must be positive)");
+    if (!v.index_to_world.allFinite()) throw file_error(v.source, "the index-to-world transform is not finite");
+    const Eigen::Vector3d s = v.spacing();
+    for (int a = 0; a < 3; ++a)
+        if (!(s[a] > 0.0)) throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is zero");
+    if (std::abs(v.index_to_world.topLeftCorner<3, 3>().determinant()) <= 1e-12 * s.prod())
+        throw file_error(v.source, "the voxel axes are degenerate (direction matrix is singular)");
+    if (!std::isfinite(v.scale_slope) || !std::isfinite(v.scale_intercept))
+        throw file_error(v.source, "the value scaling (slope/intercept) is not finite");
+    const auto expect = static_cast<std::size_t>(v.voxel_count()) * scalar_size(v.type);
+    if (v.data.size() != expect)
+        throw file_error(v.source, "holds " + std::to_string(v.data.size()) + " bytes of voxels, expected " +
+                                       std::to_string(expect));
+}
+
+void swap_bytes(Volume& v)
+{
+    const std::size_t w = scalar_size(v.type);
+    if (w == 1) return;
+    for (std::size_t i = 0; i + w <= v.data.size(); i += w) std::reverse(v.data.begin() + i, v.data.begin() + i + w);
+}
+
+Eigen::Matrix4d make_index_to_world(const Eigen::Vector3d& spacing, const Eigen::Matrix3d& direction,
+                                    const Eigen::Vector3d& origin)
+{
+    Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
+    t.topLeftCorner<3, 3>() = direction * spacing.asDiagonal();
+    t.topRightCorner<3, 1>() = origin;
+    return t;
+}
+
+} // namespace vox::io
