@@ -1,1 +1,51 @@
-int main() { return 0; }
+// voxsculpt: the command-line program. Exit codes: 0 success, 2 bad input or usage, 1 internal error.
+
+#include "app/commands.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/memory_limit.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"VoxSculpt: physics-based sculpting and cutting of volumetric objects"};
+    app.set_version_flag("--version", "voxsculpt 0.1.0");
+    app.require_subcommand(1);
+    app.fallthrough(); // global options may follow the subcommand's own
+    app.add_flag_callback("-q,--quiet", [] { vox::log::set_verbosity(vox::log::Verbosity::quiet); },
+                          "Print only errors");
+    app.add_flag_callback("-v,--verbose", [] { vox::log::set_verbosity(vox::log::Verbosity::verbose); },
+                          "Print debugging detail");
+    app.add_option_function<std::uint64_t>(
+           "--max-memory-mb", [](std::uint64_t mb) { vox::set_memory_limit_bytes(mb << 20); },
+           "Refuse inputs that would need more memory than this (default 8192, or $VOXSCULPT_MAX_MEMORY_MB)")
+        ->check(CLI::PositiveNumber);
+
+    vox::app::add_import_command(app);
+    vox::app::add_info_command(app);
+    vox::app::add_phantom_command(app);
+    vox::app::add_check_command(app);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::Success& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "voxsculpt: %s (see --help)\n", e.what());
+        return 2;
+    } catch (const vox::InputError& e) {
+        std::fprintf(stderr, "voxsculpt: %s\n", e.what());
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "voxsculpt: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "voxsculpt: internal error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,1 +1,147 @@
-// being written
+#include "io/selection.hpp"
+
+#include "core/error.hpp"
+#include "core/progress.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace vox::io {
+namespace {
+
+std::string format_number(double v)
+{
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
+
+/// A short list of the values present, for "nothing selected" messages.
+std::string describe_values(const std::map<double, std::uint64_t>& counts)
+{
+    std::ostringstream os;
+    int shown = 0;
+    for (const auto& [value, n] : counts) {
+        if (shown++ == 12) {
+            os << ", ... (" << counts.size() << " distinct values)";
+            break;
+        }
+        os << (shown > 1 ? ", " : "") << value;
+    }
+    return os.str();
+}
+
+/// The label a voxel gets under `s`, or 0 when it is not selected. `stored`/`scaled` are its values.
+struct Selector {
+    const Selection& s;
+    std::int32_t operator()(double stored, double scaled) const
+    {
+        if (s.threshold_min) {
+            const bool in = scaled >= *s.threshold_min && (!s.threshold_max || scaled <= *s.threshold_max);
+            return in ? 1 : 0;
+        }
+        if (!s.labels.empty()) {
+            for (std::int32_t l : s.labels)
+                if (stored == static_cast<double>(l)) return l;
+            return 0;
+        }
+        return stored != 0.0 ? static_cast<std::int32_t>(stored) : 0;
+    }
+};
+
+void check_integer_label(const std::string& source, double stored)
+{
+    if (stored != std::floor(stored) || std::abs(stored) > 2147483647.0)
+        throw file_error(source, "value " + format_number(stored) +
+                                     " is not an integer label; select voxels with --threshold LO[:HI] instead");
+}
+
+} // namespace
+
+std::string Selection::describe() const
+{
+    if (threshold_min)
+        return "threshold [" + format_number(*threshold_min) + ", " +
+               (threshold_max ? format_number(*threshold_max) : std::string("inf")) + "]";
+    if (labels.empty()) return "every non-zero voxel";
+    std::string out = labels.size() == 1 ? "label " : "labels ";
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        if (i > 0) out += ',';
+        out += std::to_string(labels[i]);
+    }
+    return out;
+}
+
+Selection parse_threshold(const std::string& text)
+{
+    auto parse = [&](const std::string& part) {
+        char* end = nullptr;
+        const double v = std::strtod(part.c_str(), &end);
+        if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(v))
+            throw InputError("--threshold " + text + ": '" + part + "' is not a number (expected LO or LO:HI)");
+        return v;
+    };
+    Selection s;
+    const auto colon = text.find(':');
+    s.threshold_min = parse(text.substr(0, colon));
+    if (colon != std::string::npos) {
+        s.threshold_max = parse(text.substr(colon + 1));
+        if (*s.threshold_max < *s.threshold_min) throw InputError("--threshold " + text + ": LO is greater than HI");
+    }
+    return s;
+}
+
+grid::LabelGrid select_voxels(const Volume& v, const Selection& s)
+{
+    grid::LabelGrid out(v.index_to_world);
+    out.set_metadata("source", v.source);
+    const Selector select{s};
+    const bool keep_values = s.empty();
+    Progress progress("selecting voxels", static_cast<std::uint64_t>(v.dims[2]));
+    std::int64_t n = 0;
+    for (std::int32_t k = 0; k < v.dims[2]; ++k) {
+        for (std::int32_t j = 0; j < v.dims[1]; ++j)
+            for (std::int32_t i = 0; i < v.dims[0]; ++i, ++n) {
+                const double stored = v.stored(n);
+                if (keep_values && stored != 0.0) check_integer_label(v.source, stored);
+                const std::int32_t label = select(stored, s.threshold_min ? v.scaled(n) : stored);
+                if (label != 0) out.set({i, j, k}, label);
+            }
+        progress.update(static_cast<std::uint64_t>(k + 1));
+    }
+    if (out.active_voxel_count() == 0) {
+        std::map<double, std::uint64_t> counts;
+        const bool scaled = s.threshold_min.has_value();
+        for (std::int64_t m = 0; m < v.voxel_count() && counts.size() <= 13; ++m)
+            ++counts[scaled ? v.scaled(m) : v.stored(m)];
+        throw file_error(v.source, "the selection (" + s.describe() + ") holds no voxel; " +
+                                       (scaled ? "values" : "stored values") + " present: " + describe_values(counts));
+    }
+    return out;
+}
+
+grid::LabelGrid select_labels(const grid::LabelGrid& labels, const Selection& s, const std::string& source)
+{
+    if (s.empty()) {
+        if (labels.active_voxel_count() == 0) throw file_error(source, "holds no active voxel");
+        return labels.clone();
+    }
+    grid::LabelGrid out(labels.index_to_world());
+    out.set_metadata("source", labels.metadata("source").empty() ? source : labels.metadata("source"));
+    const Selector select{s};
+    labels.for_each_active([&](const grid::Coord& c, std::int32_t label) {
+        const std::int32_t l = select(label, label);
+        if (l != 0) out.set(c, l);
+    });
+    if (out.active_voxel_count() == 0) {
+        std::map<double, std::uint64_t> counts;
+        for (const auto& [l, n] : labels.label_histogram()) counts[l] = n;
+        throw file_error(source, "the selection (" + s.describe() + ") holds no voxel; labels present: " +
+                                     describe_values(counts));
+    }
+    return out;
+}
+
+} // namespace vox::io

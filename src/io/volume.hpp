@@ -2,6 +2,7 @@
 // A dense scalar volume as read from a scan file, before selection turns it into labelled voxels.
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 #include <array>
 #include <cstddef>

@@ -1,1 +1,104 @@
-// being written
+// The voxsculpt program end to end: import -> .vdb -> info, phantoms, usage errors.
+
+#include "app/run_command.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+namespace fs = std::filesystem;
+using vox::test::quote;
+using vox::test::run_voxsculpt;
+
+namespace {
+fs::path fresh_dir(const std::string& name)
+{
+    const fs::path d = fs::path(::testing::TempDir()) / name;
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+nlohmann::json info_json(const fs::path& file)
+{
+    const auto r = run_voxsculpt("info --json " + quote(file.string()));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+}
+} // namespace
+
+TEST(Cli, LiverImportRoundTripKeepsCountsAndTransform)
+{
+    const fs::path d = fresh_dir("cli_liver");
+    const std::string liver = VOX_SOURCE_DIR "/data/liver.inr.gz";
+    const auto r = run_voxsculpt("import " + quote(liver) + " --label 255 -o " + quote((d / "liver.vdb").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto scan = info_json(liver);
+    const auto vdb = info_json(d / "liver.vdb");
+    EXPECT_EQ(vdb["active_voxels"], 3160496);
+    EXPECT_EQ(vdb["labels"]["255"], 3160496);
+    EXPECT_EQ(scan["labels"]["255"], 3160496);
+    EXPECT_EQ(scan["active_voxels"], 3160496 + 314086 + 17702 + 2);
+    for (int r0 = 0; r0 < 4; ++r0)
+        for (int c = 0; c < 4; ++c)
+            EXPECT_NEAR(vdb["index_to_world"][r0][c].get<double>(), scan["index_to_world"][r0][c].get<double>(), 1e-12);
+    // The liver's voxels lie inside the scan's box.
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_GE(vdb["world_bbox_mm"]["min"][a].get<double>(), scan["world_bbox_mm"]["min"][a].get<double>());
+        EXPECT_LE(vdb["world_bbox_mm"]["max"][a].get<double>(), scan["world_bbox_mm"]["max"][a].get<double>());
+    }
+    // Re-importing the .vdb with a selection keeps the voxels and transform again.
+    const auto r2 = run_voxsculpt("import " + quote((d / "liver.vdb").string()) + " --label 255 -o " +
+                                  quote((d / "again.vdb").string()));
+    ASSERT_EQ(r2.exit_code, 0) << r2.err;
+    EXPECT_EQ(info_json(d / "again.vdb")["active_voxels"], 3160496);
+}
+
+TEST(Cli, ThresholdSelectionGivesLabelOne)
+{
+    const fs::path d = fresh_dir("cli_threshold");
+    const auto r = run_voxsculpt("import " + quote(VOX_SOURCE_DIR "/data/liver.inr.gz") + " --threshold 100:200 -o " +
+                                 quote((d / "t.vdb").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = info_json(d / "t.vdb");
+    EXPECT_EQ(j["labels"]["1"], 314086); // only label 127 lies in [100, 200]
+    EXPECT_EQ(j["labels"].size(), 1u);
+}
+
+TEST(Cli, PhantomWritesDocumentedSizes)
+{
+    const fs::path d = fresh_dir("cli_phantom");
+    const auto r = run_voxsculpt("phantom beam --size-mm 20 4 6 --voxel-mm 2 -o " + quote((d / "b.vdb").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = info_json(d / "b.vdb");
+    EXPECT_EQ(j["active_voxels"], 10 * 2 * 3);
+    EXPECT_EQ(j["dimensions"], nlohmann::json({10, 2, 3}));
+    EXPECT_EQ(j["world_bbox_mm"]["min"], nlohmann::json({-1.0, -1.0, -1.0}));
+    EXPECT_EQ(j["world_bbox_mm"]["max"], nlohmann::json({19.0, 3.0, 5.0}));
+}
+
+TEST(Cli, HelpAndUsageErrors)
+{
+    for (const char* sub : {"", "import ", "info ", "phantom ", "phantom sphere ", "check "}) {
+        const auto r = run_voxsculpt(std::string(sub) + "--help");
+        EXPECT_EQ(r.exit_code, 0) << sub;
+        EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
+    }
+    const auto none = run_voxsculpt("");
+    EXPECT_EQ(none.exit_code, 2);
+    const auto unknown = run_voxsculpt("frobnicate");
+    EXPECT_EQ(unknown.exit_code, 2);
+    const auto missing_out = run_voxsculpt("import x.nii");
+    EXPECT_EQ(missing_out.exit_code, 2);
+    EXPECT_NE(missing_out.err.find("--output"), std::string::npos) << missing_out.err;
+}
+
+TEST(Cli, QuietPrintsNothingOnSuccess)
+{
+    const fs::path d = fresh_dir("cli_quiet");
+    const auto r = run_voxsculpt("phantom block -o " + quote((d / "b.vdb").string()) + " --quiet");
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(r.out, "");
+}

@@ -1,1 +1,362 @@
-// being written
+#include "io/mesh.hpp"
+
+#include "core/error.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace vox::io {
+namespace {
+
+const std::string k_data = VOX_SOURCE_DIR "/data/";
+const std::string k_bad = VOX_TEST_DATA_DIR "/bad/";
+
+/// A fresh folder for files a test writes, removed afterwards.
+class TempDir {
+public:
+    TempDir()
+        : m_path(std::filesystem::temp_directory_path() /
+                 ("vox_mesh_test_" + std::to_string(::getpid()) + "_" +
+                  ::testing::UnitTest::GetInstance()->current_test_info()->name()))
+    {
+        std::filesystem::create_directories(m_path);
+    }
+    ~TempDir() { std::filesystem::remove_all(m_path); }
+    [[nodiscard]] std::string path(const std::string& name) const { return (m_path / name).string(); }
+    std::string write(const std::string& name, const std::string& bytes) const
+    {
+        std::ofstream(path(name), std::ios::binary) << bytes;
+        return path(name);
+    }
+
+private:
+    std::filesystem::path m_path;
+};
+
+// The unit cube [0,1]^3, oriented outwards: corner i has coordinates (i & 1, i >> 1 & 1, i >> 2 & 1).
+const char* const k_cube_corners = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
+const int k_cube_quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+
+std::string cube_quads_text()
+{
+    std::ostringstream s;
+    for (const auto& q : k_cube_quads) s << "4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
+    return s.str();
+}
+
+std::string cube_off() { return "OFF\n# unit cube\n8 6 12\n" + std::string(k_cube_corners) + cube_quads_text(); }
+
+/// OBJ with 1-based "v/vt/vn" corners; `flip_last` reverses the last quad (an orientation defect).
+std::string cube_obj(bool flip_last = false)
+{
+    std::ostringstream s;
+    for (int i = 0; i < 8; ++i) s << "v " << (i & 1) << ' ' << (i >> 1 & 1) << ' ' << (i >> 2 & 1) << '\n';
+    s << "vt 0 0\nvn 0 0 1\n";
+    for (int f = 0; f < 6; ++f) {
+        s << 'f';
+        for (int c = 0; c < 4; ++c)
+            s << ' ' << 1 + (flip_last && f == 5 ? k_cube_quads[f][3 - c] : k_cube_quads[f][c]) << "/1/1";
+        s << '\n';
+    }
+    return s.str();
+}
+
+std::string cube_ply()
+{
+    return "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+           "element face 6\nproperty list uchar int vertex_indices\nend_header\n" +
+           std::string(k_cube_corners) + cube_quads_text();
+}
+
+Eigen::Vector3d cube_corner(int i) { return {double(i & 1), double(i >> 1 & 1), double(i >> 2 & 1)}; }
+
+std::string cube_stl_ascii()
+{
+    std::ostringstream s;
+    s << "solid cube\n";
+    for (const auto& q : k_cube_quads)
+        for (const auto& t : {std::array{q[0], q[1], q[2]}, std::array{q[0], q[2], q[3]}}) {
+            s << "facet normal 0 0 0\n outer loop\n";
+            for (int c : t) s << "  vertex " << cube_corner(c).transpose() << '\n';
+            s << " endloop\nendfacet\n";
+        }
+    s << "endsolid cube\n";
+    return s.str();
+}
+
+std::string cube_stl_binary()
+{
+    // The header starts with "solid" on purpose: binary files written by some CAD tools do.
+    std::string s = "solid but binary";
+    s.resize(80, ' ');
+    const auto put = [&s](const void* p, std::size_t n) { s.append(static_cast<const char*>(p), n); };
+    const std::uint32_t count = 12;
+    put(&count, 4);
+    for (const auto& q : k_cube_quads)
+        for (const auto& t : {std::array{q[0], q[1], q[2]}, std::array{q[0], q[2], q[3]}}) {
+            const float normal[3] = {0, 0, 0};
+            put(normal, 12);
+            for (int c : t) {
+                const Eigen::Vector3f p = cube_corner(c).cast<float>();
+                put(p.data(), 12);
+            }
+            const std::uint16_t attribute = 0;
+            put(&attribute, 2);
+        }
+    return s;
+}
+
+void expect_unit_cube(const TriangleMesh& mesh, double scale)
+{
+    const MeshInfo info = mesh_info(mesh);
+    EXPECT_EQ(info.vertices, 8u);
+    EXPECT_EQ(info.triangles, 12u);
+    EXPECT_EQ(info.edges, 18u); // 12 cube edges + 6 face diagonals
+    EXPECT_EQ(info.boundary_edges, 0u);
+    EXPECT_EQ(info.non_manifold_edges, 0u);
+    EXPECT_TRUE(info.closed);
+    EXPECT_TRUE(info.consistently_oriented);
+    EXPECT_NEAR(info.area_mm2, 6.0 * scale * scale, 1e-12);
+    EXPECT_NEAR(info.enclosed_volume_mm3, scale * scale * scale, 1e-12);
+    EXPECT_EQ(info.bbox_min, Eigen::Vector3d::Zero());
+    EXPECT_EQ(info.bbox_max, Eigen::Vector3d::Constant(scale));
+}
+
+TEST(MeshRead, UnitCubeInEveryFormat)
+{
+    const TempDir dir;
+    for (const auto& [name, bytes] :
+         std::vector<std::pair<std::string, std::string>>{{"cube.off", cube_off()},
+                                                          {"cube.OBJ", cube_obj()},
+                                                          {"cube.ply", cube_ply()},
+                                                          {"cube_ascii.stl", cube_stl_ascii()},
+                                                          {"cube_binary.stl", cube_stl_binary()}}) {
+        SCOPED_TRACE(name);
+        const std::string path = dir.write(name, bytes);
+        expect_unit_cube(read_mesh(path), 1.0);
+        expect_unit_cube(read_mesh(path, 2.5), 2.5); // file units -> mm
+    }
+}
+
+TEST(MeshInfo, TetrahedronVolumeAndAreaExact)
+{
+    TriangleMesh tet;
+    tet.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    tet.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    MeshInfo info = mesh_info(tet);
+    EXPECT_TRUE(info.closed);
+    EXPECT_TRUE(info.consistently_oriented);
+    EXPECT_EQ(info.edges, 6u);
+    EXPECT_NEAR(info.enclosed_volume_mm3, 1.0 / 6.0, 1e-15);
+    EXPECT_NEAR(info.area_mm2, 1.5 + std::sqrt(3.0) / 2.0, 1e-15);
+
+    // The volume of a closed surface does not depend on where it is.
+    for (Eigen::Vector3d& p : tet.vertices) p += Eigen::Vector3d(1000.0, -2000.0, 500.0);
+    EXPECT_NEAR(mesh_info(tet).enclosed_volume_mm3, 1.0 / 6.0, 1e-12);
+
+    // Inward orientation negates it.
+    for (Eigen::Vector3i& t : tet.triangles) std::swap(t[1], t[2]);
+    info = mesh_info(tet);
+    EXPECT_NEAR(info.enclosed_volume_mm3, -1.0 / 6.0, 1e-12);
+    EXPECT_TRUE(info.consistently_oriented);
+}
+
+TEST(MeshInfo, OpenBoxHoleCapIsTheMissingFace)
+{
+    const TempDir dir;
+    TriangleMesh box = read_mesh(dir.write("cube.off", cube_off()));
+    box.triangles.erase(box.triangles.begin(), box.triangles.begin() + 2); // the face z = 0
+    const MeshInfo info = mesh_info(box);
+    EXPECT_FALSE(info.closed);
+    EXPECT_EQ(info.boundary_edges, 4u);
+    EXPECT_EQ(info.boundary_loops, 1u);
+    EXPECT_NEAR(info.area_mm2, 5.0, 1e-12);
+    EXPECT_NEAR(info.boundary_cap_area_mm2, 1.0, 1e-12);
+    EXPECT_TRUE(info.consistently_oriented);
+}
+
+TEST(MeshInfo, SampleMeshes)
+{
+    struct Expected {
+        const char* file;
+        std::size_t vertices, triangles;
+        bool closed;
+    };
+    for (const Expected& e : {Expected{"elephant.off", 2775, 5558, true}, Expected{"lion.off", 7529, 14859, false},
+                              Expected{"sphere.off", 162, 320, true}, Expected{"cylinder.off", 1200, 2262, false}}) {
+        SCOPED_TRACE(e.file);
+        const MeshInfo info = mesh_info(read_mesh(k_data + e.file));
+        EXPECT_EQ(info.vertices, e.vertices);
+        EXPECT_EQ(info.triangles, e.triangles);
+        EXPECT_EQ(info.closed, e.closed);
+        // Every triangle has 3 edge uses: interior edges take 2, boundary edges 1.
+        if (info.non_manifold_edges == 0) {
+            EXPECT_EQ(3 * info.triangles, 2 * info.edges - info.boundary_edges);
+        }
+        if (e.closed) {
+            EXPECT_GT(info.enclosed_volume_mm3, 0.0);
+            EXPECT_TRUE(info.consistently_oriented);
+        }
+    }
+    // A half-pipe of radius 1 mm and length 3 mm: area 3 pi; its one boundary loop projects onto the
+    // 2 x 3 rectangle of the pipe's diametral plane, so the loop's vector area is exactly 6.
+    const MeshInfo cylinder = mesh_info(read_mesh(k_data + "cylinder.off"));
+    EXPECT_EQ(cylinder.boundary_edges, 136u);
+    EXPECT_EQ(cylinder.boundary_loops, 1u);
+    EXPECT_NEAR(cylinder.area_mm2, 3.0 * std::numbers::pi, 1e-3 * 3.0 * std::numbers::pi);
+    EXPECT_NEAR(cylinder.boundary_cap_area_mm2, 6.0, 1e-9);
+    const MeshInfo lion = mesh_info(read_mesh(k_data + "lion.off"));
+    EXPECT_EQ(lion.boundary_edges, 205u);
+    EXPECT_EQ(lion.non_manifold_edges, 0u);
+    EXPECT_EQ(lion.boundary_loops, 5u);
+    // Euler characteristic V - E + F = 2 of a closed genus-0 surface.
+    const MeshInfo sphere = mesh_info(read_mesh(k_data + "sphere.off"));
+    EXPECT_EQ(
+        static_cast<long>(sphere.vertices) - static_cast<long>(sphere.edges) + static_cast<long>(sphere.triangles), 2);
+}
+
+TEST(MeshInfo, SphereVolumeBetweenInscribedBounds)
+{
+    // sphere.off's vertices lie on a sphere (to the file's 5 digits), so its volume is below that
+    // of the sphere through its farthest vertex and above that of the sphere touching its nearest
+    // face plane.
+    const TriangleMesh mesh = read_mesh(k_data + "sphere.off");
+    const MeshInfo info = mesh_info(mesh);
+    const Eigen::Vector3d centre = 0.5 * (info.bbox_min + info.bbox_max);
+    double outer = 0.0;
+    for (const Eigen::Vector3d& p : mesh.vertices) outer = std::max(outer, (p - centre).norm());
+    double inner = outer;
+    for (const Eigen::Vector3d& p : mesh.vertices) EXPECT_NEAR((p - centre).norm(), outer, 1e-4 * outer);
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+        const Eigen::Vector3d a = mesh.vertices[t[0]];
+        const Eigen::Vector3d n = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).normalized();
+        inner = std::min(inner, std::abs((a - centre).dot(n)));
+    }
+    const auto ball = [](double r) { return 4.0 / 3.0 * std::numbers::pi * r * r * r; };
+    EXPECT_LT(info.enclosed_volume_mm3, ball(outer));
+    EXPECT_GT(info.enclosed_volume_mm3, ball(inner));
+}
+
+TEST(MeshRead, WeldsOpenMeshNonManifoldCopies)
+{
+    // A flipped quad makes OpenMesh refuse the face ("complex edge") and attach it to fresh vertex
+    // copies; the reader maps them back so the file's connectivity survives.
+    const TempDir dir;
+    const TriangleMesh mesh = read_mesh(dir.write("flipped.obj", cube_obj(true)));
+    const MeshInfo info = mesh_info(mesh);
+    EXPECT_EQ(info.vertices, 8u);
+    EXPECT_EQ(info.triangles, 12u);
+    EXPECT_TRUE(info.closed);
+    EXPECT_FALSE(info.consistently_oriented);
+}
+
+TEST(MeshRead, NonManifoldEdgeKept)
+{
+    const TempDir dir;
+    // Three triangles on the edge 0-1, as scans sometimes have: kept, and counted.
+    const std::string off = "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n";
+    const MeshInfo info = mesh_info(read_mesh(dir.write("fin.off", off)));
+    EXPECT_EQ(info.triangles, 3u);
+    EXPECT_EQ(info.non_manifold_edges, 1u);
+    EXPECT_EQ(info.boundary_edges, 6u);
+    EXPECT_FALSE(info.closed);
+    EXPECT_FALSE(info.consistently_oriented);
+}
+
+TEST(MeshRead, DegenerateFacesSkipped)
+{
+    const TempDir dir;
+    const std::string off = "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 1\n";
+    EXPECT_EQ(read_mesh(dir.write("degenerate.off", off)).triangles.size(), 1u);
+}
+
+/// Expects read_mesh(path) to throw an InputError of one line "PATH: ..." containing `what`.
+void expect_input_error(const std::string& path, const std::string& what, double mm_per_unit = 1.0)
+{
+    SCOPED_TRACE(path);
+    try {
+        (void)read_mesh(path, mm_per_unit);
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+        EXPECT_NE(message.find(what), std::string::npos) << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+}
+
+TEST(MeshRead, MalformedFilesThrowNamingTheFile)
+{
+    expect_input_error(k_bad + "off_nan_vertex.off", "vertex 2 has a non-finite coordinate (nan, 1, 0)");
+    expect_input_error(k_bad + "off_bad_index.off",
+                       "line 8: face 1 references vertex 99, but there are only 4 vertices");
+    expect_input_error(k_bad + "off_truncated.off", "truncated");
+    expect_input_error(k_bad + "off_no_faces.off", "has no faces");
+    expect_input_error(k_bad + "off_not_a_number.off", "line 4: vertex 1: 'zero' is not a number");
+    expect_input_error(k_bad + "off_wrong_magic.off", "not an OFF file");
+    expect_input_error(k_bad + "obj_no_faces.obj", "has no faces");
+    expect_input_error(k_bad + "obj_bad_index.obj", "reference a vertex that does not exist");
+    expect_input_error(k_bad + "obj_inf_vertex.obj", "reference a vertex that does not exist");
+    expect_input_error(k_bad + "ply_wrong_magic.ply", "OpenMesh cannot read it as PLY");
+    expect_input_error(k_bad + "ply_truncated.ply", "OpenMesh cannot read it as PLY");
+    expect_input_error(k_bad + "ply_nan_vertex.ply", "vertex 1 has a non-finite coordinate");
+    expect_input_error(k_bad + "stl_truncated.stl", "declares 10 triangles (584 bytes) but has 134 bytes");
+    expect_input_error(k_bad + "stl_nan_vertex.stl", "triangle 1, corner 1 has a non-finite coordinate");
+    expect_input_error(k_bad + "stl_truncated_ascii.stl", "truncated: facet 0 has no 'endloop'");
+    expect_input_error(k_bad + "stl_empty.stl", "not an STL file");
+}
+
+TEST(MeshRead, BadPathsAndParameters)
+{
+    expect_input_error(k_bad + "no_such_mesh.off", "no such file");
+    expect_input_error(k_bad + "no_such_mesh.obj", "no such file");
+    const TempDir dir;
+    const std::string folder = dir.path("folder.off");
+    std::filesystem::create_directory(folder);
+    expect_input_error(folder, "is a folder");
+    expect_input_error(dir.write("cube.xyz", cube_off()), "unknown mesh format '.xyz'");
+    const std::string cube = dir.write("cube.off", cube_off());
+    for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
+        expect_input_error(cube, "mm_per_unit", bad);
+}
+
+TEST(MeshRead, OpenMeshDiagnosticsSilenced)
+{
+    // OpenMesh prints "ImporterT: Face contains invalid vertex index" on its own; the user should
+    // see only our one-line error.
+    ::testing::internal::CaptureStderr();
+    ::testing::internal::CaptureStdout();
+    EXPECT_THROW((void)read_mesh(k_bad + "obj_bad_index.obj"), InputError);
+    const TempDir dir;
+    EXPECT_NO_THROW((void)read_mesh(dir.write("flipped.obj", cube_obj(true))));
+    EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+TEST(MeshCheck, RejectsBadProgrammaticMeshes)
+{
+    TriangleMesh mesh;
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    EXPECT_THROW(check_mesh(mesh, "m"), InputError);
+    mesh.triangles = {{0, 1, 3}};
+    EXPECT_THROW(check_mesh(mesh, "m"), InputError);
+    mesh.triangles = {{0, 1, 2}};
+    EXPECT_NO_THROW(check_mesh(mesh, "m"));
+    mesh.vertices[1].y() = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(check_mesh(mesh, "m"), InputError);
+}
+
+} // namespace
+} // namespace vox::io

@@ -1,1 +1,522 @@
-// being written
+#include "io/scene.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using vox::InputError;
+using namespace vox::io;
+
+const fs::path source_dir = VOX_SOURCE_DIR;
+const fs::path scenes_dir = source_dir / "data" / "scenes";
+const fs::path bad_dir = fs::path(VOX_TEST_DATA_DIR) / "bad";
+
+/// The message of the InputError `f` throws; fails the test when it throws nothing.
+std::string error_of(const std::function<void()>& f)
+{
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "no InputError thrown";
+    return {};
+}
+
+json read_json(const fs::path& path)
+{
+    std::ifstream in(path);
+    return json::parse(in);
+}
+
+/// Writes `text` to a file in the test's temporary folder and returns its path.
+fs::path write_temp(const std::string& name, const std::string& text)
+{
+    const fs::path path = fs::path(testing::TempDir()) / name;
+    std::ofstream(path) << text;
+    return path;
+}
+
+/// The smallest valid scene: a beam phantom and nothing else.
+json minimal_scene()
+{
+    return json::parse(R"({"object": {"phantom": {"shape": "beam"}, "levels": 0}})");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The example scenes.
+// ---------------------------------------------------------------------------------------------
+
+TEST(SceneExamples, EveryExampleSceneLoads)
+{
+    std::set<std::string> names;
+    for (const fs::directory_entry& entry : fs::directory_iterator(scenes_dir)) {
+        if (entry.path().extension() == ".json") {
+            SCOPED_TRACE(entry.path().string());
+            EXPECT_NO_THROW(static_cast<void>(load_scene(entry.path())));
+            names.insert(entry.path().filename().string());
+        }
+    }
+    for (const char* name : {"liver.json", "beam.json", "elephant.json", "cylinder.json"}) {
+        EXPECT_TRUE(names.count(name)) << name;
+    }
+}
+
+TEST(SceneExamples, Liver)
+{
+    const Scene s = load_scene(scenes_dir / "liver.json");
+    EXPECT_EQ(s.source, (scenes_dir / "liver.json").string());
+    EXPECT_EQ(s.folder, scenes_dir);
+    EXPECT_EQ(s.object.kind, ObjectKind::volume);
+    EXPECT_EQ(s.object.file, source_dir / "data" / "liver.inr.gz");
+    EXPECT_EQ(s.object.select.labels, (std::vector<std::int32_t>{255, 127}));
+    EXPECT_FALSE(s.object.select.threshold_min);
+    EXPECT_EQ(s.object.levels, 3);
+
+    EXPECT_EQ(s.default_material.youngs_modulus_pa, 3e4);
+    EXPECT_EQ(s.default_material.density_kg_m3, 1060.0);
+    ASSERT_EQ(s.label_materials.size(), 1u);
+    // Label 127 sets only E; nu and rho come from the scene's default material.
+    EXPECT_EQ(s.material(127).youngs_modulus_pa, 1e5);
+    EXPECT_EQ(s.material(127).poisson_ratio, 0.45);
+    EXPECT_EQ(s.material(127).density_kg_m3, 1060.0);
+    EXPECT_EQ(&s.material(255), &s.default_material);
+
+    EXPECT_EQ(s.gravity_m_s2, Eigen::Vector3d(0, 9.81, 0));
+    ASSERT_EQ(s.tools.size(), 2u);
+    EXPECT_EQ(s.tools[0].shape, ToolShape::sphere);
+    EXPECT_EQ(s.tools[0].radius_mm, 5.0);
+    EXPECT_EQ(s.tools[1].shape, ToolShape::scalpel);
+    ASSERT_EQ(s.script.size(), 5u);
+    EXPECT_EQ(s.script[2].t_s, s.script[3].t_s); // equal times are allowed
+    EXPECT_EQ(s.script[3].tool, "scalpel");
+    EXPECT_EQ(s.script[3].tool_index, 1u);
+    EXPECT_EQ(s.output.dir, scenes_dir / "out" / "liver");
+}
+
+TEST(SceneExamples, Beam)
+{
+    const Scene s = load_scene(scenes_dir / "beam.json");
+    EXPECT_EQ(s.object.kind, ObjectKind::phantom);
+    EXPECT_EQ(s.object.phantom.shape, vox::grid::PhantomShape::beam);
+    EXPECT_EQ(s.object.phantom.size_mm, Eigen::Vector3d(200, 10, 10));
+    EXPECT_EQ(s.object.phantom.voxel_mm, 1.0);
+    EXPECT_EQ(s.object.levels, 1);
+    EXPECT_EQ(s.solver.type, SolverType::dbg);
+    ASSERT_EQ(s.constraints.size(), 1u);
+    EXPECT_EQ(s.constraints[0].type, ConstraintType::fixed);
+    EXPECT_EQ(s.constraints[0].box_min_mm, Eigen::Vector3d(0, 0, 0));
+    EXPECT_EQ(s.constraints[0].box_max_mm, Eigen::Vector3d(5, 10, 10));
+    ASSERT_EQ(s.tools.size(), 1u);
+    EXPECT_EQ(s.tools[0].name, "blade");
+    EXPECT_EQ(s.tools[0].shape, ToolShape::blade);
+    EXPECT_EQ(s.tools[0].size_mm, Eigen::Vector3d(40, 1, 20));
+    ASSERT_EQ(s.script.size(), 2u);
+    EXPECT_EQ(s.script[1].t_s, 1.0);
+    EXPECT_EQ(s.script[1].position_mm, Eigen::Vector3d(100, 5, -10));
+    EXPECT_EQ(s.output.mesh_every_n_frames, 10);
+}
+
+TEST(SceneExamples, Elephant)
+{
+    const Scene s = load_scene(scenes_dir / "elephant.json");
+    EXPECT_EQ(s.object.kind, ObjectKind::mesh);
+    EXPECT_EQ(s.object.file, source_dir / "data" / "elephant.off");
+    EXPECT_EQ(s.object.scale_mm_per_unit, 100.0);
+    EXPECT_EQ(s.object.voxel_mm, 1.0);
+    EXPECT_EQ(s.gravity_m_s2, Eigen::Vector3d(0, -9.81, 0));
+    ASSERT_EQ(s.tools.size(), 2u);
+    EXPECT_EQ(s.tools[0].shape, ToolShape::scalpel);
+    EXPECT_EQ(s.tools[0].size_mm, Eigen::Vector3d(30, 0.5, 8)); // the documented default
+    EXPECT_EQ(s.tools[1].shape, ToolShape::mesh);
+    EXPECT_EQ(s.tools[1].mesh, source_dir / "data" / "sphere.off");
+}
+
+TEST(SceneExamples, Cylinder)
+{
+    const Scene s = load_scene(scenes_dir / "cylinder.json");
+    EXPECT_EQ(s.object.phantom.shape, vox::grid::PhantomShape::cylinder);
+    EXPECT_EQ(s.object.phantom.radius_mm, 5.0);
+    EXPECT_EQ(s.object.phantom.length_mm, 60.0);
+    EXPECT_EQ(s.object.phantom.voxel_mm, 0.5);
+    EXPECT_EQ(s.solver.dt_s, 0.005);
+    EXPECT_EQ(s.solver.cg_max_iterations, 200); // absent: default
+    ASSERT_EQ(s.constraints.size(), 2u);
+    EXPECT_EQ(s.constraints[1].type, ConstraintType::slide);
+    EXPECT_EQ(s.constraints[1].slide_axes, (std::array<bool, 3>{true, false, false}));
+}
+
+TEST(SceneExamples, TheFormatPageShowsTheExampleScenesAsTheyAre)
+{
+    // docs/scene-format.md shows each example under a heading naming its file; a scene edited
+    // without its page (or the reverse) fails here.
+    std::ifstream in(source_dir / "docs" / "scene-format.md");
+    const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const char* name : {"liver.json", "beam.json", "elephant.json", "cylinder.json"}) {
+        SCOPED_TRACE(name);
+        const std::size_t heading = page.find("`" + std::string(name) + "`\n");
+        ASSERT_NE(heading, std::string::npos);
+        const std::size_t begin = page.find("```json\n", heading);
+        ASSERT_NE(begin, std::string::npos);
+        const std::size_t end = page.find("```\n", begin + 8);
+        ASSERT_NE(end, std::string::npos);
+        EXPECT_EQ(json::parse(page.substr(begin + 8, end - begin - 8)), read_json(scenes_dir / name));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Defaults.
+// ---------------------------------------------------------------------------------------------
+
+TEST(SceneDefaults, AbsentKeysTakeTheDocumentedDefaults)
+{
+    const Scene s = parse_scene(minimal_scene(), "/tmp/scenes", "minimal.json");
+    EXPECT_EQ(s.object.phantom.shape, vox::grid::PhantomShape::beam);
+    EXPECT_EQ(s.object.phantom.size_mm, Eigen::Vector3d(200, 10, 10));
+    EXPECT_EQ(s.object.phantom.voxel_mm, 1.0);
+    EXPECT_EQ(s.default_material.youngs_modulus_pa, 3e4);
+    EXPECT_EQ(s.default_material.poisson_ratio, 0.45);
+    EXPECT_EQ(s.default_material.density_kg_m3, 1000.0);
+    EXPECT_TRUE(s.label_materials.empty());
+    EXPECT_EQ(s.solver.type, SolverType::dbg);
+    EXPECT_EQ(s.solver.dt_s, 0.01);
+    EXPECT_EQ(s.solver.cg_tolerance, 1e-6);
+    EXPECT_EQ(s.solver.cg_max_iterations, 200);
+    EXPECT_EQ(s.gravity_m_s2, Eigen::Vector3d(0, 0, -9.81));
+    EXPECT_TRUE(s.constraints.empty());
+    EXPECT_TRUE(s.tools.empty());
+    EXPECT_TRUE(s.script.empty());
+    EXPECT_EQ(s.output.dir, fs::path("/tmp/scenes/out"));
+    EXPECT_EQ(s.output.mesh_every_n_frames, 10);
+}
+
+TEST(SceneDefaults, EmptySectionsTakeTheDefaultsToo)
+{
+    json doc = minimal_scene();
+    doc["materials"] = json::object();
+    doc["materials"]["default"] = json::object();
+    doc["solver"] = json::object();
+    doc["output"] = json::object();
+    const Scene s = parse_scene(doc, "/tmp/scenes", "empty-sections.json");
+    EXPECT_EQ(s.default_material.poisson_ratio, 0.45);
+    EXPECT_EQ(s.solver.dt_s, 0.01);
+    EXPECT_EQ(s.output.dir, fs::path("/tmp/scenes/out"));
+}
+
+TEST(SceneDefaults, EachPhantomShapeHasItsOwnDefaults)
+{
+    const auto phantom = [](const char* shape) {
+        json doc = minimal_scene();
+        doc["object"]["phantom"]["shape"] = shape;
+        return parse_scene(doc, "/tmp", "phantom.json").object.phantom;
+    };
+    EXPECT_EQ(phantom("beam").size_mm, Eigen::Vector3d(200, 10, 10));
+    EXPECT_EQ(phantom("block").size_mm, Eigen::Vector3d(20, 20, 20));
+    EXPECT_EQ(phantom("sphere").radius_mm, 10.0);
+    EXPECT_EQ(phantom("cylinder").radius_mm, 5.0);
+    EXPECT_EQ(phantom("cylinder").length_mm, 60.0);
+    const vox::grid::PhantomSpec u = phantom("utube");
+    EXPECT_EQ(u.leg_mm, 3.0);
+    EXPECT_EQ(u.gap_mm, 2.0);
+    EXPECT_EQ(u.height_mm, 16.0);
+    EXPECT_EQ(u.depth_mm, 3.0);
+    EXPECT_EQ(u.voxel_mm, 1.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accepted forms.
+// ---------------------------------------------------------------------------------------------
+
+/// A volume object selecting with `select` (the liver scan, so the file exists).
+json volume_scene(const json& select)
+{
+    return json{{"object", {{"volume", "../liver.inr.gz"}, {"select", select}, {"levels", 3}}}};
+}
+
+TEST(SceneParse, ThresholdWithOneNumberHasNoUpperBound)
+{
+    const Scene s = parse_scene(volume_scene({{"threshold", 226}}), scenes_dir, "t.json");
+    EXPECT_TRUE(s.object.select.labels.empty());
+    EXPECT_EQ(s.object.select.threshold_min, 226.0);
+    EXPECT_FALSE(s.object.select.threshold_max);
+}
+
+TEST(SceneParse, ThresholdPairIsInclusiveAndMayBeOneValue)
+{
+    const Scene s = parse_scene(volume_scene({{"threshold", {226, 3071}}}), scenes_dir, "t.json");
+    EXPECT_EQ(s.object.select.threshold_min, 226.0);
+    EXPECT_EQ(s.object.select.threshold_max, 3071.0);
+    const Scene one = parse_scene(volume_scene({{"threshold", {255, 255}}}), scenes_dir, "t.json");
+    EXPECT_EQ(one.object.select.threshold_max, 255.0);
+}
+
+TEST(SceneParse, SingleLabelMayOmitTheBrackets)
+{
+    const Scene s = parse_scene(volume_scene({{"label", 255}}), scenes_dir, "l.json");
+    EXPECT_EQ(s.object.select.labels, std::vector<std::int32_t>{255});
+}
+
+TEST(SceneParse, ScanWithoutSelectionKeepsEveryLabel)
+{
+    json doc = json::parse(R"({
+        "object": {"volume": "../liver.inr.gz", "levels": 3},
+        "materials": {"labels": {"85": {"density_kg_m3": 1100}}}
+    })");
+    const Scene s = parse_scene(doc, scenes_dir, "whole.json");
+    EXPECT_TRUE(s.object.select.empty());
+    // Any label is accepted here; the scan is checked against it once read.
+    EXPECT_EQ(s.material(85).density_kg_m3, 1100.0);
+}
+
+TEST(SceneParse, MeshVoxelSizeIsOptional)
+{
+    const json doc = json::parse(R"({"object": {"mesh": "../sphere.off", "levels": 0}})");
+    const Scene s = parse_scene(doc, scenes_dir, "mesh.json");
+    EXPECT_FALSE(s.object.voxel_mm);
+    EXPECT_EQ(s.object.scale_mm_per_unit, 1.0);
+}
+
+TEST(SceneParse, IsxfemIsAcceptedByTheReader)
+{
+    json doc = minimal_scene();
+    doc["solver"] = {{"type", "isxfem"}};
+    EXPECT_EQ(parse_scene(doc, "/tmp", "x.json").solver.type, SolverType::isxfem);
+}
+
+TEST(SceneParse, PathsResolveAgainstTheSceneFolder)
+{
+    json doc = json::parse(R"({
+        "object": {"mesh": "../elephant.off", "voxel_mm": 0.01, "levels": 0},
+        "tools": [{"name": "stylus", "shape": "mesh", "mesh": "./../sphere.off"}],
+        "output": {"dir": "results/../run1"}
+    })");
+    const Scene s = parse_scene(doc, scenes_dir, "paths.json");
+    EXPECT_EQ(s.object.file, source_dir / "data" / "elephant.off");
+    EXPECT_EQ(s.tools[0].mesh, source_dir / "data" / "sphere.off");
+    EXPECT_EQ(s.output.dir, scenes_dir / "run1");
+    EXPECT_TRUE(s.object.file.is_absolute());
+
+    // An absolute path stays as it is.
+    doc["output"]["dir"] = "/var/tmp/vox-run";
+    EXPECT_EQ(parse_scene(doc, scenes_dir, "paths.json").output.dir, fs::path("/var/tmp/vox-run"));
+
+    // The same file names seen from another folder do not exist.
+    const std::string message = error_of([&] { static_cast<void>(parse_scene(doc, "/nonexistent/scenes", "p.json")); });
+    EXPECT_EQ(message, "p.json: object.mesh: file not found: /nonexistent/elephant.off");
+}
+
+TEST(SceneParse, RelativeFolderIsMadeAbsolute)
+{
+    const Scene s = parse_scene(minimal_scene(), "some/folder", "r.json");
+    EXPECT_TRUE(s.folder.is_absolute());
+    EXPECT_EQ(s.output.dir, (fs::current_path() / "some/folder/out").lexically_normal());
+}
+
+TEST(SceneParse, CommentsAreAllowed)
+{
+    const fs::path path = write_temp("scene_with_comments.json", R"({
+        // a block phantom
+        "object": {"phantom": {"shape": "block"}, /* the finest level */ "levels": 0}
+    })");
+    EXPECT_EQ(load_scene(path).object.phantom.shape, vox::grid::PhantomShape::block);
+}
+
+TEST(SceneParse, ErrorsFoundLaterUseTheSameFormat)
+{
+    const Scene s = parse_scene(minimal_scene(), "/tmp", "scenes/beam.json");
+    EXPECT_EQ(std::string(s.error("constraints[0].box_mm", "catches no node").what()),
+              "scenes/beam.json: constraints[0].box_mm: catches no node");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed scenes: each names the file and the exact key path.
+// ---------------------------------------------------------------------------------------------
+
+struct BadScene {
+    const char* name;     ///< tests/data/bad/scene_NAME.json
+    const char* key_path; ///< the message is "FILE: KEY_PATH: ..."; empty for the top level
+    const char* problem;  ///< part of the rest of the message
+};
+
+void PrintTo(const BadScene& b, std::ostream* os) { *os << b.name; }
+
+const BadScene bad_scenes[] = {
+    BadScene{"unknown_key", "toolz", "unknown key (known keys: object, materials, solver, gravity_m_s2"},
+    BadScene{"unknown_phantom_key", "object.phantom.radius_mm",
+             "unknown key for a beam phantom (known keys: shape, voxel_mm, size_mm)"},
+    BadScene{"wrong_type", "object.select.label[0]", "expected an integer, got \"abc\""},
+    BadScene{"missing_file", "object.volume", "file not found: "},
+    BadScene{"negative_dt", "solver.dt_s", "must be > 0, got -0.01"},
+    BadScene{"empty_tool_name", "tools[0].name", "a tool needs a name"},
+    BadScene{"duplicate_tool_name", "tools[1].name", "a tool named \"blade\" is already declared (tools[0])"},
+    BadScene{"undeclared_tool", "script[1].tool", "no tool named \"blad\" in tools (declared: \"blade\")"},
+    BadScene{"time_order", "script[2].t_s", "0.5 s is before the previous entry's 1 s"},
+    BadScene{"poisson_ratio", "materials.default.poisson_ratio", "must be in (-1, 0.5), got 0.5"},
+    BadScene{"two_sources", "object", "takes only one of \"volume\", \"phantom\", \"mesh\""},
+    BadScene{"no_object", "object", "required key is missing"},
+    BadScene{"inverted_box", "constraints[0].box_mm", "min corner is above max corner along y (10 > 0)"},
+    BadScene{"levels_range", "object.levels", "must be in [0, 6], got 7"},
+    BadScene{"levels_float", "object.levels", "expected an integer, got 2.5"},
+    BadScene{"syntax", "line 3 column 29", "syntax error"},
+    BadScene{"duplicate_key", "solver.dt_s", "key given twice"},
+    BadScene{"threshold_order", "object.select.threshold", "lower bound 3071 is above upper bound 226"},
+    BadScene{"solver_type", "solver.type", "expected one of \"dbg\", \"isxfem\", got \"fem\""},
+    BadScene{"unselected_label", "materials.labels.127", "label 127 is not in object.select.label"},
+    BadScene{"slide_axis", "constraints[0].axes[1]", "expected one of \"x\", \"y\", \"z\", got \"w\""},
+    BadScene{"slide_all_axes", "constraints[0].axes", "lists every axis"},
+    BadScene{"fixed_with_axes", "constraints[0].axes", "unknown key for a fixed constraint"},
+    BadScene{"not_object", "", "expected an object, got [{\"object\":{}}]"},
+    BadScene{"cg_tolerance", "solver.cg_tolerance", "must be in (0, 1), got 1"},
+    BadScene{"voxel_zero", "object.phantom.voxel_mm", "must be > 0, got 0"},
+    BadScene{"phantom_too_thin", "object.phantom.size_mm[1]", "0.5 mm is not a whole number of 1 mm voxels"},
+    BadScene{"voxel_misfit", "object.phantom.voxel_mm",
+             "the default size_mm[0] gives 200 mm, which is not a whole number of 3 mm voxels"},
+    BadScene{"sphere_radius", "object.phantom.radius_mm", "the diameter 4.5 mm is not a whole number of 1 mm voxels"},
+    BadScene{"utube_height", "object.phantom.height_mm", "must exceed its leg_mm"},
+    BadScene{"phantom_label_material", "materials.labels.1",
+             "only a scan selected by label (or taken whole) has labels"},
+    BadScene{"phantom_shape", "object.phantom.shape", "expected one of \"beam\", \"block\""},
+    BadScene{"tool_unknown_key", "tools[0].radius_mm", "unknown key for a blade tool"},
+    BadScene{"blade_without_size", "tools[0].size_mm", "required key is missing"},
+    BadScene{"missing_tool_mesh", "tools[0].mesh", "file not found: "},
+    BadScene{"script_unknown_key", "script[0].speed_mm_s", "unknown key"},
+    BadScene{"negative_time", "script[0].t_s", "must be >= 0, got -1"},
+    BadScene{"position_size", "script[0].position_mm", "expected an array of 3 numbers, got [0,0]"},
+    BadScene{"missing_levels", "object.levels", "required key is missing"},
+    BadScene{"empty_label", "object.select.label", "must list at least one label"},
+    BadScene{"label_and_threshold", "object.select", "takes only one of \"label\", \"threshold\""},
+    BadScene{"label_key", "materials.labels.abc", "expected an integer label as key"},
+    BadScene{"label_density", "materials.labels.255.density_kg_m3", "must be > 0, got -1"},
+    BadScene{"youngs_zero", "materials.default.youngs_modulus_pa", "must be > 0, got 0"},
+    BadScene{"gravity_type", "gravity_m_s2", "expected an array of 3 numbers, got \"down\""},
+    BadScene{"mesh_every_zero", "output.mesh_every_n_frames", "must be >= 1, got 0"},
+    BadScene{"output_dir_empty", "output.dir", "expected a path, got an empty string"}};
+
+class SceneBadFile : public testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneBadFile, NamesTheFileAndTheKeyPath)
+{
+    const BadScene& bad = GetParam();
+    const std::string file = (bad_dir / ("scene_" + std::string(bad.name) + ".json")).string();
+    ASSERT_TRUE(fs::exists(file)) << file;
+    const std::string message = error_of([&] { static_cast<void>(load_scene(file)); });
+    const std::string prefix = file + ": " + (*bad.key_path ? std::string(bad.key_path) + ": " : "");
+    EXPECT_EQ(message.substr(0, prefix.size()), prefix) << message;
+    EXPECT_NE(message.find(bad.problem, prefix.size()), std::string::npos) << message;
+}
+
+INSTANTIATE_TEST_SUITE_P(Scene, SceneBadFile, testing::ValuesIn(bad_scenes),
+                         [](const testing::TestParamInfo<BadScene>& param) { return std::string(param.param.name); });
+
+TEST(SceneMalformed, EveryBadSceneFileIsInTheTable)
+{
+    // A bad scene added without a table entry would never be checked.
+    std::set<std::string> files;
+    for (const fs::directory_entry& entry : fs::directory_iterator(bad_dir)) {
+        const std::string name = entry.path().filename().string();
+        if (name.rfind("scene_", 0) == 0) {
+            files.insert(name);
+        }
+    }
+    std::set<std::string> listed;
+    for (const BadScene& bad : bad_scenes) {
+        listed.insert("scene_" + std::string(bad.name) + ".json");
+    }
+    EXPECT_EQ(files, listed);
+}
+
+TEST(SceneMalformed, WrongTypeMessageIsExact)
+{
+    const std::string file = (bad_dir / "scene_wrong_type.json").string();
+    EXPECT_EQ(error_of([&] { static_cast<void>(load_scene(file)); }),
+              file + ": object.select.label[0]: expected an integer, got \"abc\"");
+}
+
+TEST(SceneMalformed, MissingFileNamesTheResolvedPath)
+{
+    const std::string file = (bad_dir / "scene_missing_file.json").string();
+    EXPECT_EQ(error_of([&] { static_cast<void>(load_scene(file)); }),
+              file + ": object.volume: file not found: " + (bad_dir / "no_such_scan.inr.gz").string());
+}
+
+TEST(SceneMalformed, MissingSceneFileIsNamed)
+{
+    const std::string file = (bad_dir / "scene_that_does_not_exist.json").string();
+    const std::string message = error_of([&] { static_cast<void>(load_scene(file)); });
+    EXPECT_EQ(message.rfind(file + ": ", 0), 0u) << message;
+}
+
+TEST(SceneMalformed, DuplicateKeysInsideArraysNameTheElement)
+{
+    const fs::path path = write_temp("scene_duplicate_in_array.json", R"({
+        "object": {"phantom": {"shape": "beam"}, "levels": 0},
+        "constraints": [
+            {"type": "fixed", "box_mm": [[0, 0, 0], [1, 1, 1]]},
+            {"type": "fixed", "box_mm": [[0, 0, 0], [1, 1, 1]], "type": "slide"}
+        ]
+    })");
+    EXPECT_EQ(error_of([&] { static_cast<void>(load_scene(path)); }),
+              path.string() + ": constraints[1].type: key given twice");
+}
+
+TEST(SceneMalformed, OddKeysAreQuotedInThePath)
+{
+    json doc = minimal_scene();
+    doc["solver"] = {{"dt s", 0.01}};
+    EXPECT_EQ(error_of([&] { static_cast<void>(parse_scene(doc, "/tmp", "odd.json")); }).rfind(
+                  "odd.json: solver[\"dt s\"]: unknown key", 0),
+              0u);
+}
+
+/// Every JSON object in `value` (the top level included), as a JSON pointer and a key path.
+void collect_objects(const json& value, const json::json_pointer& pointer, const std::string& path,
+                     std::vector<std::pair<json::json_pointer, std::string>>& out)
+{
+    if (value.is_object()) {
+        out.emplace_back(pointer, path);
+        for (const auto& [key, member] : value.items()) {
+            collect_objects(member, pointer / key, path.empty() ? key : path + "." + key, out);
+        }
+    } else if (value.is_array()) {
+        for (std::size_t i = 0; i < value.size(); ++i) {
+            collect_objects(value[i], pointer / i, path + "[" + std::to_string(i) + "]", out);
+        }
+    }
+}
+
+TEST(SceneMalformed, UnknownKeyIsRefusedAtEveryNestingLevel)
+{
+    // Between them the examples hold every kind of JSON object the format has.
+    std::size_t checked = 0;
+    for (const char* name : {"liver.json", "beam.json", "elephant.json", "cylinder.json"}) {
+        const json original = read_json(scenes_dir / name);
+        std::vector<std::pair<json::json_pointer, std::string>> objects;
+        collect_objects(original, json::json_pointer(), "", objects);
+        for (const auto& [pointer, path] : objects) {
+            json doc = original;
+            doc[pointer]["bogus_key"] = 1;
+            const std::string key_path = path.empty() ? "bogus_key" : path + ".bogus_key";
+            SCOPED_TRACE(std::string(name) + " " + key_path);
+            const std::string message = error_of([&] { static_cast<void>(parse_scene(doc, scenes_dir, name)); });
+            EXPECT_EQ(message.rfind(std::string(name) + ": " + key_path + ": ", 0), 0u) << message;
+            ++checked;
+        }
+    }
+    EXPECT_GE(checked, 30u);
+}
+
+} // namespace

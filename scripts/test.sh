@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Command 2 of the README: install, build, and run the whole test suite; non-zero on any failure.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+bash "$root/scripts/build.sh"
+cd "$build"
+ctest --output-on-failure --no-tests=error --parallel "${JOBS:-$(nproc)}" "$@"

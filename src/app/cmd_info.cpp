@@ -1,0 +1,171 @@
+// voxsculpt info: what a volume, label grid or mesh file holds. The JSON form is the reference;
+// the text form prints the same fields.
+
+#include "app/commands.hpp"
+#include "core/error.hpp"
+#include "io/mesh.hpp"
+#include "io/object_import.hpp"
+#include "io/volume_reader.hpp"
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <map>
+
+namespace vox::app {
+namespace {
+
+using nlohmann::json;
+
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+json matrix(const Eigen::Matrix4d& m)
+{
+    json rows = json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+    return rows;
+}
+
+/// World bounding box (mm) of the voxel boxes with indices in [lo, hi]: the 8 corners of
+/// [lo - 0.5, hi + 0.5] mapped through the index-to-world transform.
+json world_bbox(const Eigen::Matrix4d& t, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
+{
+    Eigen::Vector3d mn = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d mx = -mn;
+    for (int c = 0; c < 8; ++c) {
+        const Eigen::Vector3d ijk((c & 1 ? hi.x() + 0.5 : lo.x() - 0.5), (c & 2 ? hi.y() + 0.5 : lo.y() - 0.5),
+                                  (c & 4 ? hi.z() + 0.5 : lo.z() - 0.5));
+        const Eigen::Vector3d w = (t * ijk.homogeneous()).head<3>();
+        mn = mn.cwiseMin(w);
+        mx = mx.cwiseMax(w);
+    }
+    return {{"min", vec(mn)}, {"max", vec(mx)}};
+}
+
+json volume_info(const std::string& path)
+{
+    const io::Volume v = io::read_volume(path);
+    std::map<double, std::uint64_t> counts;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    std::uint64_t nonzero = 0;
+    bool integral = true;
+    for (std::int64_t n = 0; n < v.voxel_count(); ++n) {
+        const double s = v.stored(n);
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+        if (s != 0.0) ++nonzero;
+        // A histogram is useful for label maps; stop counting when the values are a continuum.
+        if (integral && counts.size() <= 1024) ++counts[s];
+        if (s != static_cast<double>(static_cast<std::int64_t>(s))) integral = false;
+    }
+    json j{{"file", path},
+           {"kind", "volume"},
+           {"scalar_type", io::scalar_name(v.type)},
+           {"dimensions", {v.dims[0], v.dims[1], v.dims[2]}},
+           {"spacing_mm", vec(v.spacing())},
+           {"index_to_world", matrix(v.index_to_world)},
+           {"world_bbox_mm", world_bbox(v.index_to_world, Eigen::Vector3d::Zero(),
+                                        Eigen::Vector3d(v.dims[0] - 1, v.dims[1] - 1, v.dims[2] - 1))},
+           {"active_voxels", nonzero},
+           {"stored_range", {lo, hi}},
+           {"scaling", {{"slope", v.scale_slope}, {"intercept", v.scale_intercept}}}};
+    if (integral && counts.size() <= 1024) {
+        json hist = json::object();
+        for (const auto& [value, n] : counts)
+            if (value != 0.0) hist[std::to_string(static_cast<std::int64_t>(value))] = n;
+        j["labels"] = hist;
+    }
+    return j;
+}
+
+json vdb_info(const std::string& path)
+{
+    const grid::LabelGrid g = grid::LabelGrid::load(path);
+    const grid::IndexBox box = g.index_bounds();
+    json hist = json::object();
+    for (const auto& [label, n] : g.label_histogram()) hist[std::to_string(label)] = n;
+    json j{{"file", path},
+           {"kind", "label grid"},
+           {"scalar_type", "int32"},
+           {"spacing_mm", vec(g.voxel_size())},
+           {"index_to_world", matrix(g.index_to_world())},
+           {"active_voxels", g.active_voxel_count()},
+           {"labels", hist}};
+    if (!box.empty()) {
+        const Eigen::Vector3i d = box.max - box.min + Eigen::Vector3i::Ones();
+        j["dimensions"] = {d.x(), d.y(), d.z()};
+        j["index_bbox"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
+                           {"max", {box.max.x(), box.max.y(), box.max.z()}}};
+        j["world_bbox_mm"] = world_bbox(g.index_to_world(), box.min.cast<double>(), box.max.cast<double>());
+    }
+    const std::string source = g.metadata("source");
+    if (!source.empty()) j["source"] = source;
+    return j;
+}
+
+json mesh_info_json(const std::string& path)
+{
+    const io::MeshInfo m = io::mesh_info(io::read_mesh(path));
+    return {{"file", path},
+            {"kind", "mesh"},
+            {"vertices", m.vertices},
+            {"faces", m.triangles},
+            {"boundary_edges", m.boundary_edges},
+            {"non_manifold_edges", m.non_manifold_edges},
+            {"closed", m.closed},
+            {"consistently_oriented", m.consistently_oriented},
+            {"area_mm2", m.area_mm2},
+            {"enclosed_volume_mm3", m.enclosed_volume_mm3},
+            {"world_bbox_mm", {{"min", vec(m.bbox_min)}, {"max", vec(m.bbox_max)}}}};
+}
+
+void print_text(const json& j)
+{
+    for (const auto& [key, value] : j.items()) {
+        if (key == "labels") {
+            std::printf("labels (label: voxels):\n");
+            for (const auto& [label, n] : value.items()) std::printf("  %s: %s\n", label.c_str(), n.dump().c_str());
+        } else if (key == "index_to_world") {
+            std::printf("index_to_world:\n");
+            for (const auto& row : value) std::printf("  %s\n", row.dump().c_str());
+        } else if (value.is_string()) {
+            std::printf("%s: %s\n", key.c_str(), value.get<std::string>().c_str());
+        } else {
+            std::printf("%s: %s\n", key.c_str(), value.dump().c_str());
+        }
+    }
+}
+
+} // namespace
+
+void add_info_command(CLI::App& app)
+{
+    struct Args {
+        std::string input;
+        bool as_json = false;
+    };
+    auto args = std::make_shared<Args>();
+    CLI::App* cmd = app.add_subcommand("info", "Describe a volume, .vdb label grid or mesh file");
+    cmd->add_option("file", args->input, "The file to describe")->required();
+    cmd->add_flag("--json", args->as_json, "Print JSON instead of text");
+    cmd->callback([args] {
+        const std::string& p = args->input;
+        json j;
+        if (io::is_mesh_path(p))
+            j = mesh_info_json(p);
+        else if (p.size() > 4 && p.compare(p.size() - 4, 4, ".vdb") == 0)
+            j = vdb_info(p);
+        else
+            j = volume_info(p);
+        if (args->as_json)
+            std::cout << j.dump(2) << '\n';
+        else
+            print_text(j);
+    });
+}
+
+} // namespace vox::app

@@ -1,0 +1,16 @@
+#pragma once
+// The voxsculpt subcommands. Each registers itself on the program's CLI11 app; its callback runs
+// after parsing and reports bad input by throwing vox::InputError (exit code 2).
+
+namespace CLI {
+class App;
+}
+
+namespace vox::app {
+
+void add_import_command(CLI::App& app);
+void add_info_command(CLI::App& app);
+void add_phantom_command(CLI::App& app);
+void add_check_command(CLI::App& app);
+
+} // namespace vox::app

@@ -1,0 +1,53 @@
+#include "io/object_import.hpp"
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/mesh.hpp"
+#include "io/mesh_voxelizer.hpp"
+#include "io/volume_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace vox::io {
+namespace {
+std::string lower_extension(const std::string& path)
+{
+    const auto dot = path.find_last_of('.');
+    std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+} // namespace
+
+bool is_mesh_path(const std::string& path)
+{
+    const std::string ext = lower_extension(path);
+    return ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".off";
+}
+
+grid::LabelGrid import_object(const std::string& path, const ImportOptions& options)
+{
+    if (is_mesh_path(path)) {
+        if (!options.selection.empty())
+            throw file_error(path, "--label and --threshold select voxels of volumes; a mesh is voxelised whole");
+        const TriangleMesh mesh = read_mesh(path, options.mm_per_unit);
+        const MeshInfo info = mesh_info(mesh);
+        const double h = options.voxel_mm ? *options.voxel_mm : default_voxel_mm(info);
+        VoxelizeOptions voxelize;
+        voxelize.name = path;
+        grid::LabelGrid grid = voxelize_mesh(mesh, h, voxelize);
+        if (!options.voxel_mm) log::info("{}: voxel size {:.6g} mm (longest side / 128; set --voxel-size)", path, h);
+        grid.set_metadata("source", path);
+        return grid;
+    }
+    if (options.voxel_mm || options.mm_per_unit != 1.0)
+        throw file_error(path, "--voxel-size and --scale apply to meshes; a volume keeps its own voxels");
+    if (lower_extension(path) == ".vdb") return select_labels(grid::LabelGrid::load(path), options.selection, path);
+    if (is_volume_path(path)) return select_voxels(read_volume(path), options.selection);
+    throw file_error(path, "unknown file type (expected a volume .inr[.gz] .nii[.gz] .mhd .mha .nrrd .nhdr .vdb, "
+                           "or a mesh .obj .ply .stl .off)");
+}
+
+} // namespace vox::io

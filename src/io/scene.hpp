@@ -1,0 +1,173 @@
+#pragma once
+// Scene files: one JSON document saying what to simulate (the object, its materials, the solver,
+// gravity, constraints, tools, a tool script and the output). Users' reference:
+// docs/scene-format.md. Every key carries its unit in its name; the reader is strict: an unknown
+// key, a wrong type, a value out of range or a missing file is an InputError naming the key path.
+
+#include "core/error.hpp"
+#include "grid/phantom.hpp"
+#include "io/selection.hpp"
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vox::io {
+
+/// Where the object's voxels come from.
+enum class ObjectKind {
+    volume,  ///< a scan volume (CT, MRI segmentation) and a selection of its voxels
+    phantom, ///< a generated shape
+    mesh,    ///< a closed triangle mesh, voxelised
+};
+
+/// The object to simulate: its source, and the coarsening level it is simulated at.
+struct SceneObject {
+    ObjectKind kind = ObjectKind::phantom;
+    /// volume, mesh: the file, absolute (resolved against the scene's folder); it existed when
+    /// the scene was read.
+    std::filesystem::path file;
+    /// volume: the voxels kept (labels keep their value, a threshold window gives label 1); empty
+    /// when the scene has no "select": every non-zero voxel, keeping its value as label.
+    Selection select;
+    /// phantom: shape, sizes (mm) and voxel size (mm); every size a whole number of voxels.
+    grid::PhantomSpec phantom;
+    /// mesh: voxel edge length, mm (after scaling); unset: the longest side / 128.
+    std::optional<double> voxel_mm;
+    /// mesh: millimetres per mesh unit (the mesh's vertices are multiplied by it).
+    double scale_mm_per_unit = 1.0;
+    /// The coarsening level simulated, 0..6: an element spans 2^levels voxels per axis.
+    int levels = 0;
+};
+
+/// Linear elastic material, SI units.
+struct Material {
+    /// Young's modulus E, Pa (> 0).
+    double youngs_modulus_pa = 3e4;
+    /// Poisson's ratio nu, dimensionless, in (-1, 0.5).
+    double poisson_ratio = 0.45;
+    /// Mass density, kg/m^3 (> 0).
+    double density_kg_m3 = 1000.0;
+};
+
+/// The cutting approach (see DESIGN.md): dynamic branched grid, or tetrahedra with Is-XFEM.
+enum class SolverType { dbg, isxfem };
+
+/// Time stepping and linear solve.
+struct SolverSettings {
+    SolverType type = SolverType::dbg;
+    /// Time step, s (> 0).
+    double dt_s = 0.01;
+    /// Relative residual at which the conjugate-gradient solve stops, in (0, 1).
+    double cg_tolerance = 1e-6;
+    /// Conjugate-gradient iteration cap per solve (>= 1).
+    int cg_max_iterations = 200;
+};
+
+enum class ConstraintType {
+    fixed, ///< the nodes do not move
+    slide, ///< the nodes move only along the listed world axes
+};
+
+/// Boundary condition on the nodes whose rest position lies in an axis-aligned box, boundary
+/// included. A box that catches no node is an error found when the grid exists.
+struct Constraint {
+    ConstraintType type = ConstraintType::fixed;
+    /// Box corner with the smallest coordinates, world mm.
+    Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();
+    /// Box corner with the largest coordinates, world mm (>= box_min_mm on every axis).
+    Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
+    /// slide: true for each world axis (x, y, z) the nodes may move along; one or two are true.
+    std::array<bool, 3> slide_axes{false, false, false};
+};
+
+enum class ToolShape {
+    blade,   ///< a thin box
+    scalpel, ///< a pointed surgical blade
+    sphere,  ///< a ball
+    mesh,    ///< any closed triangle mesh
+};
+
+/// A tool the script (or a haptic device) moves. Lengths in the tool's own frame, mm.
+struct ToolSpec {
+    /// Unique, non-empty; the script refers to the tool by it.
+    std::string name;
+    ToolShape shape = ToolShape::blade;
+    /// blade, scalpel: extent along the tool's x (length), y (thickness), z (height), mm; a
+    /// scalpel without size_mm is 30 x 0.5 x 8.
+    Eigen::Vector3d size_mm = Eigen::Vector3d::Zero();
+    /// sphere: radius, mm.
+    double radius_mm = 0.0;
+    /// mesh: the tool's surface mesh (vertices in mm), absolute; it existed when read.
+    std::filesystem::path mesh;
+};
+
+/// One key frame of the tool script: where a tool is at a time. Between two key frames of a tool
+/// it moves in a straight line at constant speed; before its first and after its last it stays.
+struct ScriptEntry {
+    /// Simulated time, s (>= 0; entries are in non-decreasing time order).
+    double t_s = 0.0;
+    /// The tool's name, as declared in Scene::tools.
+    std::string tool;
+    /// Index of that tool in Scene::tools.
+    std::size_t tool_index = 0;
+    /// Position of the tool's origin, world mm.
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+};
+
+/// What a run writes, and where.
+struct OutputSettings {
+    /// Output folder, absolute (given relative to the scene's folder; default "out").
+    std::filesystem::path dir;
+    /// A surface mesh is written every this many frames (>= 1).
+    int mesh_every_n_frames = 10;
+};
+
+/// A whole scene file, validated; paths absolute.
+struct Scene {
+    /// The scene file's name as given (e.g. "scenes/liver.json"): every message starts with it.
+    std::string source;
+    /// Absolute folder the scene's relative paths were resolved against.
+    std::filesystem::path folder;
+
+    SceneObject object;
+    /// Material of every voxel whose label has no entry in label_materials.
+    Material default_material;
+    /// Materials by voxel label (scans selected by label, or taken whole); keys the file did not
+    /// set come from default_material.
+    std::map<std::int32_t, Material> label_materials;
+    SolverSettings solver;
+    /// Gravitational acceleration in the world frame, m/s^2.
+    Eigen::Vector3d gravity_m_s2{0.0, 0.0, -9.81};
+    std::vector<Constraint> constraints;
+    std::vector<ToolSpec> tools;
+    /// Tool key frames in time order.
+    std::vector<ScriptEntry> script;
+    OutputSettings output;
+
+    /// The material of voxels carrying `label`.
+    [[nodiscard]] const Material& material(std::int32_t label) const;
+    /// An error about this scene found after reading it (e.g. a constraint box that catches no
+    /// node): "SOURCE: KEY_PATH: PROBLEM", key_path as "constraints[0].box_mm".
+    [[nodiscard]] InputError error(std::string_view key_path, std::string_view problem) const;
+};
+
+/// Reads and validates a scene file. Comments (// and /* */) are allowed in it. Throws
+/// InputError "FILE: key.path: problem", or "FILE: line L column C: problem" for bad JSON.
+[[nodiscard]] Scene load_scene(const std::filesystem::path& path);
+
+/// Validates an already parsed scene document. Relative paths are resolved against `folder`;
+/// messages start with `name_for_messages`.
+[[nodiscard]] Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& folder,
+                                const std::string& name_for_messages);
+
+} // namespace vox::io

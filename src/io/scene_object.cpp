@@ -1,0 +1,76 @@
+#include "io/scene_object.hpp"
+
+#include "grid/coarse_cells.hpp"
+#include "grid/phantom.hpp"
+#include "io/object_import.hpp"
+
+#include <sstream>
+
+namespace vox::io {
+
+grid::LabelGrid load_scene_object(const Scene& scene)
+{
+    const SceneObject& o = scene.object;
+    switch (o.kind) {
+    case ObjectKind::phantom: {
+        grid::LabelGrid g = grid::make_phantom(o.phantom);
+        g.set_metadata("source", std::string("phantom ") + grid::phantom_shape_name(o.phantom.shape));
+        return g;
+    }
+    case ObjectKind::mesh: {
+        ImportOptions options;
+        options.voxel_mm = o.voxel_mm;
+        options.mm_per_unit = o.scale_mm_per_unit;
+        return import_object(o.file.string(), options);
+    }
+    case ObjectKind::volume: {
+        ImportOptions options;
+        options.selection = o.select;
+        return import_object(o.file.string(), options);
+    }
+    }
+    throw scene.error("object", "unknown object kind");
+}
+
+void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
+{
+    if (scene.constraints.empty()) return;
+    const int level = scene.object.levels;
+    const std::vector<grid::Coord> cells = grid::occupied_cells(labels, level);
+    for (std::size_t c = 0; c < scene.constraints.size(); ++c) {
+        const Constraint& con = scene.constraints[c];
+        const double tol = 1e-9 * (1.0 + con.box_max_mm.cwiseAbs().maxCoeff() + con.box_min_mm.cwiseAbs().maxCoeff());
+        bool caught = false;
+        for (const grid::Coord& cell : cells) {
+            for (int corner = 0; corner < 8 && !caught; ++corner) {
+                const Eigen::Vector3d p = grid::cell_corner_world(labels, cell, level, corner);
+                caught = (p.array() >= con.box_min_mm.array() - tol).all() &&
+                         (p.array() <= con.box_max_mm.array() + tol).all();
+            }
+            if (caught) break;
+        }
+        if (!caught) {
+            const grid::IndexBox box = labels.index_bounds();
+            const grid::Coord lo(box.min.x() >> level, box.min.y() >> level, box.min.z() >> level);
+            const grid::Coord hi(box.max.x() >> level, box.max.y() >> level, box.max.z() >> level);
+            std::ostringstream os;
+            os << "catches no node at level " << level << " (nodes sit at element corners, from ("
+               << grid::cell_corner_world(labels, lo, level, 0).transpose() << ") to ("
+               << grid::cell_corner_world(labels, hi, level, 7).transpose() << ") mm)";
+            throw scene.error("constraints[" + std::to_string(c) + "].box_mm", os.str());
+        }
+    }
+}
+
+MaterialCoverage material_coverage(const Scene& scene, const grid::LabelGrid& labels)
+{
+    MaterialCoverage m;
+    const auto hist = labels.label_histogram();
+    for (const auto& [label, n] : hist)
+        if (!scene.label_materials.count(label)) m.using_default.push_back(label);
+    for (const auto& [label, mat] : scene.label_materials)
+        if (!hist.count(label)) m.unused.push_back(label);
+    return m;
+}
+
+} // namespace vox::io

@@ -1,0 +1,40 @@
+#pragma once
+// Which voxels of a scan become the object: by label, by a value window, or every non-zero voxel.
+
+#include "grid/label_grid.hpp"
+#include "io/volume.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vox::io {
+
+/// At most one of `labels` and `threshold_min` is set. With labels, voxels whose stored value is
+/// one of them keep that label. With a threshold, voxels whose scaled value (slope * stored +
+/// intercept, e.g. Hounsfield units) lies in [threshold_min, threshold_max] (inclusive; no upper
+/// bound when max is unset) get label 1. With neither, every non-zero voxel keeps its value as label.
+struct Selection {
+    std::vector<std::int32_t> labels;
+    std::optional<double> threshold_min;
+    std::optional<double> threshold_max;
+
+    [[nodiscard]] bool empty() const { return labels.empty() && !threshold_min; }
+    /// "label 255", "threshold [226, 3071]", "every non-zero voxel": for messages.
+    [[nodiscard]] std::string describe() const;
+};
+
+/// Parses "LO" or "LO:HI" (inclusive). Throws InputError on malformed text or LO > HI.
+[[nodiscard]] Selection parse_threshold(const std::string& text);
+
+/// The selected voxels of a scan, in an int grid with the scan's index-to-world transform.
+/// Throws InputError naming the scan when nothing is selected (listing the values present) or
+/// when, without a selection, a non-zero value is not an integer label.
+[[nodiscard]] grid::LabelGrid select_voxels(const Volume& volume, const Selection& selection);
+
+/// The same selection applied to an existing label grid (a .vdb file); `source` names it.
+[[nodiscard]] grid::LabelGrid select_labels(const grid::LabelGrid& labels, const Selection& selection,
+                                            const std::string& source);
+
+} // namespace vox::io

@@ -1,0 +1,46 @@
+#include "app/run_command.hpp"
+
+#include <sys/wait.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace vox::test {
+namespace {
+std::string slurp(const std::filesystem::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+} // namespace
+
+std::string quote(const std::string& s)
+{
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+CommandResult run_voxsculpt(const std::string& args)
+{
+    static std::atomic<int> counter{0};
+    const auto base = std::filesystem::temp_directory_path() /
+                      ("voxsculpt-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    const std::string cmd = quote(VOX_VOXSCULPT_EXE) + " " + args + " </dev/null >" + quote(base.string() + ".out") +
+                            " 2>" + quote(base.string() + ".err");
+    const int status = std::system(cmd.c_str());
+    CommandResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(base.string() + ".out");
+    r.err = slurp(base.string() + ".err");
+    std::filesystem::remove(base.string() + ".out");
+    std::filesystem::remove(base.string() + ".err");
+    return r;
+}
+
+} // namespace vox::test
