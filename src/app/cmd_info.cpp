@@ -4,6 +4,7 @@
 #include "app/commands.hpp"
 #include "core/error.hpp"
 #include "io/mesh.hpp"
+#include "io/mesh_info.hpp"
 #include "io/object_import.hpp"
 #include "io/volume_reader.hpp"
 

@@ -12,5 +12,6 @@ void add_import_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_phantom_command(CLI::App& app);
 void add_check_command(CLI::App& app);
+void add_grid_command(CLI::App& app);
 
 } // namespace vox::app

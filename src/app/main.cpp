@@ -29,6 +29,7 @@ int main(int argc, char** argv)
     vox::app::add_info_command(app);
     vox::app::add_phantom_command(app);
     vox::app::add_check_command(app);
+    vox::app::add_grid_command(app);
 
     try {
         app.parse(argc, argv);

@@ -3,6 +3,7 @@
 
 #include "grid/label_grid.hpp"
 #include "io/mesh.hpp"
+#include "io/mesh_info.hpp"
 
 #include <cstdint>
 #include <string>

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/mesh.hpp"
+#include "io/mesh_info.hpp"
 #include "io/mesh_voxelizer.hpp"
 #include "io/volume_reader.hpp"
 

@@ -74,3 +74,30 @@ MaterialCoverage material_coverage(const Scene& scene, const grid::LabelGrid& la
 }
 
 } // namespace vox::io
+
+namespace vox::io {
+
+grid::VoxelMaterial to_voxel_material(const Material& m)
+{
+    return {grid::lame_from_young_poisson(m.youngs_modulus_pa, m.poisson_ratio), m.density_kg_m3};
+}
+
+MaterialTable material_table(const Scene& scene)
+{
+    MaterialTable t;
+    t.materials.push_back(to_voxel_material(scene.default_material));
+    for (const auto& [label, material] : scene.label_materials) {
+        t.label_index[label] = static_cast<std::int32_t>(t.materials.size());
+        t.materials.push_back(to_voxel_material(material));
+    }
+    return t;
+}
+
+MaterialTable default_material_table()
+{
+    MaterialTable t;
+    t.materials.push_back(to_voxel_material(Material{}));
+    return t;
+}
+
+} // namespace vox::io

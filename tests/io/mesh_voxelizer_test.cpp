@@ -4,6 +4,7 @@
 #include "core/log.hpp"
 #include "core/memory_limit.hpp"
 #include "io/mesh.hpp"
+#include "io/mesh_info.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

@@ -54,7 +54,7 @@ fs::path write_temp(const std::string& name, const std::string& text)
 /// The smallest valid scene: a beam phantom and nothing else.
 json minimal_scene()
 {
-    return json::parse(R"({"object": {"phantom": {"shape": "beam"}, "levels": 0}})");
+    return json::parse(R"({"object": {"phantom": {"shape": "beam"}}})");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -188,6 +188,7 @@ TEST(SceneDefaults, AbsentKeysTakeTheDocumentedDefaults)
     EXPECT_EQ(s.object.phantom.shape, vox::grid::PhantomShape::beam);
     EXPECT_EQ(s.object.phantom.size_mm, Eigen::Vector3d(200, 10, 10));
     EXPECT_EQ(s.object.phantom.voxel_mm, 1.0);
+    EXPECT_EQ(s.object.levels, 3);
     EXPECT_EQ(s.default_material.youngs_modulus_pa, 3e4);
     EXPECT_EQ(s.default_material.poisson_ratio, 0.45);
     EXPECT_EQ(s.default_material.density_kg_m3, 1000.0);
@@ -288,6 +289,18 @@ TEST(SceneParse, MeshVoxelSizeIsOptional)
     const Scene s = parse_scene(doc, scenes_dir, "mesh.json");
     EXPECT_FALSE(s.object.voxel_mm);
     EXPECT_EQ(s.object.scale_mm_per_unit, 1.0);
+}
+
+TEST(SceneParse, LevelsRangeFromZeroToSix)
+{
+    json doc = minimal_scene();
+    for (const int level : {0, 6}) {
+        doc["object"]["levels"] = level;
+        EXPECT_EQ(parse_scene(doc, "/tmp", "l.json").object.levels, level);
+    }
+    doc["object"]["levels"] = -1;
+    EXPECT_EQ(error_of([&] { static_cast<void>(parse_scene(doc, "/tmp", "l.json")); }),
+              "l.json: object.levels: must be in [0, 6], got -1");
 }
 
 TEST(SceneParse, IsxfemIsAcceptedByTheReader)
@@ -396,7 +409,6 @@ const BadScene bad_scenes[] = {
     BadScene{"script_unknown_key", "script[0].speed_mm_s", "unknown key"},
     BadScene{"negative_time", "script[0].t_s", "must be >= 0, got -1"},
     BadScene{"position_size", "script[0].position_mm", "expected an array of 3 numbers, got [0,0]"},
-    BadScene{"missing_levels", "object.levels", "required key is missing"},
     BadScene{"empty_label", "object.select.label", "must list at least one label"},
     BadScene{"label_and_threshold", "object.select", "takes only one of \"label\", \"threshold\""},
     BadScene{"label_key", "materials.labels.abc", "expected an integer label as key"},

@@ -1,6 +1,7 @@
 #include "io/winding_number.hpp"
 
 #include "io/mesh.hpp"
+#include "io/mesh_info.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,101 @@
+#pragma once
+// The Dynamic Branched Grid (Jerabkova et al. 2010, section 2): fine voxels coarsened level by level
+// into hexahedral elements. At level L the cell of voxel (i, j, k) is (i >> L, j >> L, k >> L); a
+// cell holds one element per connected component (6-connectivity through connected faces) of its
+// voxels, so a cell with disconnected material gets superimposed elements. Elements in
+// face-adjacent cells share the four nodes of their common face exactly when a voxel of one is
+// connected to a voxel of the other across it; node identity is the closure of that sharing.
+// Each element's content is its fine voxels' exact moments per material (element_moments.hpp),
+// built by the paper's direct condensation over Morton intervals; K and M follow from them.
+
+#include "core/eigen_types.hpp"
+#include "grid/element_moments.hpp"
+#include "grid/fine_voxels.hpp"
+#include "grid/voxel_material.hpp"
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace vox::grid {
+
+/// Two elements of face-adjacent cells connected through at least one voxel face: `lower` lies in
+/// the cell on the -axis side, `upper` in the cell on the +axis side.
+struct Edge {
+    std::uint32_t lower = 0;
+    std::uint32_t upper = 0;
+    std::uint8_t axis = 0;
+    friend bool operator==(const Edge&, const Edge&) = default;
+};
+
+struct Element {
+    Coord cell{0, 0, 0};                  ///< cell index at the element's level
+    std::uint64_t code = 0;               ///< Morton code of the cell relative to the grid origin
+    std::array<std::uint32_t, 8> nodes{}; ///< node ids; corner c has bits (+x, +y, +z)
+    std::uint32_t voxel_begin = 0;        ///< its fine voxels: Level::voxels[begin, begin + count)
+    std::uint32_t voxel_count = 0;
+    ElementContent content;               ///< per-material moments, cell-local
+};
+
+/// Build figures of one level, as `voxsculpt grid` reports them.
+struct LevelStats {
+    std::uint64_t cells = 0;
+    std::uint64_t elements = 0;
+    std::uint64_t nodes = 0;
+    std::uint64_t condensation_steps_direct = 0;
+    std::uint64_t condensation_steps_recursive = 0;
+    double build_ms = 0.0;
+    std::uint64_t peak_memory_bytes = 0; ///< of the whole process when the level was done
+};
+
+struct Level {
+    int level = 0;
+    std::vector<Element> elements;      ///< sorted by the Morton code of their cell
+    std::vector<std::uint32_t> voxels;  ///< fine voxel slots, element after element, each run sorted
+    std::vector<Edge> edges;            ///< sorted, unique
+    LevelStats stats;
+};
+
+class BranchedGrid {
+public:
+    struct Options {
+        /// Number level 0's nodes too (8 slots per voxel: about 0.5 s and 200 MB for the liver);
+        /// only reports need them, the simulation never runs at level 0 of a scan.
+        bool level0_nodes = false;
+    };
+
+    /// Builds levels 1 .. max_level (at most 6) from the fine voxels, each from the one below.
+    /// `materials` is indexed by FineVoxels::material().
+    BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level, const Options& options);
+    BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level)
+        : BranchedGrid(std::move(voxels), std::move(materials), max_level, Options{})
+    {
+    }
+
+    [[nodiscard]] const FineVoxels& voxels() const { return m_voxels; }
+    [[nodiscard]] const std::vector<VoxelMaterial>& materials() const { return m_materials; }
+    [[nodiscard]] int max_level() const { return static_cast<int>(m_levels.size()) - 1; }
+    /// Level 1 .. max_level(); level 0 is described by level0_stats() (its elements are the voxels).
+    [[nodiscard]] const Level& level(int l) const { return m_levels.at(static_cast<std::size_t>(l)); }
+    /// Figures of level 0: one element and one cell per voxel; nodes counted by the same rule
+    /// (0 unless Options::level0_nodes).
+    [[nodiscard]] const LevelStats& level0_stats() const { return m_levels[0].stats; }
+
+    /// Stiffness (N/m) and scalar consistent mass (kg) of element e of level l (>= 1).
+    [[nodiscard]] Matrix24d stiffness(int l, std::uint32_t e) const;
+    [[nodiscard]] Matrix8d mass(int l, std::uint32_t e) const;
+    /// Sum of all fine voxels' masses, kg.
+    [[nodiscard]] double total_mass_kg() const;
+
+private:
+    void build_level0(bool number_nodes);
+    void build_level(int l);
+
+    FineVoxels m_voxels;
+    std::vector<VoxelMaterial> m_materials;
+    std::vector<Level> m_levels; ///< [0] holds level 0's edges and stats only
+    std::vector<std::unique_ptr<MomentMatrices>> m_maps;
+};
+
+} // namespace vox::grid

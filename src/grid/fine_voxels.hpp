@@ -1,0 +1,68 @@
+#pragma once
+// The fine level of the branched grid: the object's voxels in Morton order, each with its label
+// and material, and which of the faces between face-adjacent voxels are connected (all at
+// import; a cut in "separate" mode disconnects faces without removing voxels).
+
+#include "grid/coord_map.hpp"
+#include "grid/label_grid.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <unordered_set>
+#include <vector>
+
+namespace vox::grid {
+
+class FineVoxels {
+public:
+    static constexpr std::uint32_t missing = CoordMap::missing;
+
+    /// Takes the active voxels of `labels`; `material_of(label)` gives each voxel's material index.
+    /// Throws InputError when there is no voxel or the object spans more than 2^21 voxels on an axis.
+    FineVoxels(const LabelGrid& labels, const std::function<std::int32_t(std::int32_t)>& material_of);
+
+    /// Number of voxel slots (removed voxels keep their slot; see alive()).
+    [[nodiscard]] std::uint32_t slots() const { return static_cast<std::uint32_t>(m_codes.size()); }
+    [[nodiscard]] std::uint32_t alive_count() const { return m_alive_count; }
+    [[nodiscard]] bool alive(std::uint32_t v) const { return m_alive[v] != 0; }
+
+    /// Index of the voxel at `ijk` (source index space), or `missing` (never present or removed).
+    [[nodiscard]] std::uint32_t find(const Coord& ijk) const;
+    /// Source index (i, j, k) of voxel v: the coarse cell at level L is (i >> L, j >> L, k >> L).
+    [[nodiscard]] Coord coord(std::uint32_t v) const { return m_coords[v]; }
+    /// Morton code of v's index relative to origin(); slots are sorted by it.
+    [[nodiscard]] std::uint64_t code(std::uint32_t v) const { return m_codes[v]; }
+    [[nodiscard]] std::int32_t label(std::uint32_t v) const { return m_labels[v]; }
+    [[nodiscard]] std::int32_t material(std::uint32_t v) const { return m_materials[v]; }
+    /// A multiple of 64 per axis at or below every voxel index, so that cells of every level
+    /// (up to 6) keep their boundaries when indices are taken relative to it.
+    [[nodiscard]] const Coord& origin() const { return m_origin; }
+    [[nodiscard]] const Eigen::Matrix4d& index_to_world() const { return m_index_to_world; }
+    /// Fine voxel edges in metres (the grid's mechanics are SI).
+    [[nodiscard]] const Eigen::Vector3d& voxel_size_m() const { return m_voxel_size_m; }
+
+    /// The voxel across the face of v on the +axis side, if present and the face is connected.
+    [[nodiscard]] std::uint32_t connected_neighbour(std::uint32_t v, int axis) const;
+
+    /// Removes voxel v (no-op when already removed).
+    void remove(std::uint32_t v);
+    /// Disconnects the face between v and its +axis neighbour.
+    void disconnect(std::uint32_t v, int axis);
+
+private:
+    [[nodiscard]] std::uint64_t key(const Coord& ijk) const;
+
+    Coord m_origin;
+    Eigen::Matrix4d m_index_to_world;
+    Eigen::Vector3d m_voxel_size_m;
+    std::vector<std::uint64_t> m_codes;
+    std::vector<Coord> m_coords;
+    std::vector<std::int32_t> m_labels;
+    std::vector<std::int32_t> m_materials;
+    std::vector<std::uint8_t> m_alive;
+    std::uint32_t m_alive_count = 0;
+    CoordMap m_index;                                  ///< key(ijk) -> slot
+    std::unordered_set<std::uint64_t> m_disconnected;  ///< 4 * slot + axis of disconnected +axis faces
+};
+
+} // namespace vox::grid

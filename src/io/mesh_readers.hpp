@@ -1,0 +1,52 @@
+#pragma once
+// Internal to src/io: the per-format mesh readers that read_mesh dispatches to, and what they
+// share (fan triangulation, word splitting, number parsing). Each reader returns vertices in file
+// units; read_mesh scales them to millimetres and checks the result with check_mesh.
+
+#include "io/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vox::io::detail {
+
+/// OFF, parsed by ourselves (off_reader.cpp). Throws InputError "PATH: problem" when the file is
+/// missing, malformed or truncated.
+[[nodiscard]] TriangleMesh read_off(const std::string& path);
+
+/// STL, ascii or binary, parsed by ourselves (stl_reader.cpp); vertices shared between triangles
+/// are welded by exact position. Throws InputError "PATH: problem" when the file is missing,
+/// malformed or truncated, or a corner has a non-finite coordinate.
+[[nodiscard]] TriangleMesh read_stl(const std::string& path);
+
+/// OBJ or PLY through OpenMesh (openmesh_reader.cpp). `format` ("OBJ", "PLY") names the format in
+/// messages. Throws InputError "PATH: problem" when the file is missing or unreadable, OpenMesh
+/// refuses it, or a face references a vertex that does not exist.
+[[nodiscard]] TriangleMesh read_with_openmesh(const std::string& path, const std::string& format);
+
+/// Accumulates polygons as triangle fans, skipping triangles that repeat a vertex (zero area).
+struct MeshBuilder {
+    TriangleMesh mesh;
+    std::size_t skipped_faces = 0;
+
+    /// Adds the fan (c0, c_i, c_i+1) of the polygon's corners, indices into mesh.vertices.
+    void add_polygon(const std::vector<int>& corners);
+    /// The mesh, after a warning naming `path` when faces were skipped.
+    [[nodiscard]] TriangleMesh finish(const std::string& path);
+};
+
+/// The whole of `s` as a number ("1", "-2.5e3", "+4", "nan", "inf"); nullopt for anything else.
+[[nodiscard]] std::optional<double> parse_double(std::string_view s);
+
+/// The runs of non-whitespace in `s`, in order.
+[[nodiscard]] std::vector<std::string_view> split_words(std::string_view s);
+
+/// "(x, y, z)", for messages about a point.
+[[nodiscard]] std::string format_point(const Eigen::Vector3d& p);
+
+} // namespace vox::io::detail
