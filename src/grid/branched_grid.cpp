@@ -17,30 +17,60 @@ double ms_since(Clock::time_point t) { return std::chrono::duration<double, std:
 
 Coord shift(const Coord& c, int bits) { return {c.x() >> bits, c.y() >> bits, c.z() >> bits}; }
 
-/// Node ids by the closure of face sharing: element e's corner c is slot 8 e + c; an edge joins
-/// the four corners of the lower element's +axis face to the matching corners of the upper one.
-/// Returns the number of distinct nodes among the slots of elements for which `used(e)` holds.
-template <class Used, class Assign>
-std::uint64_t number_nodes(std::size_t element_count, const std::vector<Edge>& edges, Used&& used, Assign&& assign)
+Eigen::Vector3i decode(std::uint64_t code)
 {
-    UnionFind sets(8 * element_count);
-    for (const Edge& e : edges)
-        for (int c = 0; c < 8; ++c)
-            if ((c >> e.axis) & 1) sets.unite(8 * e.lower + c, 8 * e.upper + (c ^ (1 << e.axis)));
-    std::vector<std::uint32_t> id(8 * element_count, ~std::uint32_t{0});
-    std::uint32_t next = 0;
-    for (std::uint32_t e = 0; e < element_count; ++e) {
-        if (!used(e)) continue;
-        for (int c = 0; c < 8; ++c) {
-            const std::uint32_t root = sets.find(8 * e + c);
-            if (id[root] == ~std::uint32_t{0}) id[root] = next++;
-            assign(e, c, id[root]);
-        }
+    return {static_cast<int>(morton_decode_axis(code, 0)), static_cast<int>(morton_decode_axis(code, 1)),
+            static_cast<int>(morton_decode_axis(code, 2))};
+}
+
+std::uint64_t encode(const Eigen::Vector3i& c)
+{
+    return morton_encode(static_cast<std::uint32_t>(c.x()), static_cast<std::uint32_t>(c.y()),
+                         static_cast<std::uint32_t>(c.z()));
+}
+
+void sort_unique(std::vector<std::uint64_t>& v)
+{
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+struct Condensed {
+    ElementContent content;
+    std::uint64_t steps_direct = 0;
+    std::uint64_t steps_recursive = 0;
+};
+
+/// The paper's direct condensation into exact moments: each maximal full one-material Morton
+/// interval of the element's voxels adds its box moments in one step.
+Condensed condense(const FineVoxels& fine, int l, const std::vector<std::uint32_t>& voxels)
+{
+    const std::uint64_t local_mask = (std::uint64_t{1} << (3 * l)) - 1;
+    std::vector<CellVoxel> cell;
+    cell.reserve(voxels.size());
+    for (std::uint32_t v : voxels) cell.push_back({fine.code(v) & local_mask, fine.material(v)});
+    Condensed out;
+    for (const SubNode& s : full_subnodes(cell, l)) {
+        auto it = std::lower_bound(out.content.begin(), out.content.end(), s.material,
+                                   [](const MaterialMoments& m, std::int32_t mat) { return m.material < mat; });
+        if (it == out.content.end() || it->material != s.material)
+            it = out.content.insert(it, MaterialMoments{s.material, 0, {}});
+        add_box_moments(it->moments, decode(s.first), 1 << s.level);
+        it->voxels += 1u << (3 * s.level);
+        ++out.steps_direct;
     }
-    return next;
+    out.steps_recursive = recursive_step_count(cell, l);
+    return out;
 }
 
 } // namespace
+
+std::vector<std::uint32_t> Level::cell_elements(std::uint64_t code) const
+{
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t e = cells.find(code); e != no_index; e = elements[e].next_in_cell) out.push_back(e);
+    return out;
+}
 
 BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level,
                            const Options& options)
@@ -49,146 +79,337 @@ BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materia
     if (max_level < 0 || max_level > 6) throw InputError("levels must be 0 .. 6, got " + std::to_string(max_level));
     m_levels.resize(static_cast<std::size_t>(max_level) + 1);
     m_maps.resize(m_levels.size());
+    for (std::size_t l = 0; l < m_levels.size(); ++l) {
+        m_levels[l].level = static_cast<int>(l);
+        m_maps[l] = std::make_unique<MomentMatrices>(static_cast<int>(l), m_voxels.voxel_size_m());
+    }
     build_level0(options.level0_nodes);
-    for (int l = 1; l <= max_level; ++l) build_level(l);
+    std::vector<std::uint64_t> cells;
+    cells.reserve(m_voxels.alive_count());
+    for (std::uint32_t v = 0; v < m_voxels.slots(); ++v)
+        if (m_voxels.alive(v)) cells.push_back(m_voxels.code(v) >> 3);
+    sort_unique(cells);
+    for (int l = 1; l <= max_level; ++l) {
+        const auto start = Clock::now();
+        m_levels[static_cast<std::size_t>(l)].cells = CoordMap(cells.size());
+        rebuild_cells(l, cells, true);
+        LevelStats& s = m_levels[static_cast<std::size_t>(l)].stats;
+        s.build_ms = ms_since(start);
+        s.peak_memory_bytes = peak_memory_bytes();
+        for (auto& c : cells) c >>= 3;
+        sort_unique(cells);
+    }
 }
 
 void BranchedGrid::build_level0(bool with_nodes)
 {
     const auto start = Clock::now();
-    Level& level0 = m_levels[0];
-    for (std::uint32_t v = 0; v < m_voxels.slots(); ++v) {
-        if (!m_voxels.alive(v)) continue;
-        for (std::uint8_t axis = 0; axis < 3; ++axis) {
-            const std::uint32_t w = m_voxels.connected_neighbour(v, axis);
-            if (w != FineVoxels::missing) level0.edges.push_back({v, w, axis});
-        }
-    }
-    std::sort(level0.edges.begin(), level0.edges.end(),
-              [](const Edge& a, const Edge& b) { return std::tie(a.lower, a.upper, a.axis) < std::tie(b.lower, b.upper, b.axis); });
-    LevelStats& s = level0.stats;
+    LevelStats& s = m_levels[0].stats;
     s.cells = s.elements = m_voxels.alive_count();
-    if (with_nodes)
-        s.nodes = number_nodes(m_voxels.slots(), level0.edges, [&](std::uint32_t v) { return m_voxels.alive(v); },
-                               [](std::uint32_t, int, std::uint32_t) {});
-    m_maps[0] = std::make_unique<MomentMatrices>(0, m_voxels.voxel_size_m());
+    if (with_nodes) {
+        // Slot 8 v + c is corner c of voxel v; a connected +axis face joins four corner pairs.
+        UnionFind sets(8 * std::size_t{m_voxels.slots()});
+        for (std::uint32_t v = 0; v < m_voxels.slots(); ++v) {
+            if (!m_voxels.alive(v)) continue;
+            for (int axis = 0; axis < 3; ++axis) {
+                const std::uint32_t w = m_voxels.connected_neighbour(v, axis);
+                if (w == FineVoxels::missing) continue;
+                for (int c = 0; c < 8; ++c)
+                    if ((c >> axis) & 1) sets.unite(8 * v + c, 8 * w + (c ^ (1 << axis)));
+            }
+        }
+        for (std::uint32_t v = 0; v < m_voxels.slots(); ++v)
+            if (m_voxels.alive(v))
+                for (int c = 0; c < 8; ++c) s.nodes += sets.find(8 * v + c) == 8 * v + c;
+    }
     s.build_ms = ms_since(start);
     s.peak_memory_bytes = peak_memory_bytes();
 }
 
-void BranchedGrid::build_level(int l)
+LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_codes, bool initial)
 {
-    const auto start = Clock::now();
-    const Level& below = m_levels[static_cast<std::size_t>(l) - 1];
     Level& out = m_levels[static_cast<std::size_t>(l)];
-    out.level = l;
-
-    // Children: the voxels for level 1, the elements of level l - 1 otherwise; both are sorted by
-    // the Morton code of their cell, so the children of one cell are consecutive.
+    const Level& below = m_levels[static_cast<std::size_t>(l) - 1];
     const bool from_voxels = l == 1;
-    const std::size_t child_count = from_voxels ? m_voxels.slots() : below.elements.size();
-    auto child_alive = [&](std::size_t c) { return !from_voxels || m_voxels.alive(static_cast<std::uint32_t>(c)); };
-    auto child_code = [&](std::size_t c) {
-        return from_voxels ? m_voxels.code(static_cast<std::uint32_t>(c)) : below.elements[c].code;
-    };
-    auto child_cell = [&](std::size_t c) {
-        return from_voxels ? Coord(m_voxels.coord(static_cast<std::uint32_t>(c))) : below.elements[c].cell;
-    };
+    LevelChange change;
 
-    // Components inside each cell: children joined by an edge that stays within the parent cell.
-    UnionFind sets(child_count);
-    for (const Edge& e : below.edges)
-        if ((child_code(e.lower) >> 3) == (child_code(e.upper) >> 3)) sets.unite(e.lower, e.upper);
-
-    std::vector<std::uint32_t> element_of(child_count, ~std::uint32_t{0});
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> roots; // (root child, element) within one cell
-    for (std::size_t c = 0; c < child_count;) {
-        if (!child_alive(c)) {
-            ++c;
-            continue;
-        }
-        const std::uint64_t parent = child_code(c) >> 3;
-        roots.clear();
-        ++out.stats.cells;
-        for (; c < child_count && (child_code(c) >> 3) == parent; ++c) {
-            if (!child_alive(c)) continue;
-            const std::uint32_t root = sets.find(static_cast<std::uint32_t>(c));
-            auto it = std::find_if(roots.begin(), roots.end(), [&](const auto& r) { return r.first == root; });
-            if (it == roots.end()) {
-                Element e;
-                e.cell = shift(child_cell(c), 1);
-                e.code = parent;
-                roots.emplace_back(root, static_cast<std::uint32_t>(out.elements.size()));
-                out.elements.push_back(std::move(e));
-                it = roots.end() - 1;
+    // Children of a cell and their links, at the level below (voxels for level 1).
+    auto children_of = [&](std::uint64_t cell, std::vector<std::uint32_t>& children) {
+        children.clear();
+        for (std::uint64_t o = 0; o < 8; ++o) {
+            const std::uint64_t code = cell << 3 | o;
+            if (from_voxels) {
+                const std::uint32_t v = m_voxels.find_code(code);
+                if (v != FineVoxels::missing) children.push_back(v);
+            } else {
+                for (std::uint32_t e = below.cells.find(code); e != no_index; e = below.elements[e].next_in_cell)
+                    children.push_back(e);
             }
-            element_of[c] = it->second;
+        }
+    };
+    auto child_code = [&](std::uint32_t c) { return from_voxels ? m_voxels.code(c) : below.elements[c].code; };
+    auto for_each_child_link = [&](std::uint32_t c, auto&& f) {
+        if (from_voxels)
+            m_voxels.for_each_link(c, [&](std::uint32_t t, int dir) { f(t, dir); });
+        else
+            for (const Link& link : below.elements[c].links) f(link.element, link.direction);
+    };
+    auto append_child_voxels = [&](std::uint32_t c, std::vector<std::uint32_t>& voxels) {
+        if (from_voxels)
+            voxels.push_back(c);
+        else
+            voxels.insert(voxels.end(), below.elements[c].voxels.begin(), below.elements[c].voxels.end());
+    };
+
+    if (out.parent.size() < (from_voxels ? m_voxels.slots() : below.elements.size()))
+        out.parent.resize(from_voxels ? m_voxels.slots() : below.elements.size(), no_index);
+
+    std::vector<std::uint32_t> touched;   // elements whose links must be recomputed
+    std::vector<std::uint32_t> children;
+    std::vector<std::uint32_t> component;
+    for (std::uint64_t cell : cell_codes) {
+        const std::vector<std::uint32_t> old = out.cell_elements(cell);
+        for (std::uint32_t e : old)
+            for (const Link& link : out.elements[e].links) touched.push_back(link.element);
+
+        // Components of the cell's children through links that stay inside the cell.
+        children_of(cell, children);
+        UnionFind sets(children.size());
+        for (std::size_t i = 0; i < children.size(); ++i)
+            for_each_child_link(children[i], [&](std::uint32_t t, int) {
+                if ((child_code(t) >> 3) != cell) return;
+                const auto j = std::find(children.begin(), children.end(), t) - children.begin();
+                sets.unite(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+            });
+
+        std::vector<std::uint32_t> kept;
+        std::uint32_t head = no_index, tail = no_index;
+        for (std::size_t i = 0; i < children.size(); ++i) {
+            if (sets.find(static_cast<std::uint32_t>(i)) != i) continue; // not the first child of its component
+            component.clear();
+            for (std::size_t j = i; j < children.size(); ++j)
+                if (sets.find(static_cast<std::uint32_t>(j)) == i) component.push_back(children[j]);
+            std::sort(component.begin(), component.end());
+
+            // An old element with exactly these children keeps its id (no topology change).
+            std::uint32_t id = no_index;
+            for (std::uint32_t e : old)
+                if (out.elements[e].children == component) id = e;
+            std::vector<std::uint32_t> voxels;
+            for (std::uint32_t c : component) append_child_voxels(c, voxels);
+            if (!std::is_sorted(voxels.begin(), voxels.end())) std::sort(voxels.begin(), voxels.end());
+            if (id == no_index) {
+                std::vector<std::uint32_t> came_from;
+                for (std::uint32_t e : old)
+                    if (std::any_of(voxels.begin(), voxels.end(), [&](std::uint32_t v) {
+                            return std::binary_search(out.elements[e].voxels.begin(), out.elements[e].voxels.end(), v);
+                        }))
+                        came_from.push_back(e);
+                if (!out.free_elements.empty() && !initial) {
+                    id = out.free_elements.back();
+                    out.free_elements.pop_back();
+                } else {
+                    id = static_cast<std::uint32_t>(out.elements.size());
+                    out.elements.emplace_back();
+                }
+                if (!initial) change.created.emplace_back(id, std::move(came_from));
+                Element& e = out.elements[id];
+                e.alive = true;
+                e.nodes.fill(no_index);
+                ++out.stats.elements;
+            } else {
+                kept.push_back(id);
+                if (out.elements[id].voxels != voxels) change.updated.push_back(id);
+            }
+            Element& e = out.elements[id];
+            e.code = cell;
+            e.cell = shift(from_voxels ? m_voxels.coord(component.front()) : below.elements[component.front()].cell, 1);
+            e.children = component;
+            if (e.voxels != voxels || initial) {
+                Condensed c = condense(m_voxels, l, voxels);
+                e.content = std::move(c.content);
+                out.stats.condensation_steps_direct += initial ? c.steps_direct : 0;
+                out.stats.condensation_steps_recursive += initial ? c.steps_recursive : 0;
+                e.voxels = std::move(voxels);
+            }
+            for (std::uint32_t c : component) out.parent[c] = id;
+            e.next_in_cell = no_index;
+            if (head == no_index)
+                head = id;
+            else
+                out.elements[tail].next_in_cell = id;
+            tail = id;
+            touched.push_back(id);
+        }
+        // Old elements that were not kept are removed (cell removal or split).
+        for (std::uint32_t e : old) {
+            if (std::find(kept.begin(), kept.end(), e) != kept.end()) continue;
+            Element& dead = out.elements[e];
+            for (std::uint32_t n : dead.nodes)
+                if (n != no_index && --out.node_users[n] == 0) {
+                    out.free_nodes.push_back(n);
+                    --out.stats.nodes;
+                }
+            dead = Element{};
+            out.free_elements.push_back(e);
+            change.removed.push_back(e);
+            --out.stats.elements;
+        }
+        if (old.empty() && head != no_index) ++out.stats.cells;
+        if (!old.empty() && head == no_index) --out.stats.cells;
+        out.cells.insert(cell, head);
+    }
+
+    // Links of every element built here and of every neighbour that linked to an old element:
+    // the parents of the children's links that leave the cell.
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (std::uint32_t id : touched) {
+        Element& e = out.elements[id];
+        if (!e.alive) continue;
+        e.links.clear();
+        for (std::uint32_t c : e.children)
+            for_each_child_link(c, [&](std::uint32_t t, int dir) {
+                if ((child_code(t) >> 3) != e.code) e.links.push_back({out.parent[t], static_cast<std::uint8_t>(dir)});
+            });
+        std::sort(e.links.begin(), e.links.end(),
+                  [](const Link& a, const Link& b) { return std::tie(a.element, a.direction) < std::tie(b.element, b.direction); });
+        e.links.erase(std::unique(e.links.begin(), e.links.end()), e.links.end());
+    }
+    if (initial)
+        number_all_nodes(l);
+    else
+        renumber_nodes(l, cell_codes);
+    return change;
+}
+
+void BranchedGrid::number_all_nodes(int l)
+{
+    // Slot 8 e + c is corner c of element e; a link joins the four corners of the shared face.
+    Level& out = m_levels[static_cast<std::size_t>(l)];
+    UnionFind sets(8 * out.elements.size());
+    for (std::uint32_t e = 0; e < out.elements.size(); ++e)
+        for (const Link& link : out.elements[e].links) {
+            if (!(link.direction & 1)) continue; // each link is seen from both sides; take the lower one
+            const int axis = link.direction / 2;
+            for (int c = 0; c < 8; ++c)
+                if ((c >> axis) & 1) sets.unite(8 * e + c, 8 * link.element + (c ^ (1 << axis)));
+        }
+    std::vector<std::uint32_t> id(8 * out.elements.size(), no_index);
+    for (std::uint32_t e = 0; e < out.elements.size(); ++e)
+        for (int c = 0; c < 8; ++c) {
+            const std::uint32_t root = sets.find(8 * e + c);
+            if (id[root] == no_index) {
+                id[root] = static_cast<std::uint32_t>(out.node_users.size());
+                out.node_users.push_back(0);
+            }
+            out.elements[e].nodes[c] = id[root];
+            ++out.node_users[id[root]];
+        }
+    out.stats.nodes = out.node_users.size();
+}
+
+void BranchedGrid::renumber_nodes(int l, const std::vector<std::uint64_t>& cell_codes)
+{
+    Level& out = m_levels[static_cast<std::size_t>(l)];
+    // The grid vertices whose node classes may have changed: the corners of the rebuilt cells.
+    std::vector<std::uint64_t> vertices;
+    vertices.reserve(8 * cell_codes.size());
+    for (std::uint64_t cell : cell_codes) {
+        const Eigen::Vector3i c = decode(cell);
+        for (int b = 0; b < 8; ++b) vertices.push_back(encode(c + Eigen::Vector3i(b & 1, (b >> 1) & 1, (b >> 2) & 1)));
+    }
+    sort_unique(vertices);
+
+    struct Slot {
+        std::uint32_t element;
+        int corner;
+    };
+    std::vector<Slot> slots;
+    std::vector<std::uint32_t> taken;
+    for (std::uint64_t vertex : vertices) {
+        const Eigen::Vector3i x = decode(vertex);
+        slots.clear();
+        for (int b = 0; b < 8; ++b) {
+            const Eigen::Vector3i cell = x - Eigen::Vector3i(b & 1, (b >> 1) & 1, (b >> 2) & 1);
+            if ((cell.array() < 0).any()) continue;
+            for (std::uint32_t e = out.cells.find(encode(cell)); e != no_index; e = out.elements[e].next_in_cell)
+                slots.push_back({e, b});
+        }
+        // Two corners at this vertex are one node when their elements are linked across a face
+        // that contains the vertex.
+        UnionFind sets(slots.size());
+        for (std::size_t i = 0; i < slots.size(); ++i)
+            for (const Link& link : out.elements[slots[i].element].links) {
+                const int axis = link.direction / 2;
+                const bool up = link.direction & 1;
+                if (((slots[i].corner >> axis) & 1) != static_cast<int>(up)) continue;
+                const int other = slots[i].corner ^ (1 << axis);
+                for (std::size_t j = 0; j < slots.size(); ++j)
+                    if (slots[j].element == link.element && slots[j].corner == other)
+                        sets.unite(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+            }
+        // Each class keeps the smallest old id of its members that no other class here took.
+        taken.clear();
+        for (std::size_t i = 0; i < slots.size(); ++i) {
+            if (sets.find(static_cast<std::uint32_t>(i)) != i) continue;
+            std::uint32_t id = no_index;
+            for (std::size_t j = i; j < slots.size(); ++j) {
+                if (sets.find(static_cast<std::uint32_t>(j)) != i) continue;
+                const std::uint32_t old = out.elements[slots[j].element].nodes[slots[j].corner];
+                if (old != no_index && old < id && std::find(taken.begin(), taken.end(), old) == taken.end()) id = old;
+            }
+            if (id == no_index) {
+                if (!out.free_nodes.empty()) {
+                    id = out.free_nodes.back();
+                    out.free_nodes.pop_back();
+                } else {
+                    id = static_cast<std::uint32_t>(out.node_users.size());
+                    out.node_users.push_back(0);
+                }
+            }
+            taken.push_back(id);
+            for (std::size_t j = i; j < slots.size(); ++j) {
+                if (sets.find(static_cast<std::uint32_t>(j)) != i) continue;
+                std::uint32_t& n = out.elements[slots[j].element].nodes[slots[j].corner];
+                if (n == id) continue;
+                if (n != no_index && --out.node_users[n] == 0) {
+                    out.free_nodes.push_back(n);
+                    --out.stats.nodes;
+                }
+                if (out.node_users[id]++ == 0) ++out.stats.nodes;
+                n = id;
+            }
         }
     }
+}
 
-    // Each element's fine voxels: its children's, in Morton order.
-    for (std::size_t c = 0; c < child_count; ++c)
-        if (element_of[c] != ~std::uint32_t{0})
-            out.elements[element_of[c]].voxel_count += from_voxels ? 1 : below.elements[c].voxel_count;
-    std::uint32_t offset = 0;
-    for (Element& e : out.elements) {
-        e.voxel_begin = offset;
-        offset += e.voxel_count;
-        e.voxel_count = 0;
+UpdateReport BranchedGrid::update(std::span<const Coord> removed, std::span<const std::pair<Coord, int>> faces)
+{
+    std::vector<std::uint64_t> cells;
+    for (const Coord& c : removed) {
+        const std::uint32_t v = m_voxels.find(c);
+        if (v == FineVoxels::missing) continue;
+        m_voxels.remove(v);
+        cells.push_back(m_voxels.code(v) >> 3);
     }
-    out.voxels.resize(offset);
-    for (std::size_t c = 0; c < child_count; ++c) {
-        if (element_of[c] == ~std::uint32_t{0}) continue;
-        Element& e = out.elements[element_of[c]];
-        if (from_voxels) {
-            out.voxels[e.voxel_begin + e.voxel_count++] = static_cast<std::uint32_t>(c);
-        } else {
-            const Element& child = below.elements[c];
-            std::copy_n(below.voxels.begin() + child.voxel_begin, child.voxel_count,
-                        out.voxels.begin() + e.voxel_begin + e.voxel_count);
-            e.voxel_count += child.voxel_count;
-        }
+    for (const auto& [c, axis] : faces) {
+        const std::uint32_t v = m_voxels.find(c);
+        const std::uint32_t w = m_voxels.find(c + Coord::Unit(axis));
+        if (v == FineVoxels::missing || w == FineVoxels::missing) continue;
+        m_voxels.disconnect(v, axis);
+        cells.push_back(m_voxels.code(v) >> 3);
+        cells.push_back(m_voxels.code(w) >> 3);
     }
-
-    // Direct condensation: each maximal full one-material Morton interval adds its box moments.
-    const std::uint64_t local_mask = (std::uint64_t{1} << (3 * l)) - 1;
-    std::vector<CellVoxel> cell_voxels;
-    for (Element& e : out.elements) {
-        auto first = out.voxels.begin() + e.voxel_begin;
-        auto last = first + e.voxel_count;
-        if (!std::is_sorted(first, last)) std::sort(first, last); // superimposed children interleave
-        cell_voxels.clear();
-        for (auto it = first; it != last; ++it)
-            cell_voxels.push_back({m_voxels.code(*it) & local_mask, m_voxels.material(*it)});
-        for (const SubNode& s : full_subnodes(cell_voxels, l)) {
-            const Eigen::Vector3i origin(static_cast<int>(morton_decode_axis(s.first, 0)),
-                                         static_cast<int>(morton_decode_axis(s.first, 1)),
-                                         static_cast<int>(morton_decode_axis(s.first, 2)));
-            auto it = std::lower_bound(e.content.begin(), e.content.end(), s.material,
-                                       [](const MaterialMoments& m, std::int32_t mat) { return m.material < mat; });
-            if (it == e.content.end() || it->material != s.material)
-                it = e.content.insert(it, MaterialMoments{s.material, 0, {}});
-            add_box_moments(it->moments, origin, 1 << s.level);
-            it->voxels += 1u << (3 * s.level);
-            ++out.stats.condensation_steps_direct;
-        }
-        out.stats.condensation_steps_recursive += recursive_step_count(cell_voxels, l);
+    m_levels[0].stats.cells = m_levels[0].stats.elements = m_voxels.alive_count();
+    UpdateReport report;
+    report.levels.resize(m_levels.size());
+    for (int l = 1; l <= max_level(); ++l) {
+        sort_unique(cells);
+        report.levels[static_cast<std::size_t>(l)] = rebuild_cells(l, cells, false);
+        for (auto& c : cells) c >>= 3;
     }
-
-    // Edges between elements of different cells come from the child edges that cross cells.
-    for (const Edge& e : below.edges)
-        if ((child_code(e.lower) >> 3) != (child_code(e.upper) >> 3))
-            out.edges.push_back({element_of[e.lower], element_of[e.upper], e.axis});
-    std::sort(out.edges.begin(), out.edges.end(),
-              [](const Edge& a, const Edge& b) { return std::tie(a.lower, a.upper, a.axis) < std::tie(b.lower, b.upper, b.axis); });
-    out.edges.erase(std::unique(out.edges.begin(), out.edges.end()), out.edges.end());
-
-    out.stats.elements = out.elements.size();
-    out.stats.nodes = number_nodes(out.elements.size(), out.edges, [](std::uint32_t) { return true; },
-                                   [&](std::uint32_t e, int c, std::uint32_t id) { out.elements[e].nodes[c] = id; });
-    m_maps[static_cast<std::size_t>(l)] = std::make_unique<MomentMatrices>(l, m_voxels.voxel_size_m());
-    out.stats.build_ms = ms_since(start);
-    out.stats.peak_memory_bytes = peak_memory_bytes();
+    return report;
 }
 
 Matrix24d BranchedGrid::stiffness(int l, std::uint32_t e) const

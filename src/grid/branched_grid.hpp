@@ -7,6 +7,10 @@
 // connected to a voxel of the other across it; node identity is the closure of that sharing.
 // Each element's content is its fine voxels' exact moments per material (element_moments.hpp),
 // built by the paper's direct condensation over Morton intervals; K and M follow from them.
+//
+// Removing voxels or disconnecting faces updates only the cells that hold them, level by level
+// (cell removal, cell split, cell disconnect, or no topology change), and reports which old
+// elements each new one came from. After any sequence of changes the grid equals a rebuild.
 
 #include "core/eigen_types.hpp"
 #include "grid/element_moments.hpp"
@@ -16,26 +20,30 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace vox::grid {
 
-/// Two elements of face-adjacent cells connected through at least one voxel face: `lower` lies in
-/// the cell on the -axis side, `upper` in the cell on the +axis side.
-struct Edge {
-    std::uint32_t lower = 0;
-    std::uint32_t upper = 0;
-    std::uint8_t axis = 0;
-    friend bool operator==(const Edge&, const Edge&) = default;
+inline constexpr std::uint32_t no_index = ~std::uint32_t{0};
+
+/// A connection to an element of the face-adjacent cell in `direction` (2 axis + (1 if +side)).
+struct Link {
+    std::uint32_t element = 0;
+    std::uint8_t direction = 0;
+    friend bool operator==(const Link&, const Link&) = default;
 };
 
 struct Element {
     Coord cell{0, 0, 0};                  ///< cell index at the element's level
     std::uint64_t code = 0;               ///< Morton code of the cell relative to the grid origin
     std::array<std::uint32_t, 8> nodes{}; ///< node ids; corner c has bits (+x, +y, +z)
-    std::uint32_t voxel_begin = 0;        ///< its fine voxels: Level::voxels[begin, begin + count)
-    std::uint32_t voxel_count = 0;
+    std::vector<std::uint32_t> voxels;    ///< its fine voxel slots, in Morton order
+    std::vector<std::uint32_t> children;  ///< elements of the level below (level 1: voxel slots)
+    std::vector<Link> links;              ///< connected elements of face-adjacent cells
     ElementContent content;               ///< per-material moments, cell-local
+    std::uint32_t next_in_cell = no_index; ///< the next superimposed element of the same cell
+    bool alive = false;
 };
 
 /// Build figures of one level, as `voxsculpt grid` reports them.
@@ -51,10 +59,27 @@ struct LevelStats {
 
 struct Level {
     int level = 0;
-    std::vector<Element> elements;      ///< sorted by the Morton code of their cell
-    std::vector<std::uint32_t> voxels;  ///< fine voxel slots, element after element, each run sorted
-    std::vector<Edge> edges;            ///< sorted, unique
+    std::vector<Element> elements;       ///< slots; dead ones (alive == false) are reused
+    std::vector<std::uint32_t> free_elements;
+    CoordMap cells;                      ///< cell code -> first element of the cell
+    std::vector<std::uint32_t> parent;   ///< per child of the level below (level 1: voxel slot)
+    std::vector<std::uint32_t> node_users; ///< per node id: number of element corners using it
+    std::vector<std::uint32_t> free_nodes;
     LevelStats stats;
+
+    /// Elements of the cell with Morton code `code` (empty when none).
+    [[nodiscard]] std::vector<std::uint32_t> cell_elements(std::uint64_t code) const;
+};
+
+/// What one batch of changes did at one level.
+struct LevelChange {
+    /// Elements created, each with the old elements it came from (empty for none).
+    std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> created;
+    std::vector<std::uint32_t> removed;  ///< elements that no longer exist
+    std::vector<std::uint32_t> updated;  ///< elements kept with fewer voxels or other links
+};
+struct UpdateReport {
+    std::vector<LevelChange> levels; ///< [l] for l = 1 .. max_level (index 0 unused)
 };
 
 class BranchedGrid {
@@ -88,13 +113,23 @@ public:
     /// Sum of all fine voxels' masses, kg.
     [[nodiscard]] double total_mass_kg() const;
 
+    /// Removes fine voxels (by source index; absent ones are ignored) and disconnects the faces
+    /// between `faces[i].first` and its +axis neighbour `faces[i].second` (axis 0..2), then
+    /// updates every level locally.
+    UpdateReport update(std::span<const Coord> removed, std::span<const std::pair<Coord, int>> faces);
+
 private:
     void build_level0(bool number_nodes);
-    void build_level(int l);
+    /// (Re)builds the elements of the given cells of level l from the level below; returns what changed.
+    LevelChange rebuild_cells(int l, std::vector<std::uint64_t> cell_codes, bool initial);
+    /// Node ids of the grid vertices at the corners of the given cells, after a change.
+    void renumber_nodes(int l, const std::vector<std::uint64_t>& cell_codes);
+    /// Node ids of a whole level, at build.
+    void number_all_nodes(int l);
 
     FineVoxels m_voxels;
     std::vector<VoxelMaterial> m_materials;
-    std::vector<Level> m_levels; ///< [0] holds level 0's edges and stats only
+    std::vector<Level> m_levels; ///< [0] holds level 0's stats only
     std::vector<std::unique_ptr<MomentMatrices>> m_maps;
 };
 

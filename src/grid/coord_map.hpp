@@ -18,28 +18,33 @@ public:
     /// Inserts key -> value, or overwrites the value of an existing key.
     void insert(std::uint64_t key, std::uint32_t value)
     {
-        if (2 * (m_size + 1) > m_keys.size()) rehash(2 * m_size + 2);
-        std::size_t s = slot(key);
-        if (m_keys[s] == empty) ++m_size;
-        m_keys[s] = key;
-        m_values[s] = value;
+        if (2 * (m_size + 1) > m_slots.size()) rehash(2 * m_size + 2);
+        Slot& s = m_slots[slot(key)];
+        if (s.key == empty) ++m_size;
+        s = {key, value};
     }
     /// The value of `key`, or `missing`.
     [[nodiscard]] std::uint32_t find(std::uint64_t key) const
     {
-        const std::size_t s = slot(key);
-        return m_keys[s] == empty ? missing : m_values[s];
+        const Slot& s = m_slots[slot(key)];
+        return s.key == empty ? missing : s.value;
     }
     [[nodiscard]] std::size_t size() const { return m_size; }
 
 private:
     static constexpr std::uint64_t empty = ~std::uint64_t{0};
 
+    /// Key and value side by side: one cache line per lookup.
+    struct Slot {
+        std::uint64_t key = empty;
+        std::uint32_t value = missing;
+    };
+
     std::size_t slot(std::uint64_t key) const
     {
         // Fibonacci hashing spreads the structured (Morton or packed) keys over the table.
         std::size_t s = static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ULL) >> m_shift);
-        while (m_keys[s] != empty && m_keys[s] != key) s = (s + 1) & (m_keys.size() - 1);
+        while (m_slots[s].key != empty && m_slots[s].key != key) s = (s + 1) & (m_slots.size() - 1);
         return s;
     }
     void rehash(std::size_t expected)
@@ -50,18 +55,15 @@ private:
             capacity *= 2;
             ++bits;
         }
-        std::vector<std::uint64_t> keys(capacity, empty);
-        std::vector<std::uint32_t> values(capacity, missing);
-        std::swap(keys, m_keys);
-        std::swap(values, m_values);
+        std::vector<Slot> old(capacity);
+        std::swap(old, m_slots);
         m_shift = 64 - bits;
         m_size = 0;
-        for (std::size_t i = 0; i < keys.size(); ++i)
-            if (keys[i] != empty) insert(keys[i], values[i]);
+        for (const Slot& s : old)
+            if (s.key != empty) insert(s.key, s.value);
     }
 
-    std::vector<std::uint64_t> m_keys;
-    std::vector<std::uint32_t> m_values;
+    std::vector<Slot> m_slots;
     std::size_t m_size = 0;
     int m_shift = 60;
 };

@@ -49,6 +49,17 @@ FineVoxels::FineVoxels(const LabelGrid& labels, const std::function<std::int32_t
         m_materials[v] = material_of(entries[v].label);
         m_index.insert(entries[v].code, static_cast<std::uint32_t>(v));
     }
+    // Neighbour slots once, so that connectivity queries never hash again.
+    m_neighbours.assign(n, {missing, missing, missing, missing, missing, missing});
+    for (std::uint32_t v = 0; v < n; ++v)
+        for (int axis = 0; axis < 3; ++axis) {
+            Coord up = m_coords[v];
+            ++up[axis];
+            const std::uint32_t w = find(up);
+            if (w == missing) continue;
+            m_neighbours[v][2 * axis + 1] = w;
+            m_neighbours[w][2 * axis] = v;
+        }
 }
 
 std::uint64_t FineVoxels::key(const Coord& ijk) const
@@ -64,13 +75,16 @@ std::uint32_t FineVoxels::find(const Coord& ijk) const
     return (v != missing && m_alive[v]) ? v : missing;
 }
 
+std::uint32_t FineVoxels::find_code(std::uint64_t code) const
+{
+    const std::uint32_t v = m_index.find(code);
+    return (v != missing && m_alive[v]) ? v : missing;
+}
+
 std::uint32_t FineVoxels::connected_neighbour(std::uint32_t v, int axis) const
 {
-    Coord n = m_coords[v];
-    ++n[axis];
-    const std::uint32_t w = find(n);
-    if (w == missing || m_disconnected.count(4 * std::uint64_t{v} + axis)) return missing;
-    return w;
+    const std::uint32_t w = m_neighbours[v][2 * axis + 1];
+    return (w == missing || face_disconnected(v, axis)) ? missing : w;
 }
 
 void FineVoxels::remove(std::uint32_t v)
@@ -78,6 +92,11 @@ void FineVoxels::remove(std::uint32_t v)
     if (!m_alive[v]) return;
     m_alive[v] = 0;
     --m_alive_count;
+    for (int d = 0; d < 6; ++d) {
+        const std::uint32_t w = m_neighbours[v][d];
+        if (w != missing) m_neighbours[w][d ^ 1] = missing;
+        m_neighbours[v][d] = missing;
+    }
 }
 
 void FineVoxels::disconnect(std::uint32_t v, int axis) { m_disconnected.insert(4 * std::uint64_t{v} + axis); }

@@ -6,6 +6,7 @@
 #include "grid/coord_map.hpp"
 #include "grid/label_grid.hpp"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <unordered_set>
@@ -28,6 +29,18 @@ public:
 
     /// Index of the voxel at `ijk` (source index space), or `missing` (never present or removed).
     [[nodiscard]] std::uint32_t find(const Coord& ijk) const;
+    /// Index of the voxel whose Morton code (see code()) is `code`, or `missing`.
+    [[nodiscard]] std::uint32_t find_code(std::uint64_t code) const;
+    /// The up to six voxels face-connected to v: (slot, direction 2 axis + (1 if on the +side)).
+    template <class F> void for_each_link(std::uint32_t v, F&& f) const
+    {
+        for (int axis = 0; axis < 3; ++axis) {
+            const std::uint32_t down = m_neighbours[v][2 * axis];
+            if (down != missing && !face_disconnected(down, axis)) f(down, 2 * axis);
+            const std::uint32_t up = m_neighbours[v][2 * axis + 1];
+            if (up != missing && !face_disconnected(v, axis)) f(up, 2 * axis + 1);
+        }
+    }
     /// Source index (i, j, k) of voxel v: the coarse cell at level L is (i >> L, j >> L, k >> L).
     [[nodiscard]] Coord coord(std::uint32_t v) const { return m_coords[v]; }
     /// Morton code of v's index relative to origin(); slots are sorted by it.
@@ -44,6 +57,11 @@ public:
     /// The voxel across the face of v on the +axis side, if present and the face is connected.
     [[nodiscard]] std::uint32_t connected_neighbour(std::uint32_t v, int axis) const;
 
+    /// True when the face between v and its +axis neighbour was disconnected.
+    [[nodiscard]] bool face_disconnected(std::uint32_t v, int axis) const
+    {
+        return !m_disconnected.empty() && m_disconnected.count(4 * std::uint64_t{v} + static_cast<std::uint64_t>(axis));
+    }
     /// Removes voxel v (no-op when already removed).
     void remove(std::uint32_t v);
     /// Disconnects the face between v and its +axis neighbour.
@@ -60,6 +78,8 @@ private:
     std::vector<std::int32_t> m_labels;
     std::vector<std::int32_t> m_materials;
     std::vector<std::uint8_t> m_alive;
+    /// Present face neighbours of each voxel, in direction order (-x, +x, -y, +y, -z, +z).
+    std::vector<std::array<std::uint32_t, 6>> m_neighbours;
     std::uint32_t m_alive_count = 0;
     CoordMap m_index;                                  ///< key(ijk) -> slot
     std::unordered_set<std::uint64_t> m_disconnected;  ///< 4 * slot + axis of disconnected +axis faces

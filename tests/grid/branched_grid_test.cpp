@@ -89,11 +89,11 @@ std::set<std::set<std::tuple<int, int, int>>> reference_elements(const LabelGrid
 std::set<std::set<std::tuple<int, int, int>>> grid_elements(const BranchedGrid& grid, int level)
 {
     std::set<std::set<std::tuple<int, int, int>>> out;
-    const Level& lv = grid.level(level);
-    for (const Element& e : lv.elements) {
+    for (const Element& e : grid.level(level).elements) {
+        if (!e.alive) continue;
         std::set<std::tuple<int, int, int>> voxels;
-        for (std::uint32_t k = 0; k < e.voxel_count; ++k) {
-            const Coord c = grid.voxels().coord(lv.voxels[e.voxel_begin + k]);
+        for (std::uint32_t v : e.voxels) {
+            const Coord c = grid.voxels().coord(v);
             voxels.insert({c.x(), c.y(), c.z()});
         }
         out.insert(voxels);
@@ -131,6 +131,7 @@ TEST(BranchedGrid, UtubeBranchesAtLevelThree)
     // element's top face nodes, so the piece has 8 + 4 + 4 nodes.
     EXPECT_EQ(l3.stats.nodes, 16u);
     const Element& lower = l3.elements[0];
+    EXPECT_EQ(lower.cell, Coord(0, 0, 0));
     for (int u = 1; u <= 2; ++u) {
         const Element& upper = l3.elements[static_cast<std::size_t>(u)];
         EXPECT_EQ(upper.cell, Coord(0, 0, 1));
@@ -178,7 +179,7 @@ TEST(BranchedGrid, NodesFollowFaceConnectivityAndNeverJoinPieces)
         const Level& lv = grid.level(l);
         std::map<std::uint32_t, int> node_piece;
         for (const Element& e : lv.elements) {
-            const Coord c = grid.voxels().coord(lv.voxels[e.voxel_begin]);
+            const Coord c = grid.voxels().coord(e.voxels.front());
             const int piece = piece_of.at({c.x(), c.y(), c.z()});
             for (std::uint32_t n : e.nodes) {
                 auto [it, fresh] = node_piece.emplace(n, piece);
@@ -186,16 +187,18 @@ TEST(BranchedGrid, NodesFollowFaceConnectivityAndNeverJoinPieces)
             }
         }
         // Every connected pair shares exactly the four nodes of the common face.
-        for (const Edge& edge : lv.edges) {
-            const Element& a = lv.elements[edge.lower];
-            const Element& b = lv.elements[edge.upper];
-            EXPECT_EQ((b.cell - a.cell), Coord::Unit(edge.axis));
-            for (int c = 0; c < 8; ++c) {
-                if ((c >> edge.axis) & 1) {
-                    EXPECT_EQ(a.nodes[c], b.nodes[c ^ (1 << edge.axis)]);
+        for (const Element& a : lv.elements)
+            for (const Link& link : a.links) {
+                const Element& b = lv.elements[link.element];
+                const int axis = link.direction / 2;
+                const int side = link.direction & 1;
+                EXPECT_EQ((b.cell - a.cell), (side ? 1 : -1) * Coord::Unit(axis));
+                for (int c = 0; c < 8; ++c) {
+                    if (((c >> axis) & 1) == side) {
+                        EXPECT_EQ(a.nodes[c], b.nodes[c ^ (1 << axis)]);
+                    }
                 }
             }
-        }
     }
 }
 
@@ -212,8 +215,7 @@ TEST(BranchedGrid, ElementMatricesEqualBruteForceAndMassIsConserved)
             const Matrix8d m = grid.mass(l, e);
             mass += m.sum();
             std::vector<CellVoxel> cell;
-            for (std::uint32_t k = 0; k < el.voxel_count; ++k) {
-                const std::uint32_t v = lv.voxels[el.voxel_begin + k];
+            for (std::uint32_t v : el.voxels) {
                 const Coord local = grid.voxels().coord(v) - (el.cell * (1 << l));
                 cell.push_back({morton_encode(local.x(), local.y(), local.z()), grid.voxels().material(v)});
             }
