@@ -4,6 +4,7 @@
 #include "core/memory_usage.hpp"
 #include "core/morton.hpp"
 #include "grid/condensation.hpp"
+#include "grid/hex8.hpp"
 #include "grid/union_find.hpp"
 
 #include <algorithm>
@@ -21,6 +22,12 @@ Eigen::Vector3i decode(std::uint64_t code)
 {
     return {static_cast<int>(morton_decode_axis(code, 0)), static_cast<int>(morton_decode_axis(code, 1)),
             static_cast<int>(morton_decode_axis(code, 2))};
+}
+
+/// Index of fine voxel v inside its level-l cell.
+Eigen::Vector3i local_index(const FineVoxels& fine, std::uint32_t v, int l)
+{
+    return decode(fine.code(v) & ((std::uint64_t{1} << (3 * l)) - 1));
 }
 
 std::uint64_t encode(const Eigen::Vector3i& c)
@@ -43,7 +50,7 @@ struct Condensed {
 
 /// The paper's direct condensation into exact moments: each maximal full one-material Morton
 /// interval of the element's voxels adds its box moments in one step.
-Condensed condense(const FineVoxels& fine, int l, const std::vector<std::uint32_t>& voxels)
+Condensed condense(const FineVoxels& fine, int l, const std::vector<std::uint32_t>& voxels, bool count_recursive)
 {
     const std::uint64_t local_mask = (std::uint64_t{1} << (3 * l)) - 1;
     std::vector<CellVoxel> cell;
@@ -59,7 +66,7 @@ Condensed condense(const FineVoxels& fine, int l, const std::vector<std::uint32_
         it->voxels += 1u << (3 * s.level);
         ++out.steps_direct;
     }
-    out.steps_recursive = recursive_step_count(cell, l);
+    if (count_recursive) out.steps_recursive = recursive_step_count(cell, l);
     return out;
 }
 
@@ -79,9 +86,17 @@ BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materia
     if (max_level < 0 || max_level > 6) throw InputError("levels must be 0 .. 6, got " + std::to_string(max_level));
     m_levels.resize(static_cast<std::size_t>(max_level) + 1);
     m_maps.resize(m_levels.size());
+    m_full_stiffness.resize(m_levels.size());
+    m_full_mass.resize(m_levels.size());
     for (std::size_t l = 0; l < m_levels.size(); ++l) {
         m_levels[l].level = static_cast<int>(l);
         m_maps[l] = std::make_unique<MomentMatrices>(static_cast<int>(l), m_voxels.voxel_size_m());
+        // Equations 2 and 3: a full cell of level l is the voxel element scaled by 2^l (K), 2^3l (M).
+        const double s = static_cast<double>(1 << l);
+        for (const VoxelMaterial& m : m_materials) {
+            m_full_stiffness[l].push_back(s * hex8_stiffness(m_voxels.voxel_size_m(), m.lame));
+            m_full_mass[l].push_back(s * s * s * hex8_mass(m_voxels.voxel_size_m(), m.density_kg_m3));
+        }
     }
     build_level0(options.level0_nodes);
     std::vector<std::uint64_t> cells;
@@ -148,6 +163,7 @@ LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_c
         }
     };
     auto child_code = [&](std::uint32_t c) { return from_voxels ? m_voxels.code(c) : below.elements[c].code; };
+    auto child_alive = [&](std::uint32_t c) { return from_voxels ? m_voxels.alive(c) : below.elements[c].alive; };
     auto for_each_child_link = [&](std::uint32_t c, auto&& f) {
         if (from_voxels)
             m_voxels.for_each_link(c, [&](std::uint32_t t, int dir) { f(t, dir); });
@@ -168,7 +184,7 @@ LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_c
     std::vector<std::uint32_t> children;
     std::vector<std::uint32_t> component;
     for (std::uint64_t cell : cell_codes) {
-        const std::vector<std::uint32_t> old = out.cell_elements(cell);
+        const std::vector<std::uint32_t> old = initial ? std::vector<std::uint32_t>{} : out.cell_elements(cell);
         for (std::uint32_t e : old)
             for (const Link& link : out.elements[e].links) touched.push_back(link.element);
 
@@ -191,21 +207,49 @@ LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_c
                 if (sets.find(static_cast<std::uint32_t>(j)) == i) component.push_back(children[j]);
             std::sort(component.begin(), component.end());
 
-            // An old element with exactly these children keeps its id (no topology change).
+            // An old element whose surviving children are exactly these keeps its id: no topology
+            // change, so its content only loses the removed voxels' moments (equation 5).
             std::uint32_t id = no_index;
-            for (std::uint32_t e : old)
-                if (out.elements[e].children == component) id = e;
-            std::vector<std::uint32_t> voxels;
-            for (std::uint32_t c : component) append_child_voxels(c, voxels);
-            if (!std::is_sorted(voxels.begin(), voxels.end())) std::sort(voxels.begin(), voxels.end());
-            if (id == no_index) {
+            for (std::uint32_t e : old) {
+                const auto& before = out.elements[e].children;
+                std::size_t surviving = 0;
+                bool same = true;
+                for (std::uint32_t c : before) {
+                    if (!child_alive(c)) continue;
+                    same = same && surviving < component.size() && component[surviving] == c;
+                    ++surviving;
+                }
+                if (same && surviving == component.size()) id = e;
+            }
+            // A child that died may live on as a new child elsewhere (a split below): keeping the
+            // id needs the surviving voxels to be exactly those of these children.
+            if (id != no_index) {
+                std::size_t expect = 0, alive = 0;
+                for (std::uint32_t c : component) expect += from_voxels ? 1 : below.elements[c].voxels.size();
+                for (std::uint32_t v : out.elements[id].voxels) alive += m_voxels.alive(v);
+                if (alive != expect) id = no_index;
+            }
+            if (id != no_index) {
+                kept.push_back(id);
+                Element& e = out.elements[id];
+                const std::size_t before = e.voxels.size();
+                std::erase_if(e.voxels, [&](std::uint32_t v) {
+                    if (m_voxels.alive(v)) return false;
+                    update_content(e.content, m_voxels.material(v), local_index(m_voxels, v, l), -1);
+                    return true;
+                });
+                if (e.voxels.size() != before) change.updated.push_back(id);
+            } else {
+                std::vector<std::uint32_t> voxels;
+                for (std::uint32_t c : component) append_child_voxels(c, voxels);
+                if (!std::is_sorted(voxels.begin(), voxels.end())) std::sort(voxels.begin(), voxels.end());
                 std::vector<std::uint32_t> came_from;
                 for (std::uint32_t e : old)
                     if (std::any_of(voxels.begin(), voxels.end(), [&](std::uint32_t v) {
                             return std::binary_search(out.elements[e].voxels.begin(), out.elements[e].voxels.end(), v);
                         }))
                         came_from.push_back(e);
-                if (!out.free_elements.empty() && !initial) {
+                if (!out.free_elements.empty()) {
                     id = out.free_elements.back();
                     out.free_elements.pop_back();
                 } else {
@@ -216,22 +260,17 @@ LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_c
                 Element& e = out.elements[id];
                 e.alive = true;
                 e.nodes.fill(no_index);
+                const Condensed c = condense(m_voxels, l, voxels, initial);
+                e.content = c.content;
+                out.stats.condensation_steps_direct += initial ? c.steps_direct : 0;
+                out.stats.condensation_steps_recursive += initial ? c.steps_recursive : 0;
+                e.voxels = std::move(voxels);
                 ++out.stats.elements;
-            } else {
-                kept.push_back(id);
-                if (out.elements[id].voxels != voxels) change.updated.push_back(id);
             }
             Element& e = out.elements[id];
             e.code = cell;
             e.cell = shift(from_voxels ? m_voxels.coord(component.front()) : below.elements[component.front()].cell, 1);
             e.children = component;
-            if (e.voxels != voxels || initial) {
-                Condensed c = condense(m_voxels, l, voxels);
-                e.content = std::move(c.content);
-                out.stats.condensation_steps_direct += initial ? c.steps_direct : 0;
-                out.stats.condensation_steps_recursive += initial ? c.steps_recursive : 0;
-                e.voxels = std::move(voxels);
-            }
             for (std::uint32_t c : component) out.parent[c] = id;
             e.next_in_cell = no_index;
             if (head == no_index)
@@ -251,7 +290,7 @@ LevelChange BranchedGrid::rebuild_cells(int l, std::vector<std::uint64_t> cell_c
                     --out.stats.nodes;
                 }
             dead = Element{};
-            out.free_elements.push_back(e);
+            out.released_elements.push_back(e);
             change.removed.push_back(e);
             --out.stats.elements;
         }
@@ -409,17 +448,35 @@ UpdateReport BranchedGrid::update(std::span<const Coord> removed, std::span<cons
         report.levels[static_cast<std::size_t>(l)] = rebuild_cells(l, cells, false);
         for (auto& c : cells) c >>= 3;
     }
+    // Ids of removed elements become reusable only now: within one update an id means one element.
+    for (Level& level : m_levels) {
+        level.free_elements.insert(level.free_elements.end(), level.released_elements.begin(),
+                                   level.released_elements.end());
+        level.released_elements.clear();
+    }
     return report;
+}
+
+bool BranchedGrid::is_full(int l, std::uint32_t e) const
+{
+    const ElementContent& c = level(l).elements.at(e).content;
+    return c.size() == 1 && c[0].voxels == (1u << (3 * l));
 }
 
 Matrix24d BranchedGrid::stiffness(int l, std::uint32_t e) const
 {
-    return m_maps.at(static_cast<std::size_t>(l))->stiffness(level(l).elements.at(e).content, m_materials);
+    const auto lu = static_cast<std::size_t>(l);
+    const ElementContent& c = level(l).elements.at(e).content;
+    if (is_full(l, e)) return m_full_stiffness[lu][static_cast<std::size_t>(c[0].material)];
+    return m_maps.at(lu)->stiffness(c, m_materials);
 }
 
 Matrix8d BranchedGrid::mass(int l, std::uint32_t e) const
 {
-    return m_maps.at(static_cast<std::size_t>(l))->mass(level(l).elements.at(e).content, m_materials);
+    const auto lu = static_cast<std::size_t>(l);
+    const ElementContent& c = level(l).elements.at(e).content;
+    if (is_full(l, e)) return m_full_mass[lu][static_cast<std::size_t>(c[0].material)];
+    return m_maps.at(lu)->mass(c, m_materials);
 }
 
 double BranchedGrid::total_mass_kg() const

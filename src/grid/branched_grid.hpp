@@ -61,6 +61,7 @@ struct Level {
     int level = 0;
     std::vector<Element> elements;       ///< slots; dead ones (alive == false) are reused
     std::vector<std::uint32_t> free_elements;
+    std::vector<std::uint32_t> released_elements; ///< removed during the current update
     CoordMap cells;                      ///< cell code -> first element of the cell
     std::vector<std::uint32_t> parent;   ///< per child of the level below (level 1: voxel slot)
     std::vector<std::uint32_t> node_users; ///< per node id: number of element corners using it
@@ -107,9 +108,13 @@ public:
     /// (0 unless Options::level0_nodes).
     [[nodiscard]] const LevelStats& level0_stats() const { return m_levels[0].stats; }
 
-    /// Stiffness (N/m) and scalar consistent mass (kg) of element e of level l (>= 1).
+    /// Stiffness (N/m) and scalar consistent mass (kg) of element e of level l (>= 1). Full
+    /// one-material cells return their level's shared matrix; partial cells are evaluated from
+    /// their moments (about 10 k multiply-adds).
     [[nodiscard]] Matrix24d stiffness(int l, std::uint32_t e) const;
     [[nodiscard]] Matrix8d mass(int l, std::uint32_t e) const;
+    /// True when element e of level l fills its cell with one material (it shares its matrices).
+    [[nodiscard]] bool is_full(int l, std::uint32_t e) const;
     /// Sum of all fine voxels' masses, kg.
     [[nodiscard]] double total_mass_kg() const;
 
@@ -131,6 +136,9 @@ private:
     std::vector<VoxelMaterial> m_materials;
     std::vector<Level> m_levels; ///< [0] holds level 0's stats only
     std::vector<std::unique_ptr<MomentMatrices>> m_maps;
+    /// Per level and material: the matrices of a full cell, shared by all full cells.
+    std::vector<std::vector<Matrix24d>> m_full_stiffness;
+    std::vector<std::vector<Matrix8d>> m_full_mass;
 };
 
 } // namespace vox::grid

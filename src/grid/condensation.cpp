@@ -49,7 +49,7 @@ std::vector<VoxelMatrices> voxel_matrices(const Eigen::Vector3d& voxel_size_m, s
 
 } // namespace
 
-std::vector<SubNode> full_subnodes(std::span<const CellVoxel> v, int cell_level)
+std::vector<SubNode> full_subnodes(std::span<const CellVoxel> v, int cell_level, int dimensions)
 {
     const std::size_t n = v.size();
     // run_end[p]: one past the last index of the run of consecutive codes of one material from p.
@@ -62,11 +62,11 @@ std::vector<SubNode> full_subnodes(std::span<const CellVoxel> v, int cell_level)
     for (std::size_t p = 0; p < n;) {
         int level = cell_level;
         for (; level > 0; --level) {
-            const std::uint64_t size = std::uint64_t{1} << (3 * level);
+            const std::uint64_t size = std::uint64_t{1} << (dimensions * level);
             if (v[p].morton % size == 0 && run_end[p] - p >= size) break;
         }
         out.push_back({v[p].morton, level, v[p].material});
-        p += std::size_t{1} << (3 * level);
+        p += std::size_t{1} << (dimensions * level);
     }
     return out;
 }
@@ -163,14 +163,14 @@ CondensedElement condense_brute_force(std::span<const CellVoxel> voxels, int cel
     return out;
 }
 
-std::uint64_t recursive_step_count(std::span<const CellVoxel> voxels, int cell_level)
+std::uint64_t recursive_step_count(std::span<const CellVoxel> voxels, int cell_level, int dimensions)
 {
     std::uint64_t steps = 0;
     for (int l = 0; l < cell_level; ++l) {
         // Distinct nodes of level l: codes >> 3l, counted over the sorted sequence.
         std::uint64_t previous = ~std::uint64_t{0};
         for (const CellVoxel& v : voxels) {
-            const std::uint64_t node = v.morton >> (3 * l);
+            const std::uint64_t node = v.morton >> (dimensions * l);
             if (node != previous) ++steps;
             previous = node;
         }

@@ -36,8 +36,10 @@ struct SubNode {
 
 /// The maximal full sub-nodes of `voxels` (sorted by Morton code, unique), in Morton order,
 /// found by one pass over the codes: a run is a sub-node of level l when it starts at a multiple
-/// of 8^l and holds 8^l consecutive codes of one material.
-[[nodiscard]] std::vector<SubNode> full_subnodes(std::span<const CellVoxel> voxels, int cell_level);
+/// of 8^l and holds 8^l consecutive codes of one material. `dimensions` 2 gives the quadtree
+/// version (4^l codes per node) of the paper's Figure 6.
+[[nodiscard]] std::vector<SubNode> full_subnodes(std::span<const CellVoxel> voxels, int cell_level,
+                                                 int dimensions = 3);
 
 /// Interpolation from the corners of the sub-box at local voxel offset `origin` with edge `size`
 /// (voxels) to the corners of a cell of edge `cell_size` voxels: H(a, b) = N_b(corner a of the
@@ -63,7 +65,8 @@ struct CondensedElement {
                                                     std::span<const VoxelMaterial> materials);
 
 /// Number of recursive condensation steps without computing matrices: the non-empty octree
-/// nodes of levels 0 .. L-1.
-[[nodiscard]] std::uint64_t recursive_step_count(std::span<const CellVoxel> voxels, int cell_level);
+/// (dimensions 3) or quadtree (2) nodes of levels 0 .. L-1.
+[[nodiscard]] std::uint64_t recursive_step_count(std::span<const CellVoxel> voxels, int cell_level,
+                                                 int dimensions = 3);
 
 } // namespace vox::grid

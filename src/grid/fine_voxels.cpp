@@ -41,13 +41,20 @@ FineVoxels::FineVoxels(const LabelGrid& labels, const std::function<std::int32_t
     m_materials.resize(n);
     m_alive.assign(n, 1);
     m_alive_count = static_cast<std::uint32_t>(n);
-    m_index = CoordMap(n);
+    m_bricks = CoordMap(n / 64 + 16);
     for (std::size_t v = 0; v < n; ++v) {
         m_codes[v] = entries[v].code;
         m_coords[v] = entries[v].ijk;
         m_labels[v] = entries[v].label;
         m_materials[v] = material_of(entries[v].label);
-        m_index.insert(entries[v].code, static_cast<std::uint32_t>(v));
+        const std::uint64_t brick_code = entries[v].code >> 9;
+        std::uint32_t brick = m_bricks.find(brick_code);
+        if (brick == CoordMap::missing) {
+            brick = static_cast<std::uint32_t>(m_brick_slots.size() >> 9);
+            m_bricks.insert(brick_code, brick);
+            m_brick_slots.resize(m_brick_slots.size() + 512, missing);
+        }
+        m_brick_slots[(std::size_t{brick} << 9) | (entries[v].code & 511)] = static_cast<std::uint32_t>(v);
     }
     // Neighbour slots once, so that connectivity queries never hash again.
     m_neighbours.assign(n, {missing, missing, missing, missing, missing, missing});
@@ -71,13 +78,13 @@ std::uint64_t FineVoxels::key(const Coord& ijk) const
 
 std::uint32_t FineVoxels::find(const Coord& ijk) const
 {
-    const std::uint32_t v = m_index.find(key(ijk));
+    const std::uint32_t v = slot_of(key(ijk));
     return (v != missing && m_alive[v]) ? v : missing;
 }
 
 std::uint32_t FineVoxels::find_code(std::uint64_t code) const
 {
-    const std::uint32_t v = m_index.find(code);
+    const std::uint32_t v = slot_of(code);
     return (v != missing && m_alive[v]) ? v : missing;
 }
 

@@ -81,7 +81,16 @@ private:
     /// Present face neighbours of each voxel, in direction order (-x, +x, -y, +y, -z, +z).
     std::vector<std::array<std::uint32_t, 6>> m_neighbours;
     std::uint32_t m_alive_count = 0;
-    CoordMap m_index;                                  ///< key(ijk) -> slot
+    /// Slot lookup by Morton code: 8^3-voxel bricks (code >> 9) found by hash, then a dense
+    /// table of 512 slots per brick. Neighbour queries stay within a few cache lines, unlike a
+    /// hash over every voxel.
+    [[nodiscard]] std::uint32_t slot_of(std::uint64_t code) const
+    {
+        const std::uint32_t brick = m_bricks.find(code >> 9);
+        return brick == CoordMap::missing ? missing : m_brick_slots[(std::size_t{brick} << 9) | (code & 511)];
+    }
+    CoordMap m_bricks;
+    std::vector<std::uint32_t> m_brick_slots;
     std::unordered_set<std::uint64_t> m_disconnected;  ///< 4 * slot + axis of disconnected +axis faces
 };
 

@@ -116,30 +116,43 @@ std::size_t pieces(const BranchedGrid& grid, int l)
 
 TEST(BranchedGridUpdate, RandomRemovalsAndDisconnectionsEqualRebuilds)
 {
-    std::mt19937 rng(20261122);
-    LabelGrid labels(Eigen::Vector4d(0.5, 0.75, 1.25, 1.0).asDiagonal().toDenseMatrix());
-    for (int z = -4; z < 12; ++z)
-        for (int y = 0; y < 14; ++y)
-            for (int x = -6; x < 14; ++x)
-                if (std::bernoulli_distribution(0.8)(rng)) labels.set({x, y, z}, (x + 2 * y) % 5 == 0 ? 2 : 1);
-    BranchedGrid grid(FineVoxels(labels, material_of), k_materials, 4);
-    std::vector<std::pair<Coord, int>> disconnected;
-    std::uniform_int_distribution<int> px(-6, 13), py(0, 13), pz(-4, 11), axis(0, 2);
-    for (int batch = 0; batch < 12; ++batch) {
-        SCOPED_TRACE(testing::Message() << "batch " << batch);
-        std::vector<Coord> removed;
-        std::vector<std::pair<Coord, int>> faces;
-        const int n = 1 + batch * 7;
-        for (int k = 0; k < n; ++k) {
-            if (k % 3 == 2)
-                faces.emplace_back(Coord(px(rng), py(rng), pz(rng)), axis(rng));
-            else
-                removed.emplace_back(px(rng), py(rng), pz(rng));
+    std::size_t created = 0, removed_elements = 0, updated = 0;
+    for (unsigned seed : {20261122u, 7u, 99u}) {
+        SCOPED_TRACE(testing::Message() << "seed " << seed);
+        std::mt19937 rng(seed);
+        LabelGrid labels(Eigen::Vector4d(0.5, 0.75, 1.25, 1.0).asDiagonal().toDenseMatrix());
+        for (int z = -4; z < 12; ++z)
+            for (int y = 0; y < 14; ++y)
+                for (int x = -6; x < 14; ++x)
+                    if (std::bernoulli_distribution(0.8)(rng)) labels.set({x, y, z}, (x + 2 * y) % 5 == 0 ? 2 : 1);
+        BranchedGrid grid(FineVoxels(labels, material_of), k_materials, 4);
+        std::vector<std::pair<Coord, int>> disconnected;
+        std::uniform_int_distribution<int> px(-6, 13), py(0, 13), pz(-4, 11), axis(0, 2);
+        for (int batch = 0; batch < 16; ++batch) {
+            SCOPED_TRACE(testing::Message() << "batch " << batch);
+            std::vector<Coord> removed;
+            std::vector<std::pair<Coord, int>> faces;
+            const int n = 1 + batch * 7;
+            for (int k = 0; k < n; ++k) {
+                if (k % 3 == 2)
+                    faces.emplace_back(Coord(px(rng), py(rng), pz(rng)), axis(rng));
+                else
+                    removed.emplace_back(px(rng), py(rng), pz(rng));
+            }
+            const UpdateReport report = grid.update(removed, faces);
+            for (int l = 1; l <= 4; ++l) {
+                created += report.levels[l].created.size();
+                removed_elements += report.levels[l].removed.size();
+                updated += report.levels[l].updated.size();
+            }
+            disconnected.insert(disconnected.end(), faces.begin(), faces.end());
+            expect_equal_to_rebuild(grid, disconnected);
         }
-        grid.update(removed, faces);
-        disconnected.insert(disconnected.end(), faces.begin(), faces.end());
-        expect_equal_to_rebuild(grid, disconnected);
     }
+    // Every kind of change happened: splits and removals (created, removed) and plain updates.
+    EXPECT_GT(created, 50u);
+    EXPECT_GT(removed_elements, 50u);
+    EXPECT_GT(updated, 50u);
 }
 
 TEST(BranchedGridUpdate, CuttingABeamThroughLeavesTwoPieces)

@@ -54,6 +54,26 @@ std::uint64_t count_full_nodes(const std::vector<CellVoxel>& v, std::uint64_t fi
 
 } // namespace
 
+TEST(Condensation, ThePapersQuadtreeExampleCounts10DirectAnd67RecursiveSteps)
+{
+    // Figure 6: a level-3 quadtree cell holding the intervals [0-31] [33] [36-37] [39] [48-55]
+    // [57] [60-63]; the paper finds 10 full nodes, against 49 + 14 + 4 = 67 recursive steps.
+    std::vector<CellVoxel> v;
+    auto add = [&](std::uint64_t first, std::uint64_t last) {
+        for (std::uint64_t c = first; c <= last; ++c) v.push_back({c, 0});
+    };
+    add(0, 31), add(33, 33), add(36, 37), add(39, 39), add(48, 55), add(57, 57), add(60, 63);
+    const auto nodes = full_subnodes(v, 3, 2);
+    ASSERT_EQ(nodes.size(), 10u);
+    const std::vector<std::pair<std::uint64_t, int>> expect{{0, 2},  {16, 2}, {33, 0}, {36, 0}, {37, 0},
+                                                            {39, 0}, {48, 1}, {52, 1}, {57, 0}, {60, 1}};
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        EXPECT_EQ(nodes[i].first, expect[i].first);
+        EXPECT_EQ(nodes[i].level, expect[i].second);
+    }
+    EXPECT_EQ(recursive_step_count(v, 3, 2), 67u);
+}
+
 TEST(Condensation, FullCellIsOneDirectStepAndScalesAsThePaperSays)
 {
     for (int level = 1; level <= 3; ++level) {

@@ -1,0 +1,53 @@
+#pragma once
+// Repeated timings summarised as median and spread, and the machine they ran on, for the
+// benchmark programs (figures go to the README).
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace vox::bench {
+
+struct Summary {
+    double median = 0.0, min = 0.0, max = 0.0;
+    std::size_t runs = 0;
+};
+
+inline Summary summarize(std::vector<double> samples)
+{
+    std::sort(samples.begin(), samples.end());
+    Summary s;
+    s.runs = samples.size();
+    if (samples.empty()) return s;
+    const std::size_t n = samples.size();
+    s.median = n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+    s.min = samples.front();
+    s.max = samples.back();
+    return s;
+}
+
+/// Wall-clock milliseconds of f().
+template <class F> double time_ms(F&& f)
+{
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// "model name" of the CPU and the number of hardware threads.
+inline std::string machine()
+{
+    std::ifstream cpuinfo("/proc/cpuinfo");
+    std::string line, model = "unknown CPU";
+    while (std::getline(cpuinfo, line))
+        if (line.rfind("model name", 0) == 0) {
+            model = line.substr(line.find(':') + 2);
+            break;
+        }
+    return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
+
+} // namespace vox::bench
