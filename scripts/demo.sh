@@ -17,6 +17,10 @@ step "Liver CT segmentation (INRIMAGE-4): label 255 -> OpenVDB"
 "$vox" info --json "$out/liver.vdb" > "$out/liver-info.json"
 "$vox" info "$out/liver.vdb"
 
+step "Dynamic Branched Grid of the liver: levels 0 to 5"
+"$vox" grid "$out/liver.vdb" --levels 5
+"$vox" grid "$out/liver.vdb" --levels 5 --json > "$out/liver-grid.json"
+
 step "Closed mesh (elephant.off) voxelised through OpenVDB"
 "$vox" import "$data/elephant.off" --voxel-size 0.01 -o "$out/elephant.vdb"
 
@@ -27,6 +31,9 @@ step "Phantoms"
 "$vox" phantom beam -o "$out/beam.vdb"
 "$vox" phantom utube -o "$out/utube.vdb"
 "$vox" phantom cylinder -o "$out/cylinder.vdb"
+
+step "The U-tube branches at level 3 (a cell holding both legs gets two superimposed elements)"
+"$vox" grid "$out/utube.vdb" --levels 3
 
 step "Scene files"
 for scene in "$data"/scenes/*.json; do
