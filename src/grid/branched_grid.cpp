@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 namespace vox::grid {
 namespace {
@@ -477,6 +478,33 @@ Matrix8d BranchedGrid::mass(int l, std::uint32_t e) const
     const ElementContent& c = level(l).elements.at(e).content;
     if (is_full(l, e)) return m_full_mass[lu][static_cast<std::size_t>(c[0].material)];
     return m_maps.at(lu)->mass(c, m_materials);
+}
+
+std::uint32_t BranchedGrid::element_of(std::uint32_t v, int l) const
+{
+    std::uint32_t e = v;
+    for (int k = 1; k <= l; ++k) e = m_levels[static_cast<std::size_t>(k)].parent[e];
+    return e;
+}
+
+Eigen::Vector3d BranchedGrid::cell_corner_index(const Coord& cell, int l, int c)
+{
+    const double size = static_cast<double>(1 << l);
+    return {(cell.x() + (c & 1)) * size - 0.5, (cell.y() + ((c >> 1) & 1)) * size - 0.5,
+            (cell.z() + ((c >> 2) & 1)) * size - 0.5};
+}
+
+std::vector<Eigen::Vector3d> BranchedGrid::rest_node_positions(int l) const
+{
+    const Level& lv = level(l);
+    std::vector<Eigen::Vector3d> out(lv.node_users.size(), Eigen::Vector3d::Constant(std::nan("")));
+    const Eigen::Matrix4d& t = m_voxels.index_to_world();
+    for (const Element& e : lv.elements) {
+        if (!e.alive) continue;
+        for (int c = 0; c < 8; ++c)
+            out[e.nodes[c]] = t.topLeftCorner<3, 3>() * cell_corner_index(e.cell, l, c) + t.topRightCorner<3, 1>();
+    }
+    return out;
 }
 
 double BranchedGrid::total_mass_kg() const

@@ -115,6 +115,14 @@ public:
     [[nodiscard]] Matrix8d mass(int l, std::uint32_t e) const;
     /// True when element e of level l fills its cell with one material (it shares its matrices).
     [[nodiscard]] bool is_full(int l, std::uint32_t e) const;
+    /// The element of level l (>= 1) holding the alive fine voxel v.
+    [[nodiscard]] std::uint32_t element_of(std::uint32_t v, int l) const;
+    /// Rest position (world mm) of every node id of level l (>= 1): the corners of the cells;
+    /// ids no element uses are NaN.
+    [[nodiscard]] std::vector<Eigen::Vector3d> rest_node_positions(int l) const;
+    /// Index-space position of corner c of cell `cell` at level l (cells span 2^l voxels; a voxel's
+    /// box is its centre +- 1/2).
+    [[nodiscard]] static Eigen::Vector3d cell_corner_index(const Coord& cell, int l, int c);
     /// Sum of all fine voxels' masses, kg.
     [[nodiscard]] double total_mass_kg() const;
 

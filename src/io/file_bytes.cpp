@@ -73,6 +73,31 @@ std::vector<std::byte> read_file_bytes(const std::string& path)
     return bytes;
 }
 
+FileHead read_file_head(const std::string& path, std::size_t max_bytes)
+{
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throw file_error(path, "no such file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw file_error(path, "cannot open");
+    FileHead head;
+    head.text.resize(max_bytes);
+    in.read(head.text.data(), static_cast<std::streamsize>(head.text.size()));
+    head.whole_file = static_cast<std::size_t>(in.gcount()) < head.text.size();
+    head.text.resize(static_cast<std::size_t>(in.gcount()));
+    return head;
+}
+
+void read_file_range(const std::string& file, std::uint64_t offset, std::byte* out, std::uint64_t count,
+                     const std::string& what)
+{
+    std::ifstream in(file, std::ios::binary);
+    in.seekg(static_cast<std::streamoff>(offset));
+    in.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(count));
+    if (!in || static_cast<std::uint64_t>(in.gcount()) != count)
+        throw file_error(what, "cannot read " + std::to_string(count) + " bytes at offset " + std::to_string(offset) +
+                                   " of '" + file + "'");
+}
+
 std::vector<std::byte> inflate_exact(const std::byte* data, std::size_t size, std::size_t expected,
                                      const std::string& what)
 {

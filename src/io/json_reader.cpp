@@ -1,18 +1,19 @@
 #include "io/json_reader.hpp"
 
 #include "io/file_bytes.hpp"
+#include "io/text_parsing.hpp"
 
 #include <nlohmann/json.hpp>
 
-#include <charconv>
 #include <cstdint>
 #include <iterator>
 #include <regex>
 #include <set>
-#include <system_error>
 #include <type_traits>
 
 namespace vox::io {
+
+using detail::number_text;
 
 namespace {
 
@@ -104,13 +105,6 @@ json read_json_file(const std::filesystem::path& path)
     const std::string source = path.string();
     const std::vector<std::byte> bytes = read_file_bytes(source);
     return parse_json(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()), source);
-}
-
-std::string number_text(double v)
-{
-    std::array<char, 32> buffer{};
-    const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), v);
-    return std::string(buffer.data(), result.ptr);
 }
 
 std::string show(const json& value)

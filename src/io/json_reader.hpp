@@ -38,9 +38,6 @@ namespace vox::io {
 /// as given. Throws InputError also when the file is missing or unreadable.
 [[nodiscard]] nlohmann::json read_json_file(const std::filesystem::path& path);
 
-/// Shortest text that reads back as `v` ("0.5", "30000", "1e-06").
-[[nodiscard]] std::string number_text(double v);
-
 /// A value as the user wrote it, shortened so one message stays one readable line.
 [[nodiscard]] std::string show(const nlohmann::json& value);
 

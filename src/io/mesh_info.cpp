@@ -3,36 +3,18 @@
 
 #include "io/mesh_info.hpp"
 
+#include "grid/union_find.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cstdint>
-#include <numeric>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
 namespace vox::io {
 namespace {
-
-/// Union-find over vertex indices, for grouping boundary edges into loops.
-class DisjointSets {
-public:
-    explicit DisjointSets(std::size_t n) : m_parent(n) { std::iota(m_parent.begin(), m_parent.end(), 0); }
-    int find(int i)
-    {
-        while (m_parent[static_cast<std::size_t>(i)] != i) {
-            int& p = m_parent[static_cast<std::size_t>(i)];
-            p = m_parent[static_cast<std::size_t>(p)]; // path halving
-            i = p;
-        }
-        return i;
-    }
-    void unite(int a, int b) { m_parent[static_cast<std::size_t>(find(a))] = find(b); }
-
-private:
-    std::vector<int> m_parent;
-};
 
 /// One use of an undirected edge by a triangle: `key` packs (min, max) vertex index, `forward` says
 /// whether the triangle walks it from min to max.
@@ -61,7 +43,7 @@ std::vector<EdgeUse> sorted_edge_uses(const TriangleMesh& mesh)
 void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, MeshInfo& info)
 {
     const std::vector<EdgeUse> uses = sorted_edge_uses(mesh);
-    std::vector<std::pair<int, int>> boundary; // directed as their triangle walks them
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> boundary; // directed as their triangle walks them
     info.consistently_oriented = true;
     for (std::size_t i = 0; i < uses.size();) {
         std::size_t j = i;
@@ -70,8 +52,8 @@ void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, Me
         const std::size_t count = j - i;
         ++info.edges;
         if (count == 1) {
-            const int lo = static_cast<int>(uses[i].key >> 32);
-            const int hi = static_cast<int>(uses[i].key & 0xffffffffu);
+            const auto lo = static_cast<std::uint32_t>(uses[i].key >> 32);
+            const auto hi = static_cast<std::uint32_t>(uses[i].key & 0xffffffffu);
             boundary.emplace_back(uses[i].forward ? lo : hi, uses[i].forward ? hi : lo);
         } else if (balance != 0) {
             info.consistently_oriented = false;
@@ -82,13 +64,13 @@ void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, Me
     info.boundary_edges = boundary.size();
     info.closed = !mesh.triangles.empty() && info.boundary_edges == 0 && info.non_manifold_edges == 0;
 
-    DisjointSets sets(mesh.vertices.size());
-    for (const auto& [a, b] : boundary) sets.unite(a, b);
-    std::unordered_map<int, Eigen::Vector3d> loop_area; // by the loop's representative vertex
+    grid::UnionFind loops(mesh.vertices.size()); // boundary edges grouped into loops
+    for (const auto& [a, b] : boundary) loops.unite(a, b);
+    std::unordered_map<std::uint32_t, Eigen::Vector3d> loop_area; // by the loop's representative vertex
     for (const auto& [a, b] : boundary) {
-        const Eigen::Vector3d pa = mesh.vertices[static_cast<std::size_t>(a)] - centre;
-        const Eigen::Vector3d pb = mesh.vertices[static_cast<std::size_t>(b)] - centre;
-        auto [it, inserted] = loop_area.try_emplace(sets.find(a), Eigen::Vector3d::Zero());
+        const Eigen::Vector3d pa = mesh.vertices[a] - centre;
+        const Eigen::Vector3d pb = mesh.vertices[b] - centre;
+        auto [it, inserted] = loop_area.try_emplace(loops.find(a), Eigen::Vector3d::Zero());
         it->second += 0.5 * pa.cross(pb);
     }
     info.boundary_loops = loop_area.size();

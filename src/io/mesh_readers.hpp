@@ -1,16 +1,15 @@
 #pragma once
 // Internal to src/io: the per-format mesh readers that read_mesh dispatches to, and what they
-// share (fan triangulation, word splitting, number parsing). Each reader returns vertices in file
-// units; read_mesh scales them to millimetres and checks the result with check_mesh.
+// share (fan triangulation, point text; word splitting and number parsing are in
+// io/text_parsing.hpp). Each reader returns vertices in file units; read_mesh scales them to
+// millimetres and checks the result with check_mesh.
 
 #include "io/mesh.hpp"
 
 #include <Eigen/Core>
 
 #include <cstddef>
-#include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace vox::io::detail {
@@ -39,12 +38,6 @@ struct MeshBuilder {
     /// The mesh, after a warning naming `path` when faces were skipped.
     [[nodiscard]] TriangleMesh finish(const std::string& path);
 };
-
-/// The whole of `s` as a number ("1", "-2.5e3", "+4", "nan", "inf"); nullopt for anything else.
-[[nodiscard]] std::optional<double> parse_double(std::string_view s);
-
-/// The runs of non-whitespace in `s`, in order.
-[[nodiscard]] std::vector<std::string_view> split_words(std::string_view s);
 
 /// "(x, y, z)", for messages about a point.
 [[nodiscard]] std::string format_point(const Eigen::Vector3d& p);

@@ -23,88 +23,41 @@
 #include "core/error.hpp"
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
+#include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
 #include <algorithm>
 #include <bit>
-#include <charconv>
-#include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
 #include <string_view>
 
 namespace vox::io {
+
+using detail::field_double;
+using detail::field_int;
+using detail::HeaderFields;
+using detail::number_text;
+using detail::printable;
+using detail::split_words;
+using detail::trim;
+
 namespace {
 
 /// MetaImage headers are a few hundred bytes: a file with no ElementDataFile line in its first MiB
 /// is not one, and reading further would only pull binary data into memory.
 constexpr std::size_t k_max_header_bytes = std::size_t{1} << 20;
 
-std::string_view trim(std::string_view s)
-{
-    const auto first = s.find_first_not_of(" \t\r");
-    if (first == std::string_view::npos) return {};
-    const auto last = s.find_last_not_of(" \t\r");
-    return s.substr(first, last - first + 1);
-}
-
-/// A header excerpt safe to print in a one-line message.
-std::string printable(std::string_view s)
-{
-    std::string out;
-    for (const char c : s.substr(0, 60)) out += (c >= 32 && c < 127) ? c : '?';
-    if (s.size() > 60) out += "...";
-    return out;
-}
-
-/// Shortest text of a number for messages ("-1", not "-1.000000").
-std::string number_text(double x)
-{
-    char buf[32];
-    const auto [end, ec] = std::to_chars(buf, buf + sizeof(buf), x);
-    return ec == std::errc() ? std::string(buf, end) : std::to_string(x);
-}
-
-std::vector<std::string_view> split_words(std::string_view s)
-{
-    std::vector<std::string_view> words;
-    std::size_t pos = 0;
-    while (true) {
-        pos = s.find_first_not_of(" \t", pos);
-        if (pos == std::string_view::npos) return words;
-        const auto end = std::min(s.find_first_of(" \t", pos), s.size());
-        words.push_back(s.substr(pos, end - pos));
-        pos = end;
-    }
-}
+/// MetaImage values are separated by blanks and tabs.
+constexpr std::string_view k_separators = " \t";
 
 /// The header's keys and values, and the byte offset just past the ElementDataFile line.
-struct Header {
-    std::map<std::string, std::string, std::less<>> fields;
-    std::uint64_t end = 0;
-
-    [[nodiscard]] const std::string* find(std::string_view key) const
-    {
-        const auto it = fields.find(key);
-        return it == fields.end() ? nullptr : &it->second;
-    }
-};
-
-Header read_header(const std::string& path)
+HeaderFields read_header(const std::string& path)
 {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw file_error(path, "no such file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw file_error(path, "cannot open");
-    std::string text(k_max_header_bytes, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    const bool whole_file = static_cast<std::size_t>(in.gcount()) < text.size();
-    text.resize(static_cast<std::size_t>(in.gcount()));
-
-    Header h;
+    const auto [text, whole_file] = read_file_head(path, k_max_header_bytes);
+    HeaderFields h;
     std::size_t pos = 0;
     for (int line_no = 1; pos < text.size(); ++line_no) {
         auto nl = text.find('\n', pos);
@@ -130,44 +83,23 @@ Header read_header(const std::string& path)
                                (whole_file ? "" : " in its first MiB"));
 }
 
-double parse_double(const std::string& path, std::string_view key, std::string_view word)
-{
-    if (!word.empty() && word.front() == '+') word.remove_prefix(1);
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
-    if (ec != std::errc() || end != word.data() + word.size())
-        throw file_error(path, "'" + std::string(key) + "' value '" + printable(word) + "' is not a number");
-    if (!std::isfinite(v))
-        throw file_error(path, "'" + std::string(key) + "' value '" + printable(word) + "' is not finite");
-    return v;
-}
-
-std::int64_t parse_int(const std::string& path, std::string_view key, std::string_view word)
-{
-    std::int64_t v = 0;
-    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
-    if (ec != std::errc() || end != word.data() + word.size())
-        throw file_error(path, "'" + std::string(key) + "' value '" + printable(word) + "' is not an integer");
-    return v;
-}
-
 /// The numbers of `key`, which must hold exactly `count` of them; nullopt when the key is absent.
-std::optional<std::vector<double>> numbers(const std::string& path, const Header& h, std::string_view key,
+std::optional<std::vector<double>> numbers(const std::string& path, const HeaderFields& h, std::string_view key,
                                            std::size_t count, const std::string& why)
 {
     const std::string* value = h.find(key);
     if (!value) return std::nullopt;
-    const auto words = split_words(*value);
+    const auto words = split_words(*value, k_separators);
     if (words.size() != count)
         throw file_error(path, "'" + std::string(key) + "' has " + std::to_string(words.size()) + " values, expected " +
                                    std::to_string(count) + " " + why);
     std::vector<double> out;
-    for (const auto w : words) out.push_back(parse_double(path, key, w));
+    for (const auto w : words) out.push_back(field_double(path, key, w));
     return out;
 }
 
 /// The value of the first present key among `aliases`; refuses aliases that disagree.
-std::optional<std::vector<double>> aliased_numbers(const std::string& path, const Header& h,
+std::optional<std::vector<double>> aliased_numbers(const std::string& path, const HeaderFields& h,
                                                    std::initializer_list<std::string_view> aliases, std::size_t count,
                                                    const std::string& why)
 {
@@ -187,7 +119,7 @@ std::optional<std::vector<double>> aliased_numbers(const std::string& path, cons
     return found;
 }
 
-bool parse_bool(const std::string& path, const Header& h, std::string_view key, bool fallback)
+bool parse_bool(const std::string& path, const HeaderFields& h, std::string_view key, bool fallback)
 {
     const std::string* value = h.find(key);
     if (!value) return fallback;
@@ -218,28 +150,17 @@ std::uint64_t file_size(const std::string& path, const std::string& file)
     return size;
 }
 
-void read_exact(const std::string& path, const std::string& file, std::uint64_t offset, std::byte* out,
-                std::uint64_t count)
-{
-    std::ifstream in(file, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(count));
-    if (!in || static_cast<std::uint64_t>(in.gcount()) != count)
-        throw file_error(path, "cannot read " + std::to_string(count) + " bytes at offset " + std::to_string(offset) +
-                                   " of '" + file + "'");
-}
-
 } // namespace
 
 Volume read_metaimage(const std::string& path)
 {
-    const Header h = read_header(path);
+    const HeaderFields h = read_header(path);
 
     if (const auto* type = h.find("ObjectType"); type && *type != "Image")
         throw file_error(path, "ObjectType is '" + printable(*type) + "', expected Image");
     const std::string* ndims_text = h.find("NDims");
     if (!ndims_text) throw file_error(path, "header has no 'NDims'");
-    const std::int64_t ndims = parse_int(path, "NDims", *ndims_text);
+    const std::int64_t ndims = field_int(path, "NDims", *ndims_text);
     if (ndims != 2 && ndims != 3)
         throw file_error(path, "NDims = " + std::to_string(ndims) + ": only 2-D and 3-D images are supported");
     const auto n = static_cast<std::size_t>(ndims);
@@ -248,13 +169,13 @@ Volume read_metaimage(const std::string& path)
     Volume v;
     v.source = path;
     if (!h.find("DimSize")) throw file_error(path, "header has no 'DimSize'");
-    const auto dim_words = split_words(*h.find("DimSize"));
+    const auto dim_words = split_words(*h.find("DimSize"), k_separators);
     if (dim_words.size() != n)
         throw file_error(path, "'DimSize' has " + std::to_string(dim_words.size()) + " values, expected " +
                                    std::to_string(n) + " " + for_ndims);
     v.dims = {1, 1, 1};
     for (std::size_t a = 0; a < n; ++a) {
-        v.dims[a] = parse_int(path, "DimSize", dim_words[a]);
+        v.dims[a] = field_int(path, "DimSize", dim_words[a]);
         if (v.dims[a] <= 0)
             throw file_error(path, "'DimSize' of axis " + std::to_string(a) + " is " + std::to_string(v.dims[a]) +
                                        " (must be positive)");
@@ -263,7 +184,7 @@ Volume read_metaimage(const std::string& path)
     if (!type_name) throw file_error(path, "header has no 'ElementType'");
     v.type = element_type(path, *type_name);
     if (const auto* channels = h.find("ElementNumberOfChannels");
-        channels && parse_int(path, "ElementNumberOfChannels", *channels) != 1)
+        channels && field_int(path, "ElementNumberOfChannels", *channels) != 1)
         throw file_error(path, "ElementNumberOfChannels = " + printable(*channels) +
                                    ": only single-channel (scalar) images are supported");
     if (!parse_bool(path, h, "BinaryData", true))
@@ -300,7 +221,7 @@ Volume read_metaimage(const std::string& path)
     if (h.find("BinaryDataByteOrderMSB") && h.find("ElementByteOrderMSB") && msb != element_msb)
         throw file_error(path, "'BinaryDataByteOrderMSB' and 'ElementByteOrderMSB' disagree");
     const bool compressed = parse_bool(path, h, "CompressedData", false);
-    const std::int64_t header_size = h.find("HeaderSize") ? parse_int(path, "HeaderSize", *h.find("HeaderSize")) : 0;
+    const std::int64_t header_size = h.find("HeaderSize") ? field_int(path, "HeaderSize", *h.find("HeaderSize")) : 0;
     if (header_size < -1)
         throw file_error(path, "HeaderSize = " + std::to_string(header_size) + " (must be -1 or more)");
     const std::string& data_name = *h.find("ElementDataFile");
@@ -332,13 +253,11 @@ Volume read_metaimage(const std::string& path)
     const std::uint64_t size = file_size(path, data_path);
     std::uint64_t start = local ? h.end : 0;
     if (header_size > 0) start = static_cast<std::uint64_t>(header_size);
-    const std::string describe = std::to_string(v.dims[0]) + "x" + std::to_string(v.dims[1]) + "x" +
-                                 std::to_string(v.dims[2]) + " " + scalar_name(v.type);
 
     if (compressed) {
         std::uint64_t packed = 0;
         if (const auto* text = h.find("CompressedDataSize")) {
-            const std::int64_t declared = parse_int(path, "CompressedDataSize", *text);
+            const std::int64_t declared = field_int(path, "CompressedDataSize", *text);
             if (declared <= 0) throw file_error(path, "CompressedDataSize = " + *text + " (must be positive)");
             packed = static_cast<std::uint64_t>(declared);
             if (header_size == -1) start = packed <= size ? size - packed : 0;
@@ -353,20 +272,13 @@ Volume read_metaimage(const std::string& path)
                                             std::to_string(size > start ? size - start : 0));
         check_allocation(data_what, packed, 1);
         std::vector<std::byte> zipped(packed);
-        read_exact(path, data_path, start, zipped.data(), packed);
+        read_file_range(data_path, start, zipped.data(), packed, path);
         v.data = inflate_exact(zipped.data(), zipped.size(), bytes, data_what);
     } else {
         if (header_size == -1) start = size >= bytes ? size - bytes : 0;
-        const std::uint64_t held = size > start ? size - start : 0;
-        if (held < bytes)
-            throw file_error(data_what, "truncated: holds " + std::to_string(held) + " bytes of voxel data, " +
-                                            describe + " needs " + std::to_string(bytes));
-        if (held > bytes)
-            throw file_error(data_what, "holds " + std::to_string(held) + " bytes of voxel data, more than the " +
-                                            std::to_string(bytes) + " of " + describe +
-                                            ": the header does not describe this data");
+        check_voxel_bytes(v, size > start ? size - start : 0, data_what);
         v.data.resize(bytes);
-        read_exact(path, data_path, start, v.data.data(), bytes);
+        read_file_range(data_path, start, v.data.data(), bytes, path);
     }
     if (msb != (std::endian::native == std::endian::big)) swap_bytes(v);
     validate(v);

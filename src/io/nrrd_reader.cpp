@@ -27,6 +27,7 @@
 #include "core/error.hpp"
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
+#include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
 #include <Eigen/Geometry>
@@ -34,7 +35,6 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -45,6 +45,13 @@
 #include <string_view>
 
 namespace vox::io {
+
+using detail::field_double;
+using detail::field_int;
+using detail::HeaderFields;
+using detail::printable;
+using detail::trim;
+
 namespace {
 
 /// NRRD headers are a few hundred bytes: a header with no blank line in its first MiB is refused
@@ -53,22 +60,6 @@ constexpr std::size_t k_max_header_bytes = std::size_t{1} << 20;
 
 enum class Encoding { raw, gzip, ascii };
 enum class Space { lps, ras, las };
-
-std::string_view trim(std::string_view s)
-{
-    const auto first = s.find_first_not_of(" \t\r");
-    if (first == std::string_view::npos) return {};
-    const auto last = s.find_last_not_of(" \t\r");
-    return s.substr(first, last - first + 1);
-}
-
-std::string printable(std::string_view s)
-{
-    std::string out;
-    for (const char c : s.substr(0, 60)) out += (c >= 32 && c < 127) ? c : '?';
-    if (s.size() > 60) out += "...";
-    return out;
-}
 
 std::string lower(std::string_view s)
 {
@@ -92,8 +83,9 @@ std::string canonical_words(std::string_view s)
     return out;
 }
 
-/// Splits a per-axis description into words; a parenthesised vector "(1, 0,0)" is one word.
-std::vector<std::string_view> split_words(std::string_view s)
+/// Splits a per-axis description into words; a parenthesised vector "(1, 0,0)" and a quoted string
+/// are one word each.
+std::vector<std::string_view> split_nrrd_words(std::string_view s)
 {
     std::vector<std::string_view> words;
     std::size_t pos = 0;
@@ -114,19 +106,6 @@ std::vector<std::string_view> split_words(std::string_view s)
         pos = end;
     }
 }
-
-/// A parsed header: fields by normalised name (lower case, no spaces), and the byte offset just
-/// past the blank line that ends it (the file size when the header runs to the end of the file).
-struct Header {
-    std::map<std::string, std::string, std::less<>> fields;
-    std::uint64_t end = 0;
-
-    [[nodiscard]] const std::string* find(std::string_view key) const
-    {
-        const auto it = fields.find(key);
-        return it == fields.end() ? nullptr : &it->second;
-    }
-};
 
 /// Field names of the format; those not used below are accepted and ignored.
 const std::set<std::string, std::less<>>& known_fields()
@@ -165,16 +144,11 @@ const std::set<std::string, std::less<>>& known_fields()
     return names;
 }
 
-Header read_header(const std::string& path)
+/// The header's fields by normalised name (lower case, no spaces), and the byte offset just past the
+/// blank line that ends it (the file size when the header runs to the end of the file).
+HeaderFields read_header(const std::string& path)
 {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw file_error(path, "no such file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw file_error(path, "cannot open");
-    std::string text(k_max_header_bytes, '\0');
-    in.read(text.data(), static_cast<std::streamsize>(text.size()));
-    const bool whole_file = static_cast<std::size_t>(in.gcount()) < text.size();
-    text.resize(static_cast<std::size_t>(in.gcount()));
+    const auto [text, whole_file] = read_file_head(path, k_max_header_bytes);
 
     const auto first_nl = text.find('\n');
     const std::string_view magic = trim(std::string_view(text).substr(0, std::min(first_nl, std::size_t{16})));
@@ -183,7 +157,7 @@ Header read_header(const std::string& path)
                                    "', expected the magic NRRD0001 to NRRD0005");
 
     if (first_nl == std::string::npos) throw file_error(path, "has nothing after the NRRD magic line");
-    Header h;
+    HeaderFields h;
     std::size_t pos = first_nl + 1;
     for (int line_no = 2; pos < text.size(); ++line_no) {
         auto nl = text.find('\n', pos);
@@ -226,26 +200,11 @@ Header read_header(const std::string& path)
     return h;
 }
 
-double parse_double(const std::string& path, std::string_view field, std::string_view word, bool allow_nan = false)
-{
-    if (!word.empty() && word.front() == '+') word.remove_prefix(1);
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
-    if (ec != std::errc() || end != word.data() + word.size())
-        throw file_error(path, "'" + std::string(field) + "' value '" + printable(word) + "' is not a number");
-    if (!std::isfinite(v) && !(allow_nan && std::isnan(v)))
-        throw file_error(path, "'" + std::string(field) + "' value '" + printable(word) + "' is not finite");
-    return v;
-}
-
+/// An integer field; NRRD integers may carry a leading '+'.
 std::int64_t parse_int(const std::string& path, std::string_view field, std::string_view word)
 {
     if (!word.empty() && word.front() == '+') word.remove_prefix(1);
-    std::int64_t v = 0;
-    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), v);
-    if (ec != std::errc() || end != word.data() + word.size())
-        throw file_error(path, "'" + std::string(field) + "' value '" + printable(word) + "' is not an integer");
-    return v;
+    return field_int(path, field, word);
 }
 
 /// Parses "(x,y,z)" into exactly three finite numbers.
@@ -258,7 +217,7 @@ Eigen::Vector3d parse_vector(const std::string& path, std::string_view field, st
     std::vector<double> parts;
     while (true) {
         const auto comma = inner.find(',');
-        parts.push_back(parse_double(path, field, trim(inner.substr(0, comma))));
+        parts.push_back(field_double(path, field, trim(inner.substr(0, comma))));
         if (comma == std::string_view::npos) break;
         inner.remove_prefix(comma + 1);
     }
@@ -269,12 +228,12 @@ Eigen::Vector3d parse_vector(const std::string& path, std::string_view field, st
 }
 
 /// The words of a per-axis field, which must number one per axis.
-std::vector<std::string_view> per_axis(const std::string& path, const Header& h, std::string_view field,
+std::vector<std::string_view> per_axis(const std::string& path, const HeaderFields& h, std::string_view field,
                                        const std::string& label, std::size_t dimension)
 {
     const std::string* value = h.find(field);
     if (!value) return {};
-    auto words = split_words(*value);
+    auto words = split_nrrd_words(*value);
     if (words.size() != dimension)
         throw file_error(path, "'" + label + "' has " + std::to_string(words.size()) + " values, expected " +
                                    std::to_string(dimension) + " for dimension " + std::to_string(dimension));
@@ -368,12 +327,7 @@ std::vector<std::byte> read_range(const DataSource& src, std::uint64_t offset, s
 {
     check_allocation(src.what, count, 1);
     std::vector<std::byte> out(count);
-    std::ifstream in(src.file, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(reinterpret_cast<char*>(out.data()), static_cast<std::streamsize>(count));
-    if (!in || static_cast<std::uint64_t>(in.gcount()) != count)
-        throw file_error(src.what, "cannot read " + std::to_string(count) + " bytes at offset " +
-                                       std::to_string(offset) + " of '" + src.file + "'");
+    read_file_range(src.file, offset, out.data(), count, src.what);
     return out;
 }
 
@@ -422,7 +376,7 @@ void parse_ascii(const std::string& what, std::string_view text, Volume& v)
         if (n == count)
             throw file_error(what, "ascii data holds more than the " + std::to_string(count) + " values expected");
         const std::string_view word = text.substr(pos, end - pos);
-        const double value = parse_double(what, "ascii data", word, true);
+        const double value = field_double(what, "ascii data", word, true);
         std::byte* out = v.data.data() + n * width;
         switch (v.type) {
         case ScalarType::u8: store_as<std::uint8_t>(what, word, value, out); break;
@@ -446,7 +400,7 @@ void parse_ascii(const std::string& what, std::string_view text, Volume& v)
 
 Volume read_nrrd(const std::string& path)
 {
-    const Header h = read_header(path);
+    const HeaderFields h = read_header(path);
     auto required = [&](std::string_view field, const char* label) -> const std::string& {
         const std::string* value = h.find(field);
         if (!value) throw file_error(path, std::string("header has no '") + label + "' field");
@@ -499,7 +453,7 @@ Volume read_nrrd(const std::string& path)
     if (!has_space && (h.find("spacedirections") || h.find("spaceorigin")))
         throw file_error(path, "'space directions' or 'space origin' given without 'space'");
     if (const std::string* units = h.find("spaceunits"))
-        for (const auto word : split_words(*units))
+        for (const auto word : split_nrrd_words(*units))
             if (word != "\"mm\"" && word != "\"\"")
                 throw file_error(path, "space units " + printable(word) + " are not supported (only \"mm\")");
     // LPS from the file's frame: negate x and y for RAS, y for LAS.
@@ -527,7 +481,7 @@ Volume read_nrrd(const std::string& path)
                                                " has zero length (zero voxel spacing)");
             }
         } else {
-            const double s = spacings.empty() ? 1.0 : parse_double(path, "spacings", spacings[a], true);
+            const double s = spacings.empty() ? 1.0 : field_double(path, "spacings", spacings[a], true);
             if (std::isnan(s)) {
                 is_spatial = false;
             } else if (!(s > 0.0)) {
@@ -565,7 +519,7 @@ Volume read_nrrd(const std::string& path)
     // The data: attached after the header, or in a detached file relative to the header's folder.
     DataSource src{path, h.end, path};
     if (const std::string* data_file = h.find("datafile")) {
-        const auto words = split_words(*data_file);
+        const auto words = split_nrrd_words(*data_file);
         if (words.empty()) throw file_error(path, "'data file' is empty");
         if (words[0] == "LIST") throw file_error(path, "data file LIST (one file per slice) is not supported");
         if (words.size() > 1 && words[0].find('%') != std::string_view::npos)
@@ -588,8 +542,6 @@ Volume read_nrrd(const std::string& path)
 
     check_allocation(path, count, scalar_size(v.type));
     const std::uint64_t bytes = count * scalar_size(v.type);
-    const std::string describe = std::to_string(v.dims[0]) + "x" + std::to_string(v.dims[1]) + "x" +
-                                 std::to_string(v.dims[2]) + " " + scalar_name(v.type);
     const std::uint64_t size = file_size(src);
     const std::uint64_t start = line_skip > 0 ? skip_lines(src, src.offset, line_skip) : src.offset;
     const std::uint64_t after = size > start ? size - start : 0;
@@ -598,14 +550,7 @@ Volume read_nrrd(const std::string& path)
     case Encoding::raw: {
         const std::uint64_t skip =
             byte_skip == -1 ? (after > bytes ? after - bytes : 0) : static_cast<std::uint64_t>(byte_skip);
-        const std::uint64_t held = after > skip ? after - skip : 0;
-        if (held < bytes)
-            throw file_error(src.what, "truncated: holds " + std::to_string(held) + " bytes of voxel data, " +
-                                           describe + " needs " + std::to_string(bytes));
-        if (held > bytes)
-            throw file_error(src.what, "holds " + std::to_string(held) + " bytes of voxel data, more than the " +
-                                           std::to_string(bytes) + " of " + describe +
-                                           ": the header does not describe this data");
+        check_voxel_bytes(v, after > skip ? after - skip : 0, src.what);
         v.data = read_range(src, start + skip, bytes);
         break;
     }

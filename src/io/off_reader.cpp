@@ -10,22 +10,13 @@
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
 #include "io/mesh_readers.hpp"
+#include "io/text_parsing.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cstdint>
-#include <system_error>
 
 namespace vox::io::detail {
 namespace {
-
-std::optional<long long> parse_integer(std::string_view s)
-{
-    long long v = 0;
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
-    return v;
-}
 
 /// Yields the words of each non-blank line, with '#' comments removed, and the line's number.
 class LineReader {

@@ -3,6 +3,7 @@
 #include "io/scene.hpp"
 
 #include "io/json_reader.hpp"
+#include "io/text_parsing.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +20,8 @@
 #include <vector>
 
 namespace vox::io {
+
+using detail::number_text;
 
 namespace {
 

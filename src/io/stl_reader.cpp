@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "io/file_bytes.hpp"
 #include "io/mesh_readers.hpp"
+#include "io/text_parsing.hpp"
 
 #include <array>
 #include <bit>

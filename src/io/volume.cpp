@@ -87,6 +87,20 @@ void validate(const Volume& v)
                                        std::to_string(expect));
 }
 
+void check_voxel_bytes(const Volume& v, std::uint64_t held, const std::string& what)
+{
+    const std::uint64_t bytes = static_cast<std::uint64_t>(v.voxel_count()) * scalar_size(v.type);
+    const std::string describe = std::to_string(v.dims[0]) + "x" + std::to_string(v.dims[1]) + "x" +
+                                 std::to_string(v.dims[2]) + " " + scalar_name(v.type);
+    if (held < bytes)
+        throw file_error(what, "truncated: holds " + std::to_string(held) + " bytes of voxel data, " + describe +
+                                   " needs " + std::to_string(bytes));
+    if (held > bytes)
+        throw file_error(what, "holds " + std::to_string(held) + " bytes of voxel data, more than the " +
+                                   std::to_string(bytes) + " of " + describe +
+                                   ": the header does not describe this data");
+}
+
 void swap_bytes(Volume& v)
 {
     const std::size_t w = scalar_size(v.type);

@@ -45,6 +45,11 @@ struct Volume {
 /// Throws InputError naming the volume's source.
 void validate(const Volume& v);
 
+/// Checks that a file's raw voxel data, `held` bytes of it, is exactly what `v.dims` and `v.type`
+/// need. `what` names the data in messages. Throws InputError "WHAT: truncated: holds ..." when it
+/// is shorter, "WHAT: holds ...: the header does not describe this data" when it is longer.
+void check_voxel_bytes(const Volume& v, std::uint64_t held, const std::string& what);
+
 /// Swaps the byte order of every voxel in place (for big-endian files).
 void swap_bytes(Volume& v);
 

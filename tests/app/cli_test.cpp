@@ -1,6 +1,7 @@
 // The voxsculpt program end to end: import -> .vdb -> info, phantoms, usage errors.
 
 #include "app/run_command.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -8,18 +9,11 @@
 #include <filesystem>
 
 namespace fs = std::filesystem;
+using vox::test::fresh_dir;
 using vox::test::quote;
 using vox::test::run_voxsculpt;
 
 namespace {
-fs::path fresh_dir(const std::string& name)
-{
-    const fs::path d = fs::path(::testing::TempDir()) / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
 nlohmann::json info_json(const fs::path& file)
 {
     const auto r = run_voxsculpt("info --json " + quote(file.string()));

@@ -2,6 +2,7 @@
 // mistakes get one line on stderr naming the thing and the problem, exit code 2, and no output.
 
 #include "app/run_command.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,18 +10,11 @@
 #include <filesystem>
 
 namespace fs = std::filesystem;
+using vox::test::fresh_dir;
 using vox::test::quote;
 using vox::test::run_voxsculpt;
 
 namespace {
-
-fs::path fresh_dir(const std::string& name)
-{
-    const fs::path d = fs::path(::testing::TempDir()) / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
 
 /// Exit 2, exactly one line on stderr that contains `must_mention`, and `out_dir` left empty.
 void expect_clean_refusal(const vox::test::CommandResult& r, const std::string& must_mention, const fs::path& out_dir)

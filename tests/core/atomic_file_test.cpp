@@ -1,20 +1,15 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 namespace fs = std::filesystem;
+using vox::test::fresh_dir;
 
 namespace {
-fs::path fresh_dir(const std::string& name)
-{
-    const fs::path d = fs::path(::testing::TempDir()) / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
 std::size_t entries(const fs::path& d) { return static_cast<std::size_t>(std::distance(fs::directory_iterator(d), {})); }
 } // namespace
 

@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "io/test_volume_writers.hpp"
 #include "io/volume_reader.hpp"
+#include "test_support.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -105,28 +106,6 @@ void write(const Volume& v, Format f, const std::string& path)
     }
 }
 
-class TempFolder {
-  public:
-    TempFolder()
-    {
-        const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = std::string("vox_cross_") + test->test_suite_name() + "_" + test->name();
-        for (char& c : name)
-            if (c == '/') c = '_';
-        m_dir = fs::path(::testing::TempDir()) / name;
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    ~TempFolder() { fs::remove_all(m_dir); }
-    TempFolder(const TempFolder&) = delete;
-    TempFolder& operator=(const TempFolder&) = delete;
-
-    [[nodiscard]] std::string path(const std::string& name) const { return (m_dir / name).string(); }
-
-  private:
-    fs::path m_dir;
-};
-
 void expect_same(const Volume& expected, const Volume& got, double transform_tolerance)
 {
     EXPECT_EQ(got.dims, expected.dims);
@@ -145,7 +124,7 @@ class CrossFormat : public ::testing::TestWithParam<std::tuple<Format, ScalarTyp
 TEST_P(CrossFormat, ReadsBackWhatWasWritten)
 {
     const auto [format, type] = GetParam();
-    const TempFolder dir;
+    const test::ScratchDir dir;
     const Volume v = make_volume(type, permuting_rotation());
     const std::string path = dir.path(format_info(format).file);
     write(v, format, path);
@@ -172,7 +151,7 @@ TEST(CrossFormatGeometry, ObliqueRotationAgreesAcrossFormats)
 {
     // MetaImage and NRRD carry doubles in text: exact to 1e-9. NIfTI-1 stores the sform as float32,
     // so it can only agree to float precision (about 1e-7 relative on 20 mm coordinates).
-    const TempFolder dir;
+    const test::ScratchDir dir;
     const Volume v = make_volume(ScalarType::i16, oblique_rotation());
     for (const Format f :
          {Format::nii, Format::nii_gz, Format::mhd_raw, Format::mha_zlib, Format::nrrd_raw, Format::nrrd_gzip}) {
@@ -184,7 +163,7 @@ TEST(CrossFormatGeometry, ObliqueRotationAgreesAcrossFormats)
 
 TEST(CrossFormatGeometry, InrAxisAlignedVolume)
 {
-    const TempFolder dir;
+    const test::ScratchDir dir;
     for (const ScalarType type : {ScalarType::i16, ScalarType::u8, ScalarType::u16, ScalarType::f32, ScalarType::f64}) {
         SCOPED_TRACE(scalar_name(type));
         const Volume v = make_volume(type, Eigen::Matrix3d::Identity());
@@ -207,7 +186,7 @@ std::string big_endian_i16(const Volume& v)
 
 TEST(CrossFormatByteOrder, BigEndianMetaImageAndNrrdMatchLittleEndian)
 {
-    const TempFolder dir;
+    const test::ScratchDir dir;
     const Volume v = make_volume(ScalarType::i16, Eigen::Matrix3d::Identity());
     test::write_metaimage(v, dir.path("little.mha"), false);
     const Volume little = read_volume(dir.path("little.mha"));
@@ -231,7 +210,7 @@ TEST(CrossFormatGeometry, NrrdInRasSpaceMatchesTheLpsNifti)
 {
     // The same physical volume described in RAS (NRRD) and through NIfTI (RAS on disk, converted
     // by its reader): both must give the LPS transform with x and y negated from the RAS file.
-    const TempFolder dir;
+    const test::ScratchDir dir;
     const Volume v = make_volume(ScalarType::i16, permuting_rotation());
     const Eigen::Matrix4d ras = Eigen::Vector4d(-1, -1, 1, 1).asDiagonal() * v.index_to_world;
     std::ostringstream header;

@@ -1,29 +1,19 @@
 #include "io/json_reader.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <functional>
 #include <string>
 
 namespace vox::io {
 namespace {
 
 using nlohmann::json;
+using vox::test::error_of;
 
 const JsonContext k_context{"doc.json", "/data"};
-
-/// The message of the InputError `f` throws; fails the test when it throws nothing.
-std::string error_of(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no InputError thrown";
-    return {};
-}
 
 TEST(JsonReader, UnknownKeyIsRefusedWithItsPathAndTheKnownKeys)
 {

@@ -2,14 +2,13 @@
 
 #include "core/error.hpp"
 #include "io/mesh_info.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -19,28 +18,6 @@ namespace vox::io {
 namespace {
 
 const std::string k_bad = VOX_TEST_DATA_DIR "/bad/";
-
-/// A fresh folder for files a test writes, removed afterwards.
-class TempDir {
-public:
-    TempDir()
-        : m_path(std::filesystem::temp_directory_path() /
-                 ("vox_mesh_test_" + std::to_string(::getpid()) + "_" +
-                  ::testing::UnitTest::GetInstance()->current_test_info()->name()))
-    {
-        std::filesystem::create_directories(m_path);
-    }
-    ~TempDir() { std::filesystem::remove_all(m_path); }
-    [[nodiscard]] std::string path(const std::string& name) const { return (m_path / name).string(); }
-    std::string write(const std::string& name, const std::string& bytes) const
-    {
-        std::ofstream(path(name), std::ios::binary) << bytes;
-        return path(name);
-    }
-
-private:
-    std::filesystem::path m_path;
-};
 
 // The unit cube [0,1]^3, oriented outwards: corner i has coordinates (i & 1, i >> 1 & 1, i >> 2 & 1).
 const char* const k_cube_corners = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n";
@@ -133,7 +110,7 @@ void expect_unit_cube(const TriangleMesh& mesh, double scale)
 
 TEST(MeshRead, UnitCubeInEveryFormat)
 {
-    const TempDir dir;
+    const test::ScratchDir dir;
     for (const auto& [name, bytes] :
          std::vector<std::pair<std::string, std::string>>{{"cube.off", cube_off()},
                                                           {"cube.OBJ", cube_obj()},
@@ -151,7 +128,7 @@ TEST(MeshRead, WeldsOpenMeshNonManifoldCopies)
 {
     // A flipped quad makes OpenMesh refuse the face ("complex edge") and attach it to fresh vertex
     // copies; the reader maps them back so the file's connectivity survives.
-    const TempDir dir;
+    const test::ScratchDir dir;
     const TriangleMesh mesh = read_mesh(dir.write("flipped.obj", cube_obj(true)));
     const MeshInfo info = mesh_info(mesh);
     EXPECT_EQ(info.vertices, 8u);
@@ -162,7 +139,7 @@ TEST(MeshRead, WeldsOpenMeshNonManifoldCopies)
 
 TEST(MeshRead, NonManifoldEdgeKept)
 {
-    const TempDir dir;
+    const test::ScratchDir dir;
     // Three triangles on the edge 0-1, as scans sometimes have: kept, and counted.
     const std::string off = "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n";
     const MeshInfo info = mesh_info(read_mesh(dir.write("fin.off", off)));
@@ -175,7 +152,7 @@ TEST(MeshRead, NonManifoldEdgeKept)
 
 TEST(MeshRead, DegenerateFacesSkipped)
 {
-    const TempDir dir;
+    const test::ScratchDir dir;
     const std::string off = "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 1\n";
     EXPECT_EQ(read_mesh(dir.write("degenerate.off", off)).triangles.size(), 1u);
 }
@@ -220,7 +197,7 @@ TEST(MeshRead, BadPathsAndParameters)
 {
     expect_input_error(k_bad + "no_such_mesh.off", "no such file");
     expect_input_error(k_bad + "no_such_mesh.obj", "no such file");
-    const TempDir dir;
+    const test::ScratchDir dir;
     const std::string folder = dir.path("folder.off");
     std::filesystem::create_directory(folder);
     expect_input_error(folder, "is a folder");
@@ -237,7 +214,7 @@ TEST(MeshRead, OpenMeshDiagnosticsSilenced)
     ::testing::internal::CaptureStderr();
     ::testing::internal::CaptureStdout();
     EXPECT_THROW((void)read_mesh(k_bad + "obj_bad_index.obj"), InputError);
-    const TempDir dir;
+    const test::ScratchDir dir;
     EXPECT_NO_THROW((void)read_mesh(dir.write("flipped.obj", cube_obj(true))));
     EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
     EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");

@@ -6,6 +6,7 @@
 #include "core/memory_limit.hpp"
 #include "io/test_volume_writers.hpp"
 #include "io/volume_reader.hpp"
+#include "test_support.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -13,78 +14,32 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 
 namespace vox::io {
 namespace {
 
 namespace fs = std::filesystem;
 
+using test::be16;
+using test::le16;
+using test::world;
+
 class MetaImageReader : public ::testing::Test {
   protected:
-    void SetUp() override
-    {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_dir = fs::path(::testing::TempDir()) / (std::string("vox_metaimage_") + info->name());
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
-
-    [[nodiscard]] std::string path(const std::string& name) const { return (m_dir / name).string(); }
+    [[nodiscard]] std::string path(const std::string& name) const { return m_dir.path(name); }
 
     /// Writes `header` then `data` bytes to `name` in the test folder; returns the full path.
     std::string write(const std::string& name, const std::string& header, const std::string& data = {}) const
     {
-        std::ofstream out(path(name), std::ios::binary);
-        out << header << data;
-        return path(name);
+        return m_dir.write(name, header + data);
     }
 
-    fs::path m_dir;
+    test::ScratchDir m_dir;
 };
-
-/// Little-endian bytes of int16 values.
-std::string le16(std::initializer_list<std::int16_t> values)
-{
-    std::string out;
-    for (const std::int16_t v : values) {
-        const auto u = static_cast<std::uint16_t>(v);
-        out += static_cast<char>(u & 0xff);
-        out += static_cast<char>(u >> 8);
-    }
-    return out;
-}
-
-std::string be16(std::initializer_list<std::int16_t> values)
-{
-    std::string out = le16(values);
-    for (std::size_t i = 0; i + 1 < out.size(); i += 2) std::swap(out[i], out[i + 1]);
-    return out;
-}
-
-/// The message of the InputError `f` throws (a test failure when it throws none).
-std::string input_error(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "expected an InputError";
-    return {};
-}
 
 void expect_refused(const std::string& file, const std::string& problem)
 {
-    const std::string message = input_error([&] { (void)read_metaimage(file); });
-    EXPECT_EQ(message.rfind(file, 0), 0u) << "message does not start with the file: " << message;
-    EXPECT_NE(message.find(problem), std::string::npos) << "message lacks '" << problem << "': " << message;
-}
-
-Eigen::Vector3d world(const Volume& v, double i, double j, double k)
-{
-    return (v.index_to_world * Eigen::Vector4d(i, j, k, 1.0)).head<3>();
+    test::expect_refused([&] { (void)read_metaimage(file); }, file, problem);
 }
 
 const std::string k_head = "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n";
@@ -169,7 +124,7 @@ TEST_F(MetaImageReader, ReadsBigEndianData)
 
 TEST_F(MetaImageReader, DetachedDataIsRelativeToTheHeaderFolder)
 {
-    fs::create_directories(m_dir / "sub");
+    fs::create_directories(m_dir.root() / "sub");
     write("sub/voxels.raw", "", le16({5, -6}));
     const std::string file =
         write("a.mhd", k_head + "DimSize = 2 1 1\nElementType = MET_SHORT\nElementDataFile = sub/voxels.raw\n");

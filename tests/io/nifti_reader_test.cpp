@@ -1,6 +1,7 @@
 #include "io/volume_reader.hpp"
 
 #include "core/error.hpp"
+#include "io/test_volume_writers.hpp"
 
 #include <gtest/gtest.h>
 #include <nifti2_io.h>
@@ -13,6 +14,7 @@
 
 namespace fs = std::filesystem;
 using namespace vox::io;
+using vox::test::world;
 
 namespace {
 
@@ -30,11 +32,6 @@ std::string write_nifti_file(const std::string& name, const std::function<void(n
     nifti_image_write(nim);
     nifti_image_free(nim);
     return path;
-}
-
-Eigen::Vector3d centre(const Volume& v, double i, double j, double k)
-{
-    return (v.index_to_world * Eigen::Vector4d(i, j, k, 1)).head<3>();
 }
 
 } // namespace
@@ -59,10 +56,10 @@ TEST(NiftiReader, QformRotationIsConvertedFromRasToLps)
     const Volume v = read_volume(path);
     EXPECT_EQ(v.dims, (std::array<std::int64_t, 3>{3, 2, 2}));
     // In RAS, index axis i points along +y: voxel (1,0,0) is at (10, 22, 30); LPS negates x and y.
-    EXPECT_TRUE(centre(v, 0, 0, 0).isApprox(Eigen::Vector3d(-10, -20, 30), 1e-6));
-    EXPECT_TRUE(centre(v, 1, 0, 0).isApprox(Eigen::Vector3d(-10, -22, 30), 1e-6));
-    EXPECT_TRUE(centre(v, 0, 1, 0).isApprox(Eigen::Vector3d(-7, -20, 30), 1e-6));
-    EXPECT_TRUE(centre(v, 0, 0, 1).isApprox(Eigen::Vector3d(-10, -20, 34), 1e-6));
+    EXPECT_TRUE(world(v, 0, 0, 0).isApprox(Eigen::Vector3d(-10, -20, 30), 1e-6));
+    EXPECT_TRUE(world(v, 1, 0, 0).isApprox(Eigen::Vector3d(-10, -22, 30), 1e-6));
+    EXPECT_TRUE(world(v, 0, 1, 0).isApprox(Eigen::Vector3d(-7, -20, 30), 1e-6));
+    EXPECT_TRUE(world(v, 0, 0, 1).isApprox(Eigen::Vector3d(-10, -20, 34), 1e-6));
     EXPECT_EQ(v.stored(0), -50.0);
     EXPECT_EQ(v.stored(11), 60.0);
 }
@@ -77,8 +74,8 @@ TEST(NiftiReader, SformTakesPrecedenceAndKeepsShear)
             for (int c = 0; c < 4; ++c) nim.sto_xyz.m[r][c] = s[r][c];
     });
     const Volume v = read_volume(path);
-    EXPECT_TRUE(centre(v, 0, 0, 0).isApprox(Eigen::Vector3d(5, -7, 1), 1e-6));
-    EXPECT_TRUE(centre(v, 2, 1, 1).isApprox(Eigen::Vector3d(-(3 + 0.25 - 5), -(2 + 7), 1.5), 1e-6));
+    EXPECT_TRUE(world(v, 0, 0, 0).isApprox(Eigen::Vector3d(5, -7, 1), 1e-6));
+    EXPECT_TRUE(world(v, 2, 1, 1).isApprox(Eigen::Vector3d(-(3 + 0.25 - 5), -(2 + 7), 1.5), 1e-6));
 }
 
 TEST(NiftiReader, SlopeAndInterceptScaleValues)

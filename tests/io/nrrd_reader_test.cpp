@@ -6,98 +6,32 @@
 #include "core/memory_limit.hpp"
 #include "io/test_volume_writers.hpp"
 #include "io/volume_reader.hpp"
+#include "test_support.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <functional>
 
 namespace vox::io {
 namespace {
 
-namespace fs = std::filesystem;
+using test::be16;
+using test::gzip;
+using test::le16;
+using test::world;
 
 class NrrdReader : public ::testing::Test {
   protected:
-    void SetUp() override
-    {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_dir = fs::path(::testing::TempDir()) / (std::string("vox_nrrd_") + info->name());
-        fs::remove_all(m_dir);
-        fs::create_directories(m_dir);
-    }
-    void TearDown() override { fs::remove_all(m_dir); }
+    [[nodiscard]] std::string path(const std::string& name) const { return m_dir.path(name); }
+    std::string write(const std::string& name, const std::string& content) const { return m_dir.write(name, content); }
 
-    [[nodiscard]] std::string path(const std::string& name) const { return (m_dir / name).string(); }
-
-    std::string write(const std::string& name, const std::string& content) const
-    {
-        std::ofstream out(path(name), std::ios::binary);
-        out << content;
-        return path(name);
-    }
-
-    fs::path m_dir;
+    test::ScratchDir m_dir;
 };
-
-std::string le16(std::initializer_list<std::int16_t> values)
-{
-    std::string out;
-    for (const std::int16_t v : values) {
-        const auto u = static_cast<std::uint16_t>(v);
-        out += static_cast<char>(u & 0xff);
-        out += static_cast<char>(u >> 8);
-    }
-    return out;
-}
-
-std::string be16(std::initializer_list<std::int16_t> values)
-{
-    std::string out = le16(values);
-    for (std::size_t i = 0; i + 1 < out.size(); i += 2) std::swap(out[i], out[i + 1]);
-    return out;
-}
-
-std::string gzip(const std::string& data)
-{
-    z_stream zs{};
-    deflateInit2(&zs, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-    std::string out(deflateBound(&zs, static_cast<uLong>(data.size())) + 32, '\0');
-    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-    zs.avail_in = static_cast<uInt>(data.size());
-    zs.next_out = reinterpret_cast<Bytef*>(out.data());
-    zs.avail_out = static_cast<uInt>(out.size());
-    deflate(&zs, Z_FINISH);
-    out.resize(zs.total_out);
-    deflateEnd(&zs);
-    return out;
-}
-
-std::string input_error(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "expected an InputError";
-    return {};
-}
 
 void expect_refused(const std::string& file, const std::string& problem)
 {
-    const std::string message = input_error([&] { (void)read_nrrd(file); });
-    EXPECT_EQ(message.rfind(file, 0), 0u) << "message does not start with the file: " << message;
-    EXPECT_NE(message.find(problem), std::string::npos) << "message lacks '" << problem << "': " << message;
-}
-
-Eigen::Vector3d world(const Volume& v, double i, double j, double k)
-{
-    return (v.index_to_world * Eigen::Vector4d(i, j, k, 1.0)).head<3>();
+    test::expect_refused([&] { (void)read_nrrd(file); }, file, problem);
 }
 
 /// An attached-data NRRD: magic, `fields` (one per line), blank line, data.

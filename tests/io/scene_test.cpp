@@ -1,5 +1,7 @@
 #include "io/scene.hpp"
 
+#include "test_support.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -7,7 +9,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iterator>
 #include <set>
 #include <string>
@@ -18,24 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using vox::InputError;
+using vox::test::error_of;
 using namespace vox::io;
 
 const fs::path source_dir = VOX_SOURCE_DIR;
 const fs::path scenes_dir = source_dir / "data" / "scenes";
 const fs::path bad_dir = fs::path(VOX_TEST_DATA_DIR) / "bad";
-
-/// The message of the InputError `f` throws; fails the test when it throws nothing.
-std::string error_of(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    ADD_FAILURE() << "no InputError thrown";
-    return {};
-}
 
 json read_json(const fs::path& path)
 {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace vox::test {
 namespace {
@@ -253,6 +254,36 @@ void write_inr(const io::Volume& v, const std::string& path)
     header.append(256 - end.size() - header.size(), '\n');
     header += end;
     write_file(path, header, little_endian_bytes(v));
+}
+
+std::string le16(std::initializer_list<std::int16_t> values)
+{
+    std::string out;
+    for (const std::int16_t v : values) {
+        const auto u = static_cast<std::uint16_t>(v);
+        out += static_cast<char>(u & 0xff);
+        out += static_cast<char>(u >> 8);
+    }
+    return out;
+}
+
+std::string be16(std::initializer_list<std::int16_t> values)
+{
+    std::string out = le16(values);
+    for (std::size_t i = 0; i + 1 < out.size(); i += 2) std::swap(out[i], out[i + 1]);
+    return out;
+}
+
+std::string gzip(const std::string& data)
+{
+    const auto* first = reinterpret_cast<const std::byte*>(data.data());
+    const std::vector<std::byte> zipped = deflate_bytes(std::vector<std::byte>(first, first + data.size()), true);
+    return {reinterpret_cast<const char*>(zipped.data()), zipped.size()};
+}
+
+Eigen::Vector3d world(const io::Volume& v, double i, double j, double k)
+{
+    return (v.index_to_world * Eigen::Vector4d(i, j, k, 1.0)).head<3>();
 }
 
 } // namespace vox::test

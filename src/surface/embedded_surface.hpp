@@ -1,0 +1,93 @@
+#pragma once
+// The object's surface: marching cubes over the fine voxels with voxel centres as cube corners
+// (cube_polygons.hpp), every vertex embedded by trilinear coordinates in the element of the
+// simulated level that holds the voxel it belongs to, so the deformed surface follows the element
+// nodes. One surface serves pictures, contact and export. Removing voxels or disconnecting faces
+// recomputes only the cubes that touch them; the result equals a fresh extraction.
+
+#include "grid/branched_grid.hpp"
+#include "surface/cube_polygons.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+namespace vox::surface {
+
+struct SurfaceVertex {
+    std::uint64_t key = 0;            ///< identity: voxel face, face centre or cube centre (see .cpp)
+    std::uint32_t voxel = 0;          ///< the fine voxel (slot) it belongs to
+    Eigen::Vector3d rest{0, 0, 0};    ///< rest position in the grid's index space (voxel units)
+    std::uint32_t element = 0;        ///< element of the simulated level holding `voxel`
+    Eigen::Vector3d local{0, 0, 0};   ///< trilinear coordinates in that element's cell
+    std::int32_t label = 0;           ///< material label of `voxel`
+    std::uint32_t users = 0;          ///< triangles using it; 0 marks a free slot
+};
+
+/// A compact copy of the surface: positions in world millimetres, triangles with outward normals
+/// in world space, one label per vertex.
+struct SurfaceMesh {
+    std::vector<Eigen::Vector3d> positions;
+    std::vector<Eigen::Vector3i> triangles;
+    std::vector<std::int32_t> labels;
+};
+
+class EmbeddedSurface {
+public:
+    /// Extracts the whole surface of `grid`'s voxels, embedded at `level` (1 .. grid.max_level()).
+    EmbeddedSurface(const grid::BranchedGrid& grid, int level);
+
+    /// Brings the surface up to date after `grid.update(removed, faces)` returned `report`.
+    void update(const grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
+                std::span<const std::pair<grid::Coord, int>> faces, const grid::UpdateReport& report);
+
+    [[nodiscard]] int level() const { return m_level; }
+    [[nodiscard]] std::size_t vertex_count() const { return m_vertex_count; }
+    [[nodiscard]] std::size_t triangle_count() const { return m_triangle_count; }
+    /// Vertex slots (users == 0: free) and triangle slots (a free one has vertex no_index).
+    [[nodiscard]] const std::vector<SurfaceVertex>& vertices() const { return m_vertices; }
+    [[nodiscard]] const std::vector<std::array<std::uint32_t, 3>>& triangles() const { return m_triangles; }
+
+    /// Deformed vertex positions (per vertex slot, world mm) from the level's node positions
+    /// (per node id, world mm): x = sum over corners of N_c(local) * node position.
+    void deform(const grid::BranchedGrid& grid, std::span<const Eigen::Vector3d> node_positions,
+                std::vector<Eigen::Vector3d>& out) const;
+    /// The surface at rest, or deformed by `node_positions`, as a compact mesh.
+    [[nodiscard]] SurfaceMesh mesh(const grid::BranchedGrid& grid) const;
+    [[nodiscard]] SurfaceMesh mesh(const grid::BranchedGrid& grid, std::span<const Eigen::Vector3d> node_positions) const;
+
+    /// Taubin smoothing of the rest positions (lambda 0.5, mu -0.53 per iteration pair), each
+    /// vertex staying embedded in its element: its trilinear coordinates are recomputed there.
+    void smooth(const grid::BranchedGrid& grid, int iterations);
+
+private:
+    void extract_cube(const grid::BranchedGrid& grid, const grid::Coord& cube);
+    void clear_cube(std::uint64_t cube_key);
+    std::uint32_t vertex_for(const grid::BranchedGrid& grid, const grid::Coord& cube, const CubeVertex& v,
+                             const std::array<std::uint32_t, 8>& corners);
+    void embed(const grid::BranchedGrid& grid, SurfaceVertex& v) const;
+    void release_vertex(std::uint32_t v);
+    [[nodiscard]] std::uint64_t cube_key(const grid::Coord& cube) const;
+
+    int m_level = 1;
+    grid::Coord m_origin{0, 0, 0};
+    std::vector<SurfaceVertex> m_vertices;
+    std::vector<std::uint32_t> m_free_vertices;
+    grid::CoordMap m_vertex_index; ///< key -> vertex slot (missing when freed)
+    std::vector<std::array<std::uint32_t, 3>> m_triangles;
+    std::vector<std::uint32_t> m_free_triangles;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> m_cube_triangles;
+    /// Face- and cube-centre vertices by the voxel they belong to (crossings are found by key).
+    std::unordered_multimap<std::uint32_t, std::uint32_t> m_centre_vertices;
+    std::size_t m_vertex_count = 0;
+    std::size_t m_triangle_count = 0;
+    bool m_flip = false; ///< the index-to-world transform mirrors: flip windings in world space
+    /// Triangulations by cube configuration (8 presence bits, 12 connection bits), filled on demand.
+    std::unordered_map<std::uint32_t, CubeCase> m_cases;
+};
+
+} // namespace vox::surface
