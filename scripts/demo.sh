@@ -21,6 +21,10 @@ step "Dynamic Branched Grid of the liver: levels 0 to 5"
 "$vox" grid "$out/liver.vdb" --levels 5
 "$vox" grid "$out/liver.vdb" --levels 5 --json > "$out/liver-grid.json"
 
+step "The liver's marching-cubes surface, in world millimetres"
+"$vox" export "$out/liver.vdb" -o "$out/liver-surface.ply"
+"$vox" export "$out/liver.vdb" -o "$out/liver-surface.obj"
+
 step "Closed mesh (elephant.off) voxelised through OpenVDB"
 "$vox" import "$data/elephant.off" --voxel-size 0.01 -o "$out/elephant.vdb"
 

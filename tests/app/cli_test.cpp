@@ -74,7 +74,7 @@ TEST(Cli, PhantomWritesDocumentedSizes)
 
 TEST(Cli, HelpAndUsageErrors)
 {
-    for (const char* sub : {"", "import ", "info ", "phantom ", "phantom sphere ", "check "}) {
+    for (const char* sub : {"", "import ", "info ", "phantom ", "phantom sphere ", "check ", "grid ", "export "}) {
         const auto r = run_voxsculpt(std::string(sub) + "--help");
         EXPECT_EQ(r.exit_code, 0) << sub;
         EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
@@ -86,6 +86,30 @@ TEST(Cli, HelpAndUsageErrors)
     const auto missing_out = run_voxsculpt("import x.nii");
     EXPECT_EQ(missing_out.exit_code, 2);
     EXPECT_NE(missing_out.err.find("--output"), std::string::npos) << missing_out.err;
+}
+
+TEST(Cli, ExportWritesTheClosedSurfaceInWorldMillimetres)
+{
+    const fs::path d = fresh_dir("cli_export");
+    const std::string vdb = (d / "b.vdb").string();
+    ASSERT_EQ(run_voxsculpt("phantom block --size-mm 6 4 2 --voxel-mm 2 -o " + quote(vdb)).exit_code, 0);
+    for (const char* ext : {"obj", "ply", "stl", "off"}) {
+        const std::string mesh = (d / (std::string("b.") + ext)).string();
+        const auto r = run_voxsculpt("export " + quote(vdb) + " -o " + quote(mesh));
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto j = info_json(mesh);
+        // A 3 x 2 x 1 voxel box: 8 + 2 * 4 * (2 + 1 + 0) + 2 * 2 * (2 * 1) = 40 triangles.
+        EXPECT_EQ(j["faces"], 40) << ext;
+        EXPECT_EQ(j["closed"], true) << ext;
+        EXPECT_EQ(j["consistently_oriented"], true) << ext;
+        EXPECT_GT(j["enclosed_volume_mm3"].get<double>(), 0.0) << ext;
+        // Vertices sit on voxel faces: the box spans [-1, 5] x [-1, 3] x [-1, 1] mm.
+        EXPECT_NEAR(j["world_bbox_mm"]["min"][0].get<double>(), -1.0, 1e-6);
+        EXPECT_NEAR(j["world_bbox_mm"]["max"][0].get<double>(), 5.0, 1e-6);
+    }
+    const auto bad = run_voxsculpt("export " + quote(vdb) + " -o " + quote((d / "b.xyz").string()));
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(bad.err.find("b.xyz"), std::string::npos);
 }
 
 TEST(Cli, QuietPrintsNothingOnSuccess)
