@@ -14,5 +14,6 @@ void add_phantom_command(CLI::App& app);
 void add_check_command(CLI::App& app);
 void add_grid_command(CLI::App& app);
 void add_export_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 } // namespace vox::app

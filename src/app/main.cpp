@@ -31,6 +31,7 @@ int main(int argc, char** argv)
     vox::app::add_check_command(app);
     vox::app::add_grid_command(app);
     vox::app::add_export_command(app);
+    vox::app::add_run_command(app);
 
     try {
         app.parse(argc, argv);

@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -26,6 +27,8 @@ using detail::number_text;
 namespace {
 
 constexpr NameTable<SolverType, 2> solver_types{{{"dbg", SolverType::dbg}, {"isxfem", SolverType::isxfem}}};
+constexpr NameTable<SolverMode, 2> solver_modes{
+    {{"dynamic", SolverMode::dynamic}, {"static", SolverMode::static_equilibrium}}};
 constexpr NameTable<ConstraintType, 2> constraint_types{
     {{"fixed", ConstraintType::fixed}, {"slide", ConstraintType::slide}}};
 constexpr NameTable<ToolShape, 4> tool_shapes{{{"blade", ToolShape::blade},
@@ -38,6 +41,42 @@ constexpr NameTable<ToolShape, 4> tool_shapes{{{"blade", ToolShape::blade},
 // ---------------------------------------------------------------------------------------------
 
 const Bound positive = greater_than(0.0);
+
+constexpr std::array<char, 3> axis_names{'x', 'y', 'z'};
+
+/// An [x, y, z] array of finite numbers. A JSON file cannot hold NaN or infinity, but a document
+/// built in code (parse_scene) can.
+Eigen::Vector3d finite_vector(const JsonNode& node)
+{
+    // Checked before as<>, whose range check would report a NaN as out of range.
+    if (node.value().is_array() && node.value().size() == 3) {
+        for (const JsonNode& item : node.elements()) {
+            if (item.value().is_number_float() && !std::isfinite(item.value().get<double>())) {
+                item.fail("must be a finite number");
+            }
+        }
+    }
+    return as<Eigen::Vector3d>(node);
+}
+
+/// An axis-aligned box [[x, y, z], [x, y, z]]: its min and max corners, world mm.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> read_box(const JsonNode& box)
+{
+    if (!box.value().is_array() || box.value().size() != 2) {
+        box.fail_type("[[x, y, z], [x, y, z]] (the box's min and max corners)");
+    }
+    const std::vector<JsonNode> corners = box.elements();
+    const Eigen::Vector3d lo = finite_vector(corners[0]);
+    const Eigen::Vector3d hi = finite_vector(corners[1]);
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        const auto i = static_cast<Eigen::Index>(axis);
+        if (lo[i] > hi[i]) {
+            box.fail(std::string("min corner is above max corner along ") + axis_names[axis] + " (" +
+                     number_text(lo[i]) + " > " + number_text(hi[i]) + ")");
+        }
+    }
+    return {lo, hi};
+}
 
 /// A scalpel's size when the scene gives none: about a No. 10 surgical blade, mm.
 const Eigen::Vector3d default_scalpel_size_mm(30.0, 0.5, 8.0);
@@ -241,50 +280,56 @@ SolverSettings read_solver(JsonReader r)
     if (const std::optional<JsonNode> node = r.optional_node("type")) {
         s.type = choose_enum(*node, solver_types);
     }
+    if (const std::optional<JsonNode> node = r.optional_node("mode")) {
+        s.mode = choose_enum(*node, solver_modes);
+    }
     s.dt_s = r.optional("dt_s", s.dt_s, positive);
     s.cg_tolerance = r.optional("cg_tolerance", s.cg_tolerance, open_range(0.0, 1.0));
     s.cg_max_iterations = r.optional("cg_max_iterations", s.cg_max_iterations, at_least(1));
+    s.rayleigh_mass_per_s = r.optional("rayleigh_mass_per_s", s.rayleigh_mass_per_s, at_least(0.0));
+    s.rayleigh_stiffness_s = r.optional("rayleigh_stiffness_s", s.rayleigh_stiffness_s, at_least(0.0));
+    s.newton_max_iterations = r.optional("newton_max_iterations", s.newton_max_iterations, at_least(1));
     r.finish();
     return s;
 }
 
 Constraint read_constraint(JsonReader r)
 {
-    static constexpr std::array<char, 3> axis_names{'x', 'y', 'z'};
     Constraint c;
     c.type = choose_enum(r.required_node("type"), constraint_types);
+    std::tie(c.box_min_mm, c.box_max_mm) = read_box(r.required_node("box_mm"));
 
-    const JsonNode box = r.required_node("box_mm");
-    if (!box.value().is_array() || box.value().size() != 2) {
-        box.fail_type("[[x, y, z], [x, y, z]] (the box's min and max corners)");
-    }
-    const std::vector<JsonNode> corners = box.elements();
-    c.box_min_mm = as<Eigen::Vector3d>(corners[0]);
-    c.box_max_mm = as<Eigen::Vector3d>(corners[1]);
-    for (int axis = 0; axis < 3; ++axis) {
-        if (c.box_min_mm[axis] > c.box_max_mm[axis]) {
-            box.fail(std::string("min corner is above max corner along ") + axis_names[static_cast<std::size_t>(axis)] +
-                     " (" + number_text(c.box_min_mm[axis]) + " > " + number_text(c.box_max_mm[axis]) + ")");
-        }
-    }
-
+    // fixed holds every axis (the default); slide holds the axes it lists.
+    c.held_axes = {true, true, true};
     if (c.type == ConstraintType::slide) {
+        c.held_axes = {false, false, false};
         const JsonNode axes = r.required_node("axes");
         const std::vector<JsonNode> items = axes.elements();
         for (const JsonNode& item : items) {
             const auto axis = static_cast<std::size_t>(choose(item, {"x", "y", "z"}).front() - 'x');
-            if (c.slide_axes[axis]) {
+            if (c.held_axes[axis]) {
                 item.fail(std::string("axis ") + axis_names[axis] + " is listed twice");
             }
-            c.slide_axes[axis] = true;
+            c.held_axes[axis] = true;
         }
-        if (items.empty() || items.size() == 3) {
-            axes.fail(items.empty() ? "lists no axis; a constraint that allows no motion is \"fixed\""
-                                    : "lists every axis; such a constraint holds nothing");
+        if (items.empty()) {
+            axes.fail("lists no axis; such a constraint holds nothing");
+        }
+        if (items.size() == 3) {
+            axes.fail("lists every axis; that is a fixed constraint (\"type\": \"fixed\")");
         }
     }
     r.finish(c.type == ConstraintType::fixed ? "for a fixed constraint" : "for a slide constraint");
     return c;
+}
+
+Load read_load(JsonReader r)
+{
+    Load l;
+    std::tie(l.box_min_mm, l.box_max_mm) = read_box(r.required_node("box_mm"));
+    l.force_n = finite_vector(r.required_node("force_n"));
+    r.finish();
+    return l;
 }
 
 ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
@@ -383,6 +428,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     const std::optional<JsonNode> solver = root.optional_node("solver");
     const std::optional<JsonNode> gravity = root.optional_node("gravity_m_s2");
     const std::optional<JsonNode> constraints = root.optional_node("constraints");
+    const std::optional<JsonNode> loads = root.optional_node("loads");
     const std::optional<JsonNode> tools = root.optional_node("tools");
     const std::optional<JsonNode> script = root.optional_node("script");
     const std::optional<JsonNode> output = root.optional_node("output");
@@ -399,11 +445,16 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
         scene.solver = read_solver(JsonReader(*solver));
     }
     if (gravity) {
-        scene.gravity_m_s2 = as<Eigen::Vector3d>(*gravity);
+        scene.gravity_m_s2 = finite_vector(*gravity);
     }
     if (constraints) {
         for (const JsonNode& node : constraints->elements()) {
             scene.constraints.push_back(read_constraint(JsonReader(node)));
+        }
+    }
+    if (loads) {
+        for (const JsonNode& node : loads->elements()) {
+            scene.loads.push_back(read_load(JsonReader(node)));
         }
     }
     if (tools) {

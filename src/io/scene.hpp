@@ -1,6 +1,6 @@
 #pragma once
 // Scene files: one JSON document saying what to simulate (the object, its materials, the solver,
-// gravity, constraints, tools, a tool script and the output). Users' reference:
+// gravity, constraints, loads, tools, a tool script and the output). Users' reference:
 // docs/scene-format.md. Every key carries its unit in its name; the reader is strict
 // (io/json_reader.hpp): an unknown key, a wrong type, a value out of range or a missing file is an
 // InputError naming the key path.
@@ -65,20 +65,37 @@ struct Material {
 /// The cutting approach (see DESIGN.md): dynamic branched grid, or tetrahedra with Is-XFEM.
 enum class SolverType { dbg, isxfem };
 
+/// What a frame computes.
+enum class SolverMode {
+    dynamic,            ///< "dynamic": one implicit time step of dt_s per frame (inertia and damping)
+    static_equilibrium, ///< "static": every frame solves to equilibrium under the frame's loads
+};
+
 /// Time stepping and linear solve.
 struct SolverSettings {
     SolverType type = SolverType::dbg;
+    /// Key "mode": "dynamic" (default) or "static" (quasi-static: every frame is solved to
+    /// equilibrium by Newton iterations on the corotational system, until the force residual
+    /// relative to the load meets cg_tolerance; extra frames then change nothing).
+    SolverMode mode = SolverMode::dynamic;
     /// Time step, s (> 0).
     double dt_s = 0.01;
-    /// Relative residual at which the conjugate-gradient solve stops, in (0, 1).
+    /// Relative residual at which the conjugate-gradient solve stops, in (0, 1); in static mode
+    /// also the relative force residual at which the Newton iterations stop.
     double cg_tolerance = 1e-6;
     /// Conjugate-gradient iteration cap per solve (>= 1).
     int cg_max_iterations = 200;
+    /// Rayleigh damping, mass part: alpha in C = alpha M + beta K, 1/s (>= 0).
+    double rayleigh_mass_per_s = 0.5;
+    /// Rayleigh damping, stiffness part: beta in C = alpha M + beta K, s (>= 0).
+    double rayleigh_stiffness_s = 0.002;
+    /// Static mode: Newton iteration cap per frame (>= 1).
+    int newton_max_iterations = 20;
 };
 
 enum class ConstraintType {
     fixed, ///< the nodes do not move
-    slide, ///< the nodes move only along the listed world axes
+    slide, ///< the nodes are held along the listed world axes and move freely along the others
 };
 
 /// Boundary condition on the nodes whose rest position lies in an axis-aligned box, boundary
@@ -89,8 +106,22 @@ struct Constraint {
     Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();
     /// Box corner with the largest coordinates, world mm (>= box_min_mm on every axis).
     Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
-    /// slide: true for each world axis (x, y, z) the nodes may move along; one or two are true.
-    std::array<bool, 3> slide_axes{false, false, false};
+    /// World axes (x, y, z) along which the nodes are held: all three for fixed, the listed one or
+    /// two for slide (a roller holds the two axes across its rolling direction; a symmetry plane
+    /// x = 0 holds x).
+    std::array<bool, 3> held_axes{true, true, true};
+};
+
+/// An external point force: a total force, world frame, shared equally by the nodes whose rest
+/// position lies in an axis-aligned box, boundary included. A box that catches no node is an
+/// error found when the grid exists.
+struct Load {
+    /// Box corner with the smallest coordinates, world mm.
+    Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();
+    /// Box corner with the largest coordinates, world mm (>= box_min_mm on every axis).
+    Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
+    /// Total force on the box's nodes, N, world frame (each of n nodes gets force_n / n).
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
 };
 
 enum class ToolShape {
@@ -152,6 +183,8 @@ struct Scene {
     /// Gravitational acceleration in the world frame, m/s^2.
     Eigen::Vector3d gravity_m_s2{0.0, 0.0, -9.81};
     std::vector<Constraint> constraints;
+    /// External point forces, constant in time; none by default.
+    std::vector<Load> loads;
     std::vector<ToolSpec> tools;
     /// Tool key frames in time order.
     std::vector<ScriptEntry> script;
@@ -159,8 +192,9 @@ struct Scene {
 
     /// The material of voxels carrying `label`.
     [[nodiscard]] const Material& material(std::int32_t label) const;
-    /// An error about this scene found after reading it (e.g. a constraint box that catches no
-    /// node): "SOURCE: KEY_PATH: PROBLEM", key_path as "constraints[0].box_mm".
+    /// An error about this scene found after reading it (e.g. a constraint or load box that
+    /// catches no node): "SOURCE: KEY_PATH: PROBLEM", key_path as "constraints[0].box_mm" or
+    /// "loads[0].box_mm".
     [[nodiscard]] InputError error(std::string_view key_path, std::string_view problem) const;
 };
 

@@ -1,0 +1,57 @@
+#pragma once
+// The mechanical model of one level of the branched grid: per element its nodes, condensed K and M
+// (in the element's index-aligned frame), the shape-function gradients at the centroid of its
+// material (where the corotational rotation is taken: reliable for partly filled elements), and
+// the nodes' rest positions. SI units throughout: metres, kilograms, newtons.
+
+#include "core/eigen_types.hpp"
+#include "grid/branched_grid.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace vox::fem {
+
+struct HexElement {
+    std::array<std::uint32_t, 8> dof_node{};   ///< dense node index (0 .. node_count-1) per corner
+    const Matrix24d* stiffness = nullptr;      ///< N/m, index-aligned frame; shared for full cells
+    Matrix8d mass = Matrix8d::Zero();          ///< kg, scalar consistent mass (times I3 per axis)
+    Eigen::Matrix<double, 8, 3> gradient;      ///< dN_c/dX at the material centroid, 1/m, index-aligned frame
+    Vector24d rest;                            ///< corner rest positions, m, index-aligned frame
+    std::uint32_t grid_element = 0;            ///< the branched-grid element it models
+};
+
+class HexModel {
+public:
+    /// Builds the model of `level` (1 .. grid.max_level()) of `grid`.
+    HexModel(const grid::BranchedGrid& grid, int level);
+
+    [[nodiscard]] int level() const { return m_level; }
+    [[nodiscard]] std::size_t node_count() const { return m_rest_world.size(); }
+    [[nodiscard]] const std::vector<HexElement>& elements() const { return m_elements; }
+    /// Rest positions of the nodes, world frame, m.
+    [[nodiscard]] const std::vector<Eigen::Vector3d>& rest_positions() const { return m_rest_world; }
+    /// Grid node id of each dense node, and the dense index of each grid node id (or no_index).
+    [[nodiscard]] const std::vector<std::uint32_t>& grid_node() const { return m_grid_node; }
+    [[nodiscard]] const std::vector<std::uint32_t>& dense_node() const { return m_dense_node; }
+    /// Orthonormal part of the index-to-world map: world = frame * index-aligned (a reflection
+    /// when the scan's transform mirrors).
+    [[nodiscard]] const Eigen::Matrix3d& frame() const { return m_frame; }
+    /// Consistent mass row sums per node, kg: gravity loads are these times g.
+    [[nodiscard]] const std::vector<double>& nodal_mass() const { return m_nodal_mass; }
+    [[nodiscard]] double total_mass() const;
+
+private:
+    int m_level = 1;
+    std::vector<HexElement> m_elements;
+    std::vector<Matrix24d> m_partial_stiffness; ///< owned by partial elements
+    std::vector<Matrix24d> m_full_stiffness;    ///< per material, shared by full cells
+    std::vector<Eigen::Vector3d> m_rest_world;
+    std::vector<std::uint32_t> m_grid_node, m_dense_node;
+    std::vector<double> m_nodal_mass;
+    Eigen::Matrix3d m_frame = Eigen::Matrix3d::Identity();
+};
+
+} // namespace vox::fem
