@@ -26,7 +26,7 @@ step "The liver's marching-cubes surface, in world millimetres"
 "$vox" export "$out/liver.vdb" -o "$out/liver-surface.obj"
 
 step "Closed mesh (elephant.off) voxelised through OpenVDB"
-"$vox" import "$data/elephant.off" --voxel-size 0.01 -o "$out/elephant.vdb"
+"$vox" import "$data/elephant.off" --scale 100 --voxel-size 1 -o "$out/elephant.vdb"
 
 step "Open scan mesh with holes (lion.off) voxelised by generalized winding number"
 "$vox" import "$data/lion.off" -o "$out/lion.vdb"

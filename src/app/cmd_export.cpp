@@ -20,6 +20,7 @@ void add_export_command(CLI::App& app)
     struct Args {
         std::string input, output;
         SelectionOptions selection;
+        MeshOptions mesh;
         int smooth = 0;
         int level = 1;
     };
@@ -28,6 +29,7 @@ void add_export_command(CLI::App& app)
     cmd->add_option("input", args->input, "Volume, .vdb or mesh file")->required();
     cmd->add_option("-o,--output", args->output, "Mesh file: .obj, .ply (with per-vertex labels), .stl or .off")->required();
     add_selection_options(*cmd, args->selection);
+    add_mesh_options(*cmd, args->mesh);
     cmd->add_option("--smooth", args->smooth, "Taubin smoothing iterations in rest space (default 0)")
         ->check(CLI::Range(0, 1000));
     cmd->add_option("--level", args->level, "Level of the elements the surface is embedded in (default 1)")
@@ -35,9 +37,7 @@ void add_export_command(CLI::App& app)
     cmd->callback([args] {
         if (!io::is_writable_mesh_path(args->output))
             throw InputError(args->output + ": the output must end in .obj, .ply, .stl or .off");
-        io::ImportOptions options;
-        options.selection = args->selection.to_selection();
-        const grid::LabelGrid labels = io::import_object(args->input, options);
+        const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, args->mesh));
         const io::MaterialTable table = io::default_material_table();
         const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }),
                                    table.materials, args->level);

@@ -38,6 +38,7 @@ void add_grid_command(CLI::App& app)
     struct Args {
         std::string input;
         SelectionOptions selection;
+        MeshOptions mesh;
         std::optional<int> levels;
         bool as_json = false;
     };
@@ -45,6 +46,7 @@ void add_grid_command(CLI::App& app)
     CLI::App* cmd = app.add_subcommand("grid", "Build the branched grid of a volume or scene and report each level");
     cmd->add_option("input", args->input, "Volume, .vdb, mesh, or scene (.json)")->required();
     add_selection_options(*cmd, args->selection);
+    add_mesh_options(*cmd, args->mesh);
     cmd->add_option("--levels", args->levels, "Build levels 0 .. L (0..6; default: the scene's level, else 3)")
         ->check(CLI::Range(0, 6));
     cmd->add_flag("--json", args->as_json, "Print JSON instead of a table");
@@ -54,16 +56,15 @@ void add_grid_command(CLI::App& app)
         io::MaterialTable table = io::default_material_table();
         int levels = args->levels.value_or(3);
         if (is_scene) {
-            if (!args->selection.to_selection().empty())
-                throw InputError("--label and --threshold do not apply to a scene (its object says what it selects)");
+            if (!args->selection.to_selection().empty() || args->mesh.voxel_mm || args->mesh.mm_per_unit != 1.0)
+                throw InputError("--label, --threshold, --voxel-size and --scale do not apply to a scene (its object "
+                                 "says what it selects)");
             const io::Scene scene = io::load_scene(args->input);
             labels.emplace(io::load_scene_object(scene));
             table = io::material_table(scene);
             levels = args->levels.value_or(scene.object.levels);
         } else {
-            io::ImportOptions options;
-            options.selection = args->selection.to_selection();
-            labels.emplace(io::import_object(args->input, options));
+            labels.emplace(io::import_object(args->input, import_options(args->selection, args->mesh)));
         }
         const grid::BranchedGrid g(grid::FineVoxels(*labels, [&](std::int32_t l) { return table.index_of(l); }),
                                    table.materials, levels, {.level0_nodes = true});

@@ -12,8 +12,7 @@ void add_import_command(CLI::App& app)
     struct Args {
         std::string input, output;
         SelectionOptions selection;
-        std::optional<double> voxel_mm;
-        double mm_per_unit = 1.0;
+        MeshOptions mesh;
     };
     auto args = std::make_shared<Args>();
     CLI::App* cmd = app.add_subcommand("import", "Read a scan or mesh and write its labelled voxels as an OpenVDB file");
@@ -21,17 +20,10 @@ void add_import_command(CLI::App& app)
         ->required();
     cmd->add_option("-o,--output", args->output, "Output .vdb file (int32 labels + index-to-world transform)")->required();
     add_selection_options(*cmd, args->selection);
-    cmd->add_option("--voxel-size", args->voxel_mm, "Meshes: voxel edge in mm (default: longest side / 128)")
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--scale", args->mm_per_unit, "Meshes: millimetres per file unit (default 1)")
-        ->check(CLI::PositiveNumber);
+    add_mesh_options(*cmd, args->mesh);
     cmd->callback([args] {
         require_vdb_extension(args->output);
-        io::ImportOptions options;
-        options.selection = args->selection.to_selection();
-        options.voxel_mm = args->voxel_mm;
-        options.mm_per_unit = args->mm_per_unit;
-        const grid::LabelGrid labels = io::import_object(args->input, options);
+        const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, args->mesh));
         labels.save(args->output);
         std::string histogram;
         for (const auto& [label, n] : labels.label_histogram()) {

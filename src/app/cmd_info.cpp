@@ -20,7 +20,8 @@
 namespace vox::app {
 namespace {
 
-using nlohmann::json;
+// Insertion order: fields print in a sensible order and labels in numeric order.
+using json = nlohmann::ordered_json;
 
 json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 
@@ -108,9 +109,9 @@ json vdb_info(const std::string& path)
     return j;
 }
 
-json mesh_info_json(const std::string& path)
+json mesh_info_json(const std::string& path, double mm_per_unit)
 {
-    const io::MeshInfo m = io::mesh_info(io::read_mesh(path));
+    const io::MeshInfo m = io::mesh_info(io::read_mesh(path, mm_per_unit));
     return {{"file", path},
             {"kind", "mesh"},
             {"vertices", m.vertices},
@@ -120,8 +121,30 @@ json mesh_info_json(const std::string& path)
             {"closed", m.closed},
             {"consistently_oriented", m.consistently_oriented},
             {"area_mm2", m.area_mm2},
-            {"enclosed_volume_mm3", m.enclosed_volume_mm3},
+            // An open mesh encloses no well-defined volume.
+            {"enclosed_volume_mm3", m.closed ? json(m.enclosed_volume_mm3) : json(nullptr)},
             {"world_bbox_mm", {{"min", vec(m.bbox_min)}, {"max", vec(m.bbox_max)}}}};
+}
+
+/// A value for people: numbers with 7 significant digits, arrays and objects inline.
+std::string human(const json& v)
+{
+    if (v.is_number_float()) {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, "%.7g", v.get<double>());
+        return buffer;
+    }
+    if (v.is_array()) {
+        std::string out = "[";
+        for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + human(v[i]);
+        return out + "]";
+    }
+    if (v.is_object()) {
+        std::string out;
+        for (const auto& [key, item] : v.items()) out += (out.empty() ? "" : ", ") + key + ": " + human(item);
+        return out;
+    }
+    return v.is_string() ? v.get<std::string>() : v.dump();
 }
 
 void print_text(const json& j)
@@ -132,13 +155,13 @@ void print_text(const json& j)
             for (const auto& [label, n] : value.items()) std::printf("  %s: %s\n", label.c_str(), n.dump().c_str());
         } else if (key == "index_to_world") {
             std::printf("index_to_world:\n");
-            for (const auto& row : value) std::printf("  %s\n", row.dump().c_str());
-        } else if (value.is_string()) {
-            std::printf("%s: %s\n", key.c_str(), value.get<std::string>().c_str());
+            for (const auto& row : value) std::printf("  %s\n", human(row).c_str());
         } else {
-            std::printf("%s: %s\n", key.c_str(), value.dump().c_str());
+            std::printf("%s: %s\n", key.c_str(), human(value).c_str());
         }
     }
+    if (j.contains("kind") && j["kind"] == "volume" && !j.contains("labels"))
+        std::printf("labels: not listed (more than 1024 distinct values, or values that are not integers)\n");
 }
 
 } // namespace
@@ -148,16 +171,19 @@ void add_info_command(CLI::App& app)
     struct Args {
         std::string input;
         bool as_json = false;
+        double mm_per_unit = 1.0;
     };
     auto args = std::make_shared<Args>();
     CLI::App* cmd = app.add_subcommand("info", "Describe a volume, .vdb label grid or mesh file");
     cmd->add_option("file", args->input, "The file to describe")->required();
     cmd->add_flag("--json", args->as_json, "Print JSON instead of text");
+    cmd->add_option("--scale", args->mm_per_unit, "Meshes: millimetres per file unit (default 1)")
+        ->check(CLI::PositiveNumber);
     cmd->callback([args] {
         const std::string& p = args->input;
         json j;
         if (io::is_mesh_path(p))
-            j = mesh_info_json(p);
+            j = mesh_info_json(p, args->mm_per_unit);
         else if (p.size() > 4 && p.compare(p.size() - 4, 4, ".vdb") == 0)
             j = vdb_info(p);
         else

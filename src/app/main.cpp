@@ -23,7 +23,13 @@ int main(int argc, char** argv)
     app.add_option_function<std::uint64_t>(
            "--max-memory-mb", [](std::uint64_t mb) { vox::set_memory_limit_bytes(mb << 20); },
            "Refuse inputs that would need more memory than this (default 8192, or $VOXSCULPT_MAX_MEMORY_MB)")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Validator(
+            [](const std::string& text) {
+                return text.find_first_not_of("0123456789") == std::string::npos && text.find_first_not_of('0') != std::string::npos
+                           ? std::string()
+                           : std::string("must be a positive whole number of MiB");
+            },
+            "MiB"));
 
     vox::app::add_import_command(app);
     vox::app::add_info_command(app);
@@ -34,6 +40,17 @@ int main(int argc, char** argv)
     vox::app::add_run_command(app);
 
     try {
+        vox::check_memory_limit_environment();
+        // CLI11 would report an unknown first word as a missing subcommand; say what is wrong.
+        if (argc > 1 && argv[1][0] != '-') {
+            bool known = false;
+            for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+                known = known || sub->get_name() == argv[1];
+            if (!known) {
+                std::fprintf(stderr, "voxsculpt: unknown subcommand '%s' (see --help)\n", argv[1]);
+                return 2;
+            }
+        }
         app.parse(argc, argv);
     } catch (const CLI::Success& e) {
         return app.exit(e);

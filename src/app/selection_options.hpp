@@ -1,7 +1,10 @@
 #pragma once
 // The --label / --threshold options shared by the subcommands that read volumes.
 
+#include "io/object_import.hpp"
 #include "io/selection.hpp"
+
+#include <optional>
 
 #include <string>
 #include <vector>
@@ -20,6 +23,16 @@ struct SelectionOptions {
 };
 
 void add_selection_options(CLI::App& cmd, SelectionOptions& options);
+
+/// --voxel-size and --scale, for subcommands that may read meshes.
+struct MeshOptions {
+    std::optional<double> voxel_mm;
+    double mm_per_unit = 1.0;
+};
+void add_mesh_options(CLI::App& cmd, MeshOptions& options);
+
+/// What io::import_object needs from both groups of options.
+[[nodiscard]] io::ImportOptions import_options(const SelectionOptions& selection, const MeshOptions& mesh);
 
 /// Throws InputError unless `path` ends in .vdb.
 void require_vdb_extension(const std::string& path);

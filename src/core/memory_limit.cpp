@@ -21,6 +21,16 @@ std::atomic<std::uint64_t> g_limit{initial_limit()};
 } // namespace
 
 std::uint64_t memory_limit_bytes() { return g_limit.load(); }
+
+void check_memory_limit_environment()
+{
+    const char* env = std::getenv("VOXSCULPT_MAX_MEMORY_MB");
+    if (!env) return;
+    char* end = nullptr;
+    const unsigned long long mb = std::strtoull(env, &end, 10);
+    if (end == env || *end != '\0' || mb == 0 || env[0] == '-')
+        throw InputError(std::string("VOXSCULPT_MAX_MEMORY_MB=") + env + ": not a positive whole number of MiB");
+}
 void set_memory_limit_bytes(std::uint64_t bytes) { g_limit = bytes; }
 
 void check_allocation(const std::string& what, std::uint64_t count, std::uint64_t bytes_each)

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/memory_usage.hpp"
+#include "core/progress.hpp"
 #include "core/morton.hpp"
 #include "grid/condensation.hpp"
 #include "grid/hex8.hpp"
@@ -105,7 +106,9 @@ BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materia
     for (std::uint32_t v = 0; v < m_voxels.slots(); ++v)
         if (m_voxels.alive(v)) cells.push_back(m_voxels.code(v) >> 3);
     sort_unique(cells);
+    Progress progress("building the branched grid", static_cast<std::uint64_t>(max_level));
     for (int l = 1; l <= max_level; ++l) {
+        progress.update(static_cast<std::uint64_t>(l - 1));
         const auto start = Clock::now();
         m_levels[static_cast<std::size_t>(l)].cells = CoordMap(cells.size());
         rebuild_cells(l, cells, true);

@@ -1,6 +1,7 @@
 #include "grid/fine_voxels.hpp"
 
 #include "core/error.hpp"
+#include "core/memory_limit.hpp"
 #include "core/morton.hpp"
 
 #include <algorithm>
@@ -21,6 +22,8 @@ FineVoxels::FineVoxels(const LabelGrid& labels, const std::function<std::int32_t
     if (((box.max - m_origin).array() >= k_max_extent).any())
         throw InputError("the object spans more than 2^21 voxels along an axis");
 
+    // About 64 bytes per voxel for the fine level (index, neighbours, codes), more for the levels.
+    check_allocation("the object's fine voxels", labels.active_voxel_count(), 64);
     struct Entry {
         std::uint64_t code;
         Coord ijk;

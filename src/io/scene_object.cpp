@@ -1,5 +1,6 @@
 #include "io/scene_object.hpp"
 
+#include "core/error.hpp"
 #include "grid/coarse_cells.hpp"
 #include "grid/phantom.hpp"
 #include "io/object_import.hpp"
@@ -9,6 +10,17 @@
 namespace vox::io {
 
 grid::LabelGrid load_scene_object(const Scene& scene)
+{
+    // Problems found while building the object (an empty selection, a phantom too large, a mesh
+    // that encloses nothing) are reported against the scene's "object" key too.
+    try {
+        return build_scene_object(scene);
+    } catch (const InputError& e) {
+        throw scene.error("object", e.what());
+    }
+}
+
+grid::LabelGrid build_scene_object(const Scene& scene)
 {
     const SceneObject& o = scene.object;
     switch (o.kind) {
@@ -54,9 +66,10 @@ void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
             const grid::Coord lo(box.min.x() >> level, box.min.y() >> level, box.min.z() >> level);
             const grid::Coord hi(box.max.x() >> level, box.max.y() >> level, box.max.z() >> level);
             std::ostringstream os;
-            os << "catches no node at level " << level << " (nodes sit at element corners, from ("
-               << grid::cell_corner_world(labels, lo, level, 0).transpose() << ") to ("
-               << grid::cell_corner_world(labels, hi, level, 7).transpose() << ") mm)";
+            const Eigen::Vector3d a = grid::cell_corner_world(labels, lo, level, 0);
+            const Eigen::Vector3d b = grid::cell_corner_world(labels, hi, level, 7);
+            os << "catches no node at level " << level << " (nodes sit at element corners, from (" << a.x() << ", "
+               << a.y() << ", " << a.z() << ") to (" << b.x() << ", " << b.y() << ", " << b.z() << ") mm)";
             throw scene.error("constraints[" + std::to_string(c) + "].box_mm", os.str());
         }
     }

@@ -11,7 +11,10 @@
 namespace vox::io {
 
 /// The labelled voxels of the scene's object (a scan and its selection, a phantom, or a mesh).
+/// Errors name the scene and its "object" key, then the problem.
 [[nodiscard]] grid::LabelGrid load_scene_object(const Scene& scene);
+/// The same without the scene's name in front of errors.
+[[nodiscard]] grid::LabelGrid build_scene_object(const Scene& scene);
 
 /// Throws the scene's InputError ("constraints[2].box_mm: catches no node ...") when a constraint
 /// box holds no element corner node at the scene's level.

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/morton.hpp"
+#include "core/progress.hpp"
 
 #include <Eigen/LU>
 
@@ -323,7 +324,9 @@ void EmbeddedSurface::smooth(const grid::BranchedGrid& grid, int iterations)
     // Taubin's lambda|mu filter in world space (anisotropic voxels must not bias it).
     std::vector<Eigen::Vector3d> x(m_vertices.size()), next(m_vertices.size());
     for (std::size_t i = 0; i < m_vertices.size(); ++i) x[i] = linear * m_vertices[i].rest;
+    Progress progress("smoothing the surface", static_cast<std::uint64_t>(2 * iterations));
     for (int it = 0; it < 2 * iterations; ++it) {
+        progress.update(static_cast<std::uint64_t>(it));
         const double factor = it % 2 == 0 ? 0.5 : -0.53;
         for (std::size_t i = 0; i < x.size(); ++i) {
             next[i] = x[i];
