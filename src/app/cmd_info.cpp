@@ -3,6 +3,7 @@
 
 #include "app/commands.hpp"
 #include "core/error.hpp"
+#include "io/file_bytes.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
 #include "io/object_import.hpp"
@@ -86,6 +87,7 @@ json volume_info(const std::string& path)
 
 json vdb_info(const std::string& path)
 {
+    io::check_input_file(path);
     const grid::LabelGrid g = grid::LabelGrid::load(path);
     const grid::IndexBox box = g.index_bounds();
     json hist = json::object();

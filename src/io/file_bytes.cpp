@@ -12,14 +12,37 @@
 
 namespace vox::io {
 namespace {
-void check_readable(const std::string& path)
+
+/// zlib's description of the last gzip error, without the "PATH: " zlib puts in front (our
+/// messages start with the path already).
+std::string gz_message(gzFile gz, const std::string& path, int& err)
+{
+    const char* msg = gzerror(gz, &err);
+    std::string text = msg ? msg : "";
+    if (text.starts_with(path + ": ")) text.erase(0, path.size() + 2);
+    return text;
+}
+
+} // namespace
+
+void check_input_file(const std::string& path)
 {
     std::error_code ec;
     const auto st = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(st)) throw file_error(path, "no such file");
+    if (!std::filesystem::exists(st)) {
+        if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+            throw file_error(path, "cannot open: " + ec.message());
+        throw file_error(path, "no such file");
+    }
     if (std::filesystem::is_directory(st)) throw file_error(path, "is a folder, not a file");
+    if (!std::filesystem::is_regular_file(st)) throw file_error(path, "is not a regular file");
+    errno = 0;
+    if (!std::ifstream(path, std::ios::binary))
+        throw file_error(path, std::string("cannot open: ") + (errno ? std::strerror(errno) : "permission denied"));
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) throw file_error(path, "cannot read its size: " + ec.message());
+    if (size == 0) throw file_error(path, "is empty");
 }
-} // namespace
 
 bool is_gzip_file(const std::string& path)
 {
@@ -31,7 +54,7 @@ bool is_gzip_file(const std::string& path)
 
 std::vector<std::byte> read_file_bytes(const std::string& path)
 {
-    check_readable(path);
+    check_input_file(path);
     if (!is_gzip_file(path)) {
         std::ifstream in(path, std::ios::binary | std::ios::ate);
         if (!in) throw file_error(path, std::string("cannot open: ") + std::strerror(errno));
@@ -55,7 +78,7 @@ std::vector<std::byte> read_file_bytes(const std::string& path)
         const int n = gzread(gz, bytes.data() + used, static_cast<unsigned>(bytes.size() - used));
         if (n < 0) {
             int err = 0;
-            std::string msg = gzerror(gz, &err);
+            const std::string msg = gz_message(gz, path, err);
             gzclose(gz);
             throw file_error(path, "corrupt gzip data (" + msg + ")");
         }
@@ -64,19 +87,18 @@ std::vector<std::byte> read_file_bytes(const std::string& path)
     }
     // gzread returns 0 at a truncated stream too; tell that apart from a clean end.
     int err = 0;
-    const char* msg = gzerror(gz, &err);
+    const std::string what = gz_message(gz, path, err);
     const bool truncated = err != Z_OK && err != Z_STREAM_END;
-    const std::string what = msg ? msg : "";
     gzclose(gz);
     if (truncated) throw file_error(path, "corrupt or truncated gzip data (" + what + ")");
+    if (used == 0) throw file_error(path, "is empty once decompressed (gzip of no data)");
     bytes.resize(used);
     return bytes;
 }
 
 FileHead read_file_head(const std::string& path, std::size_t max_bytes)
 {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw file_error(path, "no such file");
+    check_input_file(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw file_error(path, "cannot open");
     FileHead head;

@@ -8,11 +8,17 @@
 
 namespace vox::io {
 
+/// Checks that `path` names a non-empty regular file that can be opened, before a reader (ours or a
+/// library's) looks inside. Throws InputError "PATH: no such file", "PATH: is a folder, not a
+/// file", "PATH: is not a regular file", "PATH: cannot open: REASON" or "PATH: is empty".
+void check_input_file(const std::string& path);
+
 /// True when the file starts with the gzip magic bytes (1f 8b).
 [[nodiscard]] bool is_gzip_file(const std::string& path);
 
 /// Reads the whole file, decompressing it when it is gzip. Throws InputError naming the file when
-/// it is missing, unreadable, corrupt, or larger than the memory limit once decompressed.
+/// it fails check_input_file, is corrupt or truncated gzip, is empty once decompressed, or is
+/// larger than the memory limit once decompressed.
 [[nodiscard]] std::vector<std::byte> read_file_bytes(const std::string& path);
 
 /// The first bytes of a file, as read by read_file_head.
@@ -22,8 +28,7 @@ struct FileHead {
 };
 
 /// Reads at most the first `max_bytes` of a plain (uncompressed) file, for formats with a text
-/// header before binary data. Throws InputError "PATH: no such file" when the path is not a
-/// regular file, "PATH: cannot open" when it cannot be opened.
+/// header before binary data. Throws InputError as check_input_file does.
 [[nodiscard]] FileHead read_file_head(const std::string& path, std::size_t max_bytes);
 
 /// Reads `count` bytes at byte `offset` of `file` into `out`. Throws InputError "WHAT: cannot read

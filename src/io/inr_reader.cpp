@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
+#include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
 #include <cmath>
@@ -12,6 +13,9 @@
 #include <sstream>
 
 namespace vox::io {
+
+using detail::printable;
+
 namespace {
 
 constexpr std::string_view k_magic = "#INRIMAGE-4#{";
@@ -28,7 +32,8 @@ long long parse_int(const std::string& path, const std::map<std::string, std::st
     }
     char* end = nullptr;
     const long long v = std::strtoll(it->second.c_str(), &end, 10);
-    if (end == it->second.c_str() || *end != '\0') throw file_error(path, key + "=" + it->second + " is not an integer");
+    if (end == it->second.c_str() || *end != '\0')
+        throw file_error(path, key + "=" + printable(it->second) + " is not an integer");
     return v;
 }
 
@@ -40,7 +45,7 @@ double parse_real(const std::string& path, const std::map<std::string, std::stri
     char* end = nullptr;
     const double v = std::strtod(it->second.c_str(), &end);
     if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v))
-        throw file_error(path, key + "=" + it->second + " is not a finite number");
+        throw file_error(path, key + "=" + printable(it->second) + " is not a finite number");
     return v;
 }
 
@@ -58,16 +63,17 @@ ScalarType parse_type(const std::string& path, const std::string& type, long lon
         if (bits == 32) return ScalarType::f32;
         if (bits == 64) return ScalarType::f64;
     } else {
-        throw file_error(path, "unsupported TYPE=" + type + " (expected unsigned fixed, signed fixed or float)");
+        throw file_error(path,
+                         "unsupported TYPE=" + printable(type) + " (expected unsigned fixed, signed fixed or float)");
     }
-    throw file_error(path, "unsupported PIXSIZE of " + std::to_string(bits) + " bits for TYPE=" + type);
+    throw file_error(path, "unsupported PIXSIZE of " + std::to_string(bits) + " bits for TYPE=" + printable(type));
 }
 
 bool big_endian_cpu(const std::string& path, const std::string& cpu)
 {
     if (cpu.empty() || cpu == "decm" || cpu == "alpha" || cpu == "pc") return false;
     if (cpu == "sun" || cpu == "sgi") return true;
-    throw file_error(path, "unknown CPU=" + cpu + " (expected decm, alpha, pc, sun or sgi)");
+    throw file_error(path, "unknown CPU=" + printable(cpu) + " (expected decm, alpha, pc, sun or sgi)");
 }
 
 } // namespace
@@ -86,7 +92,7 @@ Volume read_inr(const std::string& path)
     for (std::string line; std::getline(lines, line);) {
         if (line.empty() || line[0] == '#') continue;
         const auto eq = line.find('=');
-        if (eq == std::string::npos) throw file_error(path, "header line \"" + line + "\" has no '='");
+        if (eq == std::string::npos) throw file_error(path, "header line \"" + printable(line) + "\" has no '='");
         kv[line.substr(0, eq)] = line.substr(eq + 1);
     }
 
@@ -98,7 +104,7 @@ Volume read_inr(const std::string& path)
         if (v.dims[a] <= 0)
             throw file_error(path, std::string(1, "XYZ"[a]) + "DIM=" + std::to_string(v.dims[a]) + " is not positive");
     if (parse_int(path, kv, "VDIM", 1, false) != 1)
-        throw file_error(path, "VDIM=" + kv["VDIM"] + ": only scalar images (VDIM=1) are supported");
+        throw file_error(path, "VDIM=" + printable(kv["VDIM"]) + ": only scalar images (VDIM=1) are supported");
     std::string bits_text = kv.count("PIXSIZE") ? kv["PIXSIZE"] : "8 bits";
     const long long bits = std::strtoll(bits_text.c_str(), nullptr, 10);
     v.type = parse_type(path, kv.count("TYPE") ? kv["TYPE"] : "unsigned fixed", bits);

@@ -1,9 +1,9 @@
 // Surface mesh reading: the choice of reader by extension, the scaling to millimetres and the
 // final check every reader's result goes through.
 //
-// OFF and STL are parsed by our own readers because OpenMesh's accept damaged files silently
-// (details in off_reader.cpp and stl_reader.cpp); both formats are simple enough to check byte for
-// byte. OBJ and PLY, with their many variants, go through OpenMesh (openmesh_reader.cpp).
+// Every format is parsed by our own reader (off_reader.cpp, obj_reader.cpp, ply_reader.cpp,
+// stl_reader.cpp) rather than OpenMesh's, which accept damaged files silently (details in each
+// reader): a bad vertex or index must stop the import, not change the shape.
 
 #include "io/mesh.hpp"
 
@@ -31,7 +31,8 @@ TriangleMesh read_by_format(const std::string& path)
     const std::string ext = lower_extension(path);
     if (ext == ".off") return detail::read_off(path);
     if (ext == ".stl") return detail::read_stl(path);
-    if (ext == ".obj" || ext == ".ply") return detail::read_with_openmesh(path, ext == ".obj" ? "OBJ" : "PLY");
+    if (ext == ".obj") return detail::read_obj(path);
+    if (ext == ".ply") return detail::read_ply(path);
     throw file_error(path, "unknown mesh format '" + ext + "' (expected .off, .obj, .ply or .stl)");
 }
 

@@ -17,12 +17,12 @@ struct TriangleMesh {
     std::vector<Eigen::Vector3i> triangles;
 };
 
-/// Reads a surface mesh, choosing the format by the file's extension (case-insensitive): .off and
-/// .stl (ascii or binary) by our own parsers, .obj and .ply through OpenMesh. Polygons are
+/// Reads a surface mesh, choosing the format by the file's extension (case-insensitive): .off,
+/// .obj, .ply (ascii or binary) and .stl (ascii or binary), all by our own parsers. Polygons are
 /// fan-triangulated; faces that repeat a vertex (zero area) are skipped with a warning. Coordinates
 /// are multiplied by `mm_per_unit` to give world millimetres.
 /// Throws InputError "PATH: problem" when the file is missing or unreadable, has an unknown
-/// extension, is malformed or truncated, has no faces, a face references a missing vertex, or a
+/// extension, is empty, malformed or truncated, has no faces, a face references a missing vertex, or a
 /// vertex has a NaN or infinite coordinate; also when `mm_per_unit` is not positive and finite.
 [[nodiscard]] TriangleMesh read_mesh(const std::string& path, double mm_per_unit = 1.0);
 

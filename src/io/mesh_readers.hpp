@@ -23,10 +23,18 @@ namespace vox::io::detail {
 /// malformed or truncated, or a corner has a non-finite coordinate.
 [[nodiscard]] TriangleMesh read_stl(const std::string& path);
 
-/// OBJ or PLY through OpenMesh (openmesh_reader.cpp). `format` ("OBJ", "PLY") names the format in
-/// messages. Throws InputError "PATH: problem" when the file is missing or unreadable, OpenMesh
-/// refuses it, or a face references a vertex that does not exist.
-[[nodiscard]] TriangleMesh read_with_openmesh(const std::string& path, const std::string& format);
+/// Wavefront OBJ, parsed by ourselves (obj_reader.cpp): "v" and "f" records (corners i, i/j, i//k,
+/// i/j/k, negative indices counting back), other records ignored. Throws InputError "PATH: line N:
+/// problem" for a non-finite or malformed vertex, a bad index or a face with fewer than 3 corners,
+/// and "PATH: problem" when the file is missing, empty, binary or has no faces.
+[[nodiscard]] TriangleMesh read_obj(const std::string& path);
+
+/// PLY, ascii or binary (either byte order), parsed by ourselves (ply_reader.cpp): x, y, z of
+/// element vertex, the vertex_indices list of element face, everything else read past. Throws
+/// InputError "PATH: problem" when the file is missing or empty, the header is malformed, the data
+/// is truncated or longer than declared, a coordinate is not finite, an index is out of range, a
+/// face has fewer than 3 corners, or there is no face.
+[[nodiscard]] TriangleMesh read_ply(const std::string& path);
 
 /// Accumulates polygons as triangle fans, skipping triangles that repeat a vertex (zero area).
 struct MeshBuilder {

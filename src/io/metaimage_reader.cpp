@@ -68,6 +68,9 @@ HeaderFields read_header(const std::string& path)
         pos = std::min(nl + 1, text.size());
         if (line.empty()) continue;
         const auto eq = line.find('=');
+        if (detail::is_binary(line))
+            throw file_error(path, "not a MetaImage header: line " + std::to_string(line_no) +
+                                       " holds binary data, not 'Key = value' text");
         if (eq == std::string_view::npos || trim(line.substr(0, eq)).empty())
             throw file_error(path, "not a MetaImage header: line " + std::to_string(line_no) +
                                        " is not 'Key = value' ('" + printable(line) + "')");
@@ -237,6 +240,8 @@ Volume read_metaimage(const std::string& path)
         const std::filesystem::path name(data_name);
         data_path = (name.is_absolute() ? name : std::filesystem::path(path).parent_path() / name).string();
         std::error_code ec;
+        if (std::filesystem::is_directory(data_path, ec))
+            throw file_error(path, "data file '" + data_path + "' (ElementDataFile) is a folder, not a file");
         if (!std::filesystem::is_regular_file(data_path, ec))
             throw file_error(path, "data file '" + data_path + "' (ElementDataFile) does not exist");
     }

@@ -2,17 +2,32 @@
 // the sform when its code is set, else the qform when its code is set, else the voxel sizes alone;
 // NIfTI's RAS world is converted to LPS by negating x and y. Unlike ITK we keep any shear of the
 // sform instead of dropping it, so voxel centres land exactly where the file says.
+//
+// The raw header is checked here before libnifti sees it: libnifti prints its own diagnostics on
+// stderr for some bad headers (e.g. "** ERROR: nifti_convert_n1hdr2nim: bad dim[1]") and quietly
+// mends others (a NaN or zero pixdim becomes 1 mm), while a bad file must give one line of ours.
 
 #include "core/error.hpp"
 #include "core/memory_limit.hpp"
+#include "io/file_bytes.hpp"
+#include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
 #include <nifti2_io.h>
+#include <zlib.h>
 
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
+#include <string_view>
+#include <vector>
 
 namespace vox::io {
 namespace {
@@ -21,6 +36,7 @@ struct NiftiDeleter {
     void operator()(nifti_image* nim) const { nifti_image_free(nim); }
 };
 using NiftiPtr = std::unique_ptr<nifti_image, NiftiDeleter>;
+using detail::printable;
 
 ScalarType scalar_type(const std::string& path, int datatype)
 {
@@ -35,9 +51,165 @@ ScalarType scalar_type(const std::string& path, int datatype)
     case DT_FLOAT64: return ScalarType::f64;
     default: break;
     }
-    const char* name = nifti_datatype_string(datatype);
-    throw file_error(path, std::string("unsupported voxel type ") + (name ? name : "?") + " (code " +
+    const char* name = nifti_datatype_string(datatype); // a table look-up: prints nothing
+    throw file_error(path, std::string("unsupported voxel type ") + (name ? name : "?") + " (datatype code " +
                                std::to_string(datatype) + ")");
+}
+
+/// The fields of a NIfTI-1 or NIfTI-2 header that decide whether libnifti may read it, in native
+/// byte order and widened to the NIfTI-2 types.
+struct RawHeader {
+    int version = 1;
+    std::array<std::int64_t, 8> dim{};
+    std::array<double, 8> pixdim{};
+    int datatype = 0;
+    int bitpix = 0;
+    double vox_offset = 0.0;
+    std::size_t header_size = 0;
+    std::uint64_t voxel_bytes = 0; ///< of the 3-D volume the dimensions describe
+};
+
+template <class T> T byte_swapped(T v)
+{
+    auto bytes = std::bit_cast<std::array<unsigned char, sizeof(T)>>(v);
+    std::reverse(bytes.begin(), bytes.end());
+    return std::bit_cast<T>(bytes);
+}
+
+/// The first bytes of the file (decompressed when it is gzip): at most `size`, fewer at its end.
+std::vector<char> read_head(const std::string& path, std::size_t size)
+{
+    gzFile gz = gzopen(path.c_str(), "rb"); // reads plain files as they are
+    if (!gz) throw file_error(path, "cannot open");
+    std::vector<char> head(size);
+    const int got = gzread(gz, head.data(), static_cast<unsigned>(size));
+    int err = Z_OK;
+    std::string msg = gzerror(gz, &err);
+    gzclose(gz);
+    if (got < 0 || (static_cast<std::size_t>(got) < size && err != Z_OK && err != Z_STREAM_END)) {
+        if (msg.starts_with(path + ": ")) msg.erase(0, path.size() + 2);
+        throw file_error(path, "corrupt or truncated gzip data (" + msg + ")");
+    }
+    head.resize(static_cast<std::size_t>(got));
+    return head;
+}
+
+/// Reads and checks the raw header: size and magic, dimensions, voxel sizes, voxel type, data
+/// offset. Throws InputError "PATH: problem" naming the field.
+RawHeader check_header(const std::string& path)
+{
+    const std::vector<char> head = read_head(path, sizeof(nifti_2_header));
+    if (head.empty()) throw file_error(path, "is empty once decompressed (gzip of no data)");
+    if (head.size() < 4)
+        throw file_error(path, "not a NIfTI file: " + std::to_string(head.size()) + " bytes, too short for a header");
+    std::int32_t sizeof_hdr = 0;
+    std::memcpy(&sizeof_hdr, head.data(), 4);
+    bool swap = false;
+    RawHeader raw;
+    if (sizeof_hdr == 348 || byte_swapped(sizeof_hdr) == 348) {
+        raw.version = 1;
+        swap = sizeof_hdr != 348;
+    } else if (sizeof_hdr == 540 || byte_swapped(sizeof_hdr) == 540) {
+        raw.version = 2;
+        swap = sizeof_hdr != 540;
+    } else {
+        throw file_error(path, "not a NIfTI file: sizeof_hdr is " + std::to_string(sizeof_hdr) +
+                                   ", expected 348 (NIfTI-1) or 540 (NIfTI-2)");
+    }
+    const std::size_t need = raw.version == 1 ? sizeof(nifti_1_header) : sizeof(nifti_2_header);
+    if (head.size() < need)
+        throw file_error(path, "truncated: the NIfTI-" + std::to_string(raw.version) + " header needs " +
+                                   std::to_string(need) + " bytes, the file has " + std::to_string(head.size()));
+    const auto native = [swap](auto v) { return swap ? byte_swapped(v) : v; };
+
+    std::string_view magic;
+    if (raw.version == 1) {
+        nifti_1_header h;
+        std::memcpy(&h, head.data(), sizeof h);
+        magic = std::string_view(head.data() + offsetof(nifti_1_header, magic), 4);
+        for (int i = 0; i < 8; ++i) {
+            raw.dim[static_cast<std::size_t>(i)] = native(h.dim[i]);
+            raw.pixdim[static_cast<std::size_t>(i)] = native(h.pixdim[i]);
+        }
+        raw.datatype = native(h.datatype);
+        raw.vox_offset = native(h.vox_offset);
+        raw.bitpix = native(h.bitpix);
+        if (magic != std::string_view("n+1\0", 4) && magic != std::string_view("ni1\0", 4)) {
+            const std::string text = printable(magic.substr(0, magic.find('\0')));
+            throw file_error(path, text.empty() ? std::string("has no NIfTI magic (an old ANALYZE 7.5 header?); "
+                                                              "expected 'n+1'")
+                                                : "wrong magic '" + text + "' for a NIfTI-1 header (expected 'n+1')");
+        }
+    } else {
+        nifti_2_header h;
+        std::memcpy(&h, head.data(), sizeof h);
+        magic = std::string_view(head.data() + offsetof(nifti_2_header, magic), 8);
+        for (int i = 0; i < 8; ++i) {
+            raw.dim[static_cast<std::size_t>(i)] = native(h.dim[i]);
+            raw.pixdim[static_cast<std::size_t>(i)] = native(h.pixdim[i]);
+        }
+        raw.datatype = native(h.datatype);
+        raw.vox_offset = static_cast<double>(native(h.vox_offset));
+        raw.bitpix = native(h.bitpix);
+        if (magic != std::string_view("n+2\0\r\n\032\n", 8) && magic != std::string_view("ni2\0\r\n\032\n", 8))
+            throw file_error(path, "wrong magic '" +
+                                       printable(magic.substr(0, std::min<std::size_t>(4, magic.find('\0')))) +
+                                       "' for a NIfTI-2 header (expected 'n+2' and the bytes 0 13 10 26 10)");
+    }
+    if (magic[1] != '+')
+        throw file_error(path, "magic '" + printable(magic.substr(0, 3)) +
+                                   "' marks the header of a .hdr/.img pair; a .nii file must have 'n+" +
+                                   std::to_string(raw.version) + "' (header and voxels in one file)");
+
+    const std::int64_t ndim = raw.dim[0];
+    if (ndim < 1 || ndim > 7)
+        throw file_error(path, "dim[0] = " + std::to_string(ndim) + " (the number of dimensions) is not in 1..7");
+    for (std::size_t d = 1; d <= static_cast<std::size_t>(ndim); ++d)
+        if (raw.dim[d] < 1)
+            throw file_error(path, "dim[" + std::to_string(d) + "] = " + std::to_string(raw.dim[d]) +
+                                       " (a size along an axis) is not at least 1");
+    for (std::size_t d = 4; d <= static_cast<std::size_t>(ndim); ++d)
+        if (raw.dim[d] > 1)
+            throw file_error(path, "has " + std::to_string(ndim) + " dimensions with dim[" + std::to_string(d) +
+                                       "] = " + std::to_string(raw.dim[d]) + "; only 3-D scalar volumes are supported");
+    for (std::size_t a = 1; a <= std::min<std::size_t>(3, static_cast<std::size_t>(ndim)); ++a)
+        if (!std::isfinite(raw.pixdim[a]) || !(raw.pixdim[a] > 0.0))
+            throw file_error(path, "pixdim[" + std::to_string(a) + "] = " + detail::number_text(raw.pixdim[a]) +
+                                       " is not a positive voxel size");
+    const ScalarType type = scalar_type(path, raw.datatype);
+    if (raw.bitpix != 8 * static_cast<int>(scalar_size(type)))
+        throw file_error(path, "bitpix = " + std::to_string(raw.bitpix) + " does not match datatype " +
+                                   scalar_name(type) + " (" + std::to_string(8 * scalar_size(type)) + " bits)");
+    // Refuse absurd dimensions before libnifti multiplies them and allocates the voxels.
+    std::uint64_t count = 1;
+    for (std::size_t d = 1; d <= std::min<std::size_t>(3, static_cast<std::size_t>(ndim)); ++d) {
+        const auto n = static_cast<std::uint64_t>(raw.dim[d]);
+        if (count > std::numeric_limits<std::uint64_t>::max() / n)
+            throw file_error(path, "its dimensions overflow 64-bit sizes");
+        count *= n;
+    }
+    check_allocation(path, count, scalar_size(type));
+    raw.voxel_bytes = count * scalar_size(type);
+    raw.header_size = need;
+    // The voxels follow the header and its 4-byte extension flag: at byte 352 (NIfTI-1) or 544 (NIfTI-2) or later.
+    if (!std::isfinite(raw.vox_offset) || raw.vox_offset < static_cast<double>(need + 4) || raw.vox_offset > 1e15)
+        throw file_error(path, "vox_offset = " + detail::number_text(raw.vox_offset) +
+                                   " does not point past the header (at least " + std::to_string(need + 4) + ")");
+    return raw;
+}
+
+/// Refuses a plain (not gzip) file too short for the voxels its header declares; libnifti would
+/// only say that it cannot load them.
+void check_data_size(const std::string& path, const RawHeader& raw)
+{
+    if (is_gzip_file(path)) return;
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    const auto offset = static_cast<std::uint64_t>(raw.vox_offset);
+    if (ec || size >= offset + raw.voxel_bytes) return;
+    throw file_error(path, "truncated: holds " + std::to_string(size > offset ? size - offset : 0) +
+                               " bytes of voxel data after vox_offset " + std::to_string(offset) +
+                               ", the header's dimensions need " + std::to_string(raw.voxel_bytes));
 }
 
 Eigen::Matrix4d to_eigen(const nifti_dmat44& m)
@@ -48,14 +220,19 @@ Eigen::Matrix4d to_eigen(const nifti_dmat44& m)
     return t;
 }
 
-Eigen::Matrix4d ras_index_to_world(const nifti_image& nim)
+Eigen::Matrix4d ras_index_to_world(const nifti_image& nim, const RawHeader& raw)
 {
     if (nim.sform_code > 0) return to_eigen(nim.sto_xyz);
     if (nim.qform_code > 0) return to_eigen(nim.qto_xyz);
+    // The voxel sizes of the header (checked positive along the image's axes); an axis the image
+    // does not have (a 2-D image's third) gets 1 mm when its pixdim is unset.
     Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
-    t(0, 0) = nim.dx;
-    t(1, 1) = nim.dy;
-    t(2, 2) = nim.dz;
+    for (std::size_t a = 1; a <= 3; ++a) {
+        const double d = raw.pixdim[a];
+        const bool used = static_cast<std::int64_t>(a) <= raw.dim[0];
+        t(static_cast<Eigen::Index>(a - 1), static_cast<Eigen::Index>(a - 1)) =
+            used || (std::isfinite(d) && d > 0.0) ? d : 1.0;
+    }
     return t;
 }
 
@@ -65,26 +242,19 @@ Volume read_nifti(const std::string& path)
 {
     static std::once_flag quiet;
     std::call_once(quiet, [] { nifti_set_debug_level(0); });
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw file_error(path, "no such file");
+    check_input_file(path);
+    const RawHeader raw = check_header(path);
+    check_data_size(path, raw);
 
-    // Header first: refuse absurd dimensions before libnifti allocates the voxels.
-    NiftiPtr nim(nifti_image_read(path.c_str(), 0));
-    if (!nim) throw file_error(path, "not a readable NIfTI file (bad magic, size or header)");
-    for (int d = 4; d <= nim->dim[0] && d < 8; ++d)
-        if (nim->dim[d] > 1)
-            throw file_error(path, "has " + std::to_string(nim->dim[0]) + " dimensions with dim[" + std::to_string(d) +
-                                       "] = " + std::to_string(nim->dim[d]) + "; only 3-D scalar volumes are supported");
+    NiftiPtr nim(nifti_image_read(path.c_str(), 0)); // the header only
+    if (!nim) throw file_error(path, "not a readable NIfTI file (libnifti refuses its header)");
     Volume v;
     v.source = path;
     v.type = scalar_type(path, nim->datatype);
     v.dims = {nim->nx, nim->dim[0] >= 2 ? nim->ny : 1, nim->dim[0] >= 3 ? nim->nz : 1};
     for (int a = 0; a < 3; ++a)
-        if (v.dims[a] <= 0) throw file_error(path, "dimension " + std::to_string(a) + " is " + std::to_string(v.dims[a]));
-    for (int a = 1; a <= 3; ++a)
-        if (!(nim->pixdim[a] > 0.0) && nim->dim[0] >= a)
-            throw file_error(path, "pixdim[" + std::to_string(a) + "] = " + std::to_string(nim->pixdim[a]) +
-                                       " is not a positive voxel size");
+        if (v.dims[a] <= 0)
+            throw file_error(path, "dimension " + std::to_string(a) + " is " + std::to_string(v.dims[a]));
     check_allocation(path, static_cast<std::uint64_t>(v.voxel_count()), scalar_size(v.type));
 
     if (nifti_image_load(nim.get()) != 0 || nim->data == nullptr)
@@ -94,7 +264,7 @@ Volume read_nifti(const std::string& path)
     std::memcpy(v.data.data(), nim->data, bytes);
 
     const Eigen::Matrix4d lps_from_ras = Eigen::Vector4d(-1.0, -1.0, 1.0, 1.0).asDiagonal();
-    v.index_to_world = lps_from_ras * ras_index_to_world(*nim);
+    v.index_to_world = lps_from_ras * ras_index_to_world(*nim, raw);
     // NIfTI: a zero slope means "no scaling".
     if (nim->scl_slope != 0.0) {
         v.scale_slope = nim->scl_slope;

@@ -153,8 +153,10 @@ HeaderFields read_header(const std::string& path)
     const auto first_nl = text.find('\n');
     const std::string_view magic = trim(std::string_view(text).substr(0, std::min(first_nl, std::size_t{16})));
     if (magic.size() != 8 || magic.substr(0, 7) != "NRRD000" || magic[7] < '1' || magic[7] > '5')
-        throw file_error(path, "not a NRRD file: starts with '" + printable(magic) +
-                                   "', expected the magic NRRD0001 to NRRD0005");
+        throw file_error(path,
+                         "not a NRRD file: starts with " +
+                             (detail::is_binary(magic) ? std::string("binary data") : "'" + printable(magic) + "'") +
+                             ", expected the magic NRRD0001 to NRRD0005");
 
     if (first_nl == std::string::npos) throw file_error(path, "has nothing after the NRRD magic line");
     HeaderFields h;
@@ -171,6 +173,9 @@ HeaderFields read_header(const std::string& path)
             return h;
         }
         if (line.front() == '#') continue;
+        if (detail::is_binary(line))
+            throw file_error(path, "header line " + std::to_string(line_no) +
+                                       " holds binary data (the header must end with a blank line before the data)");
         // "key:=value" pairs are free-form metadata; a field's ": " may come later on the line only
         // inside its description, so whichever separator comes first decides.
         const auto kv = line.find(":=");
@@ -530,6 +535,8 @@ Volume read_nrrd(const std::string& path)
         src.offset = 0;
         src.what = path + " (data file " + src.file + ")";
         std::error_code ec;
+        if (std::filesystem::is_directory(src.file, ec))
+            throw file_error(path, "data file '" + src.file + "' is a folder, not a file");
         if (!std::filesystem::is_regular_file(src.file, ec))
             throw file_error(path, "data file '" + src.file + "' does not exist");
     }

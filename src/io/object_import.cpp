@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/file_bytes.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
 #include "io/mesh_voxelizer.hpp"
@@ -45,7 +46,10 @@ grid::LabelGrid import_object(const std::string& path, const ImportOptions& opti
     }
     if (options.voxel_mm || options.mm_per_unit != 1.0)
         throw file_error(path, "--voxel-size and --scale apply to meshes; a volume keeps its own voxels");
-    if (lower_extension(path) == ".vdb") return select_labels(grid::LabelGrid::load(path), options.selection, path);
+    if (lower_extension(path) == ".vdb") {
+        check_input_file(path); // the same "no such file", "is a folder", "is empty" as every reader
+        return select_labels(grid::LabelGrid::load(path), options.selection, path);
+    }
     if (is_volume_path(path)) return select_voxels(read_volume(path), options.selection);
     throw file_error(path, "unknown file type (expected a volume .inr[.gz] .nii[.gz] .mhd .mha .nrrd .nhdr .vdb, "
                            "or a mesh .obj .ply .stl .off)");

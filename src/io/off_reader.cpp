@@ -46,7 +46,7 @@ private:
     std::size_t m_line = 0;
 };
 
-std::string quoted(std::string_view s) { return "'" + std::string(s.substr(0, 40)) + "'"; }
+std::string quoted(std::string_view s) { return "'" + printable(s) + "'"; }
 
 struct OffCounts {
     long long vertices = 0;
@@ -59,7 +59,7 @@ OffCounts parse_off_header(const std::string& path, LineReader& lines)
     if (!lines.next(words) || !words[0].ends_with("OFF"))
         throw file_error(path, "not an OFF file (it does not start with the keyword OFF)");
     if (words[0].find('4') != std::string_view::npos || words[0].starts_with('n'))
-        throw file_error(path, "only 3-dimensional OFF is supported, not " + std::string(words[0]));
+        throw file_error(path, "only 3-dimensional OFF is supported, not " + printable(words[0]));
     if (words.size() > 1 && words[1] == "BINARY") throw file_error(path, "binary OFF is not supported");
     words.erase(words.begin());
     if (words.empty() && !lines.next(words)) throw file_error(path, "truncated: no vertex and face counts");
@@ -113,7 +113,7 @@ TriangleMesh parse_off(const std::string& path, std::string_view text)
         for (long long c = 1; c <= *n; ++c) {
             const auto i = parse_integer(words[static_cast<std::size_t>(c)]);
             if (!i || *i < 0 || *i >= counts.vertices)
-                throw at_line("face " + std::to_string(f) + " references vertex " + std::string(words[c]) +
+                throw at_line("face " + std::to_string(f) + " references vertex " + printable(words[c]) +
                               ", but there are only " + std::to_string(counts.vertices) + " vertices");
             corners.push_back(static_cast<int>(*i));
         }

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -51,11 +53,25 @@ struct Selector {
     }
 };
 
+/// `v`, a whole number, written out in full ("4000000000", not "4e+09").
+std::string whole_number_text(double v)
+{
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(0) << v;
+    return os.str();
+}
+
 void check_integer_label(const std::string& source, double stored)
 {
-    if (stored != std::floor(stored) || std::abs(stored) > 2147483647.0)
+    if (!std::isfinite(stored) || stored != std::floor(stored))
         throw file_error(source, "value " + format_number(stored) +
                                      " is not an integer label; select voxels with --threshold LO[:HI] instead");
+    if (stored < static_cast<double>(std::numeric_limits<std::int32_t>::min()) ||
+        stored > static_cast<double>(std::numeric_limits<std::int32_t>::max()))
+        throw file_error(source, "label " +
+                                     (std::abs(stored) < 1e18 ? whole_number_text(stored) : format_number(stored)) +
+                                     " does not fit a 32-bit signed label; select voxels with --threshold LO[:HI] "
+                                     "instead");
 }
 
 } // namespace

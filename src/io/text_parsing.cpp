@@ -79,6 +79,14 @@ std::string printable(std::string_view s)
     return out;
 }
 
+bool is_binary(std::string_view s)
+{
+    return std::any_of(s.begin(), s.end(), [](char c) {
+        const auto u = static_cast<unsigned char>(c);
+        return (u < 32 && k_white_space.find(c) == std::string_view::npos) || u == 127;
+    });
+}
+
 std::string number_text(double v)
 {
     std::array<char, 32> buffer{};

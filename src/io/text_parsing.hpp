@@ -1,7 +1,7 @@
 #pragma once
 // Internal to src/io: text parsing shared by the readers of text formats and text headers (OFF,
-// STL ascii, MetaImage, NRRD): words, numbers, the fields of a "key = value" header, and short
-// texts for error messages.
+// OBJ, PLY, STL ascii, MetaImage, NRRD): words, numbers, the fields of a "key = value" header, and
+// short texts for error messages.
 
 #include <cstddef>
 #include <cstdint>
@@ -45,6 +45,10 @@ inline constexpr std::string_view k_white_space = " \t\r\n\v\f";
 /// At most the first 60 characters of `s`, anything outside printable ASCII shown as '?' and "..."
 /// after a cut: file text safe to quote in a one-line message.
 [[nodiscard]] std::string printable(std::string_view s);
+
+/// True when `s` holds a control byte other than white space (NUL, ESC, ...): binary data, not
+/// text. Messages then say so instead of quoting it.
+[[nodiscard]] bool is_binary(std::string_view s);
 
 /// Shortest text that reads back as `v` ("0.5", "30000", "1e-06", "-1").
 [[nodiscard]] std::string number_text(double v);

@@ -1,8 +1,9 @@
 // One volume through every format: written by the test writers (NIfTI through libnifti2's own
 // writer), read back through read_volume, it must give the same voxels, dimensions and transform.
-// Also: hand-made big-endian files, and the malformed files of tests/data/bad.
+// Also: hand-made big-endian files, and the malformed volume files of tests/data/bad.
 
 #include "core/error.hpp"
+#include "io/object_import.hpp"
 #include "io/test_volume_writers.hpp"
 #include "io/volume_reader.hpp"
 #include "test_support.hpp"
@@ -228,10 +229,12 @@ TEST(CrossFormatGeometry, NrrdInRasSpaceMatchesTheLpsNifti)
 
 TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
 {
-    // What each file of ours must be refused for (tests/data/bad/README.md says why).
+    // What each file of ours must be refused for (tests/data/bad/README.md says why), imported as
+    // `voxsculpt import FILE` does: read, then every non-zero voxel kept as its label.
     const std::map<std::string, std::string> expected = {
         {"mha_bad_element_type.mha", "unsupported ElementType"},
         {"mha_compressed_corrupt.mha", "corrupt compressed data"},
+        {"mha_empty.mha", ": is empty"},
         {"mha_multichannel.mha", "single-channel"},
         {"mha_no_datafile_line.mha", "no 'ElementDataFile' line"},
         {"mha_truncated.mha", "truncated"},
@@ -243,13 +246,19 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
         {"mhd_ndims4.mhd", "NDims = 4"},
         {"mhd_negative_spacing.mhd", "voxel spacing of axis 1 is -1"},
         {"mhd_singular_matrix.mhd", "degenerate"},
+        {"nii_bad_dim.nii", "dim[1] = 0"},
+        {"nii_empty.nii", ": is empty"},
         {"nii_huge_dims.nii", "memory limit"},
+        {"nii_nan_pixdim.nii", "pixdim[2] = nan is not a positive voxel size"},
         {"nii_truncated.nii.gz", "truncated"},
-        {"nii_zero_spacing.nii", ""}, // worded by read_nifti's checks (pixdim or sform column)
+        {"nii_wrong_magic.nii", "wrong magic 'n+2'"},
+        {"nii_zero_spacing.nii", "pixdim[2] = 0"},
         {"nrrd_bad_type.nrrd", "unsupported type 'int64'"},
         {"nrrd_bzip2.nrrd", "unsupported encoding 'bzip2'"},
+        {"nrrd_empty.nrrd", ": is empty"},
         {"nrrd_gzip_corrupt.nrrd", "corrupt"},
         {"nrrd_huge_dims.nrrd", "memory limit"},
+        {"nrrd_label_too_big.nrrd", "label 4000000000 does not fit a 32-bit signed label"},
         {"nrrd_missing_datafile.nhdr", "does not exist"},
         {"nrrd_missing_endian.nrrd", "no 'endian' field"},
         {"nrrd_nan_origin.nrrd", "not finite"},
@@ -271,12 +280,13 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
         const auto it = expected.find(name);
         ASSERT_NE(it, expected.end()) << "add " << name << " to this table and to tests/data/bad/README.md";
         try {
-            (void)read_volume(entry.path().string());
-            ADD_FAILURE() << "read without an error";
+            (void)import_object(entry.path().string(), ImportOptions{});
+            ADD_FAILURE() << "imported without an error";
         } catch (const InputError& e) {
             const std::string message = e.what();
-            EXPECT_NE(message.find(name), std::string::npos) << message;
+            EXPECT_EQ(message.rfind(entry.path().string() + ": ", 0), 0u) << message;
             EXPECT_NE(message.find(it->second), std::string::npos) << message;
+            EXPECT_EQ(message.find('\n'), std::string::npos) << message;
         }
     }
     EXPECT_EQ(seen, expected.size()) << "a file listed here is missing from " << bad;

@@ -266,6 +266,23 @@ TEST_F(MetaImageReader, RefusesMissingOrMismatchedData)
     expect_refused(write("dup.mha", k_head + "DimSize = 4 1 1\nDimSize = 4 1 1\n"), "appears twice");
 }
 
+TEST_F(MetaImageReader, BinaryFilesAreNotEchoed)
+{
+    // A scan of another format named .mha: say it holds binary data instead of quoting its bytes.
+    const std::string gz = write("scan.mha", test::gzip("#INRIMAGE-4#{\nXDIM=2\n"));
+    const std::string message = test::error_of([&] { (void)read_metaimage(gz); });
+    EXPECT_EQ(message, gz + ": not a MetaImage header: line 1 holds binary data, not 'Key = value' text");
+    // Text that is not a header is still quoted, so the user sees what it is.
+    expect_refused(write("text.mha", "ply\nformat ascii 1.0\n"), "line 1 is not 'Key = value' ('ply')");
+    expect_refused(write("empty.mha", ""), ": is empty");
+    fs::create_directories(path("folder.mha"));
+    expect_refused(path("folder.mha"), ": is a folder, not a file");
+    fs::create_directories(path("voxels.raw"));
+    expect_refused(
+        write("detached.mhd", k_head + "DimSize = 1 1 1\nElementType = MET_UCHAR\nElementDataFile = voxels.raw\n"),
+        "(ElementDataFile) is a folder, not a file");
+}
+
 TEST_F(MetaImageReader, RefusesHugeDimensionsBeforeAllocating)
 {
     // 4096^3 floats need 256 GiB: the header alone must be refused, with no data present at all.

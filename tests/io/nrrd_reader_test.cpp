@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 
 namespace vox::io {
 namespace {
@@ -313,6 +314,19 @@ TEST_F(NrrdReader, RefusesBadHeaders)
         "axis 0 (3 samples) is not spatial");
     expect_refused(write("fourd.nrrd", nrrd("type: uchar\ndimension: 4\nsizes: 1 1 1 2\n" + raw, "ab")),
                    "has 4 spatial axes");
+}
+
+TEST_F(NrrdReader, BinaryEmptyAndFolderAreNamed)
+{
+    const std::string gz = write("scan.nrrd", gzip("NRRD0004\n"));
+    EXPECT_EQ(test::error_of([&] { (void)read_nrrd(gz); }),
+              gz + ": not a NRRD file: starts with binary data, expected the magic NRRD0001 to NRRD0005");
+    expect_refused(write("empty.nrrd", ""), ": is empty");
+    std::filesystem::create_directories(path("folder.nhdr"));
+    expect_refused(path("folder.nhdr"), ": is a folder, not a file");
+    std::filesystem::create_directories(path("voxels.raw"));
+    expect_refused(write("detached.nhdr", "NRRD0004\n" + k_short3 + "encoding: raw\ndata file: voxels.raw\n"),
+                   "data file '" + path("voxels.raw") + "' is a folder, not a file");
 }
 
 TEST_F(NrrdReader, RefusesMissingOrMismatchedData)

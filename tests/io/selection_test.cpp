@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstring>
+#include <string>
 
 using namespace vox::io;
 
@@ -70,4 +72,37 @@ TEST(Selection, MalformedThresholds)
     EXPECT_THROW((void)parse_threshold("5:1"), vox::InputError);
     EXPECT_THROW((void)parse_threshold("1:"), vox::InputError);
     EXPECT_THROW((void)parse_threshold("nan"), vox::InputError);
+}
+
+TEST(Selection, LabelsMustFitInt32)
+{
+    // uint32 4000000000 is a whole number, but no 32-bit signed label: say so, not "not an integer".
+    Volume v = make_volume({0, 0});
+    v.type = ScalarType::u32;
+    v.data.resize(8);
+    const std::uint32_t values[2] = {1, 4000000000u};
+    std::memcpy(v.data.data(), values, sizeof values);
+    try {
+        (void)select_voxels(v, Selection{});
+        ADD_FAILURE() << "no error";
+    } catch (const vox::InputError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("test.nii: label 4000000000 does not fit a 32-bit signed label", 0), 0u)
+            << e.what();
+    }
+    // The limits themselves fit; a fraction is still "not an integer label".
+    const std::int32_t extremes[2] = {-2147483647 - 1, 2147483647};
+    v.type = ScalarType::i32;
+    std::memcpy(v.data.data(), extremes, sizeof extremes);
+    const auto g = select_voxels(v, Selection{});
+    EXPECT_EQ(g.get({0, 0, 0}), -2147483647 - 1);
+    EXPECT_EQ(g.get({1, 0, 0}), 2147483647);
+    v.type = ScalarType::f32;
+    const float fractions[2] = {0.0f, 2.5f};
+    std::memcpy(v.data.data(), fractions, sizeof fractions);
+    try {
+        (void)select_voxels(v, Selection{});
+        ADD_FAILURE() << "no error";
+    } catch (const vox::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("value 2.5 is not an integer label"), std::string::npos) << e.what();
+    }
 }
