@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "grid/hex8.hpp"
 
+#include <algorithm>
 #include <numeric>
 
 namespace vox::fem {
@@ -78,6 +79,15 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level)
         }
         m_elements.push_back(el);
     }
+    double density = 0.0;
+    for (const grid::VoxelMaterial& m : grid.materials()) density = std::max(density, m.density_kg_m3);
+    const double floor = 1e-3 * density * (cell * cell * cell) * h.prod() / 8.0;
+    m_added_mass.assign(m_nodal_mass.size(), 0.0);
+    for (std::size_t n = 0; n < m_nodal_mass.size(); ++n)
+        if (m_nodal_mass[n] < floor) {
+            m_added_mass[n] = floor - m_nodal_mass[n];
+            m_nodal_mass[n] = floor;
+        }
 }
 
 double HexModel::total_mass() const { return std::accumulate(m_nodal_mass.begin(), m_nodal_mass.end(), 0.0); }

@@ -39,8 +39,13 @@ public:
     /// Orthonormal part of the index-to-world map: world = frame * index-aligned (a reflection
     /// when the scan's transform mirrors).
     [[nodiscard]] const Eigen::Matrix3d& frame() const { return m_frame; }
-    /// Consistent mass row sums per node, kg: gravity loads are these times g.
+    /// Consistent mass row sums per node plus the floor below, kg: gravity loads are these times g.
     [[nodiscard]] const std::vector<double>& nodal_mass() const { return m_nodal_mass; }
+    /// Lumped mass added to nodes whose share of material is tiny (a corner far from the one voxel
+    /// of a partly filled element): each node weighs at least 1e-3 of a full cell's corner mass.
+    /// Without it such nodes have almost no inertia and almost no stiffness, and any solve leaves
+    /// them wherever its residual stops caring. Kg per node (0 for most).
+    [[nodiscard]] const std::vector<double>& added_mass() const { return m_added_mass; }
     [[nodiscard]] double total_mass() const;
 
 private:
@@ -51,6 +56,7 @@ private:
     std::vector<Eigen::Vector3d> m_rest_world;
     std::vector<std::uint32_t> m_grid_node, m_dense_node;
     std::vector<double> m_nodal_mass;
+    std::vector<double> m_added_mass;
     Eigen::Matrix3d m_frame = Eigen::Matrix3d::Identity();
 };
 

@@ -3,7 +3,6 @@
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
 
 #include <algorithm>
 #include <chrono>
@@ -101,6 +100,13 @@ double ImplicitSolver::assemble(double m_scale, double k_scale)
                             k_scale * block(i, j) + (i == j ? m_scale * el.mass(c, d) : 0.0);
             }
     }
+    if (m_scale != 0.0)
+        for (std::size_t n = 0; n < m_x.size(); ++n)
+            if (m_model.added_mass()[n] > 0.0)
+                for (int i = 0; i < 3; ++i) {
+                    const auto d = static_cast<Eigen::Index>(3 * n + static_cast<std::size_t>(i));
+                    m_matrix.coeffRef(d, d) += m_scale * m_model.added_mass()[n];
+                }
     return energy;
 }
 
@@ -125,15 +131,43 @@ void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 
 int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double, Eigen::RowMajor>, Eigen::Lower | Eigen::Upper,
-                             Eigen::DiagonalPreconditioner<double>>
-        cg;
-    cg.setTolerance(m_options.cg_tolerance);
-    cg.setMaxIterations(m_options.cg_max_iterations);
-    cg.compute(m_matrix);
-    x = cg.solveWithGuess(rhs, x);
-    residual = cg.error();
-    return static_cast<int>(cg.iterations());
+    // Conjugate gradients on the Jacobi-scaled system D^-1/2 A D^-1/2 y = D^-1/2 b, x = D^-1/2 y,
+    // stopping when the scaled residual falls below the tolerance relative to the scaled right-hand
+    // side. Unscaled, nodes that carry almost no material (an element holding one voxel of 512)
+    // would barely count in the residual and could move wildly while the solve "converges".
+    const Eigen::Index n = rhs.size();
+    Eigen::VectorXd inv_sqrt_d(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const double d = m_matrix.coeff(i, i);
+        inv_sqrt_d[i] = d > 0.0 ? 1.0 / std::sqrt(d) : 1.0;
+    }
+    const double b_norm = rhs.cwiseProduct(inv_sqrt_d).norm();
+    if (b_norm == 0.0) {
+        x.setZero();
+        residual = 0.0;
+        return 0;
+    }
+    Eigen::VectorXd r = rhs - m_matrix * x;
+    Eigen::VectorXd z = r.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+    Eigen::VectorXd p = z, q(n);
+    double rz = r.dot(z);
+    int it = 0;
+    residual = std::sqrt(std::max(rz, 0.0)) / b_norm;
+    while (residual > m_options.cg_tolerance && it < m_options.cg_max_iterations) {
+        q.noalias() = m_matrix * p;
+        const double pq = p.dot(q);
+        if (!(pq > 0.0)) break; // not positive definite along p: stop rather than diverge
+        const double alpha = rz / pq;
+        x += alpha * p;
+        r -= alpha * q;
+        z = r.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+        const double rz_next = r.dot(z);
+        p = z + (rz_next / rz) * p;
+        rz = rz_next;
+        residual = std::sqrt(std::max(rz, 0.0)) / b_norm;
+        ++it;
+    }
+    return it;
 }
 
 StepStats ImplicitSolver::step()
@@ -153,6 +187,8 @@ StepStats ImplicitSolver::step()
         for (const HexElement& el : m_model.elements())
             for (int c = 0; c < 8; ++c)
                 for (int d = 0; d < 8; ++d) rhs.segment<3>(3 * el.dof_node[c]) += el.mass(c, d) * m_v[el.dof_node[d]];
+        for (std::size_t i = 0; i < m_x.size(); ++i)
+            rhs.segment<3>(static_cast<Eigen::Index>(3 * i)) += m_model.added_mass()[i] * m_v[i];
         apply_constraints(rhs);
         Eigen::VectorXd next = v;
         for (Eigen::Index i = 0; i < n; ++i)
@@ -189,6 +225,7 @@ StepStats ImplicitSolver::step()
     for (const HexElement& el : m_model.elements())
         for (int c = 0; c < 8; ++c)
             for (int d = 0; d < 8; ++d) s.kinetic_energy_j += 0.5 * el.mass(c, d) * m_v[el.dof_node[c]].dot(m_v[el.dof_node[d]]);
+    for (std::size_t i = 0; i < m_x.size(); ++i) s.kinetic_energy_j += 0.5 * m_model.added_mass()[i] * m_v[i].squaredNorm();
     for (std::size_t i = 0; i < m_x.size(); ++i)
         s.max_displacement_m = std::max(s.max_displacement_m, (m_x[i] - m_model.rest_positions()[i]).norm());
     s.step_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -201,6 +238,7 @@ Eigen::Vector3d ImplicitSolver::momentum() const
     for (const HexElement& el : m_model.elements())
         for (int c = 0; c < 8; ++c)
             for (int d = 0; d < 8; ++d) p += el.mass(c, d) * m_v[el.dof_node[d]];
+    for (std::size_t i = 0; i < m_x.size(); ++i) p += m_model.added_mass()[i] * m_v[i];
     return p;
 }
 

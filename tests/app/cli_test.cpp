@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <fstream>
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
@@ -74,7 +75,7 @@ TEST(Cli, PhantomWritesDocumentedSizes)
 
 TEST(Cli, HelpAndUsageErrors)
 {
-    for (const char* sub : {"", "import ", "info ", "phantom ", "phantom sphere ", "check ", "grid ", "export "}) {
+    for (const char* sub : {"", "import ", "info ", "phantom ", "phantom sphere ", "check ", "grid ", "export ", "run "}) {
         const auto r = run_voxsculpt(std::string(sub) + "--help");
         EXPECT_EQ(r.exit_code, 0) << sub;
         EXPECT_NE(r.out.find("Usage"), std::string::npos) << sub;
@@ -110,6 +111,34 @@ TEST(Cli, ExportWritesTheClosedSurfaceInWorldMillimetres)
     const auto bad = run_voxsculpt("export " + quote(vdb) + " -o " + quote((d / "b.xyz").string()));
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.err.find("b.xyz"), std::string::npos);
+}
+
+TEST(Cli, RunWritesStatsAndDeformedSurfaces)
+{
+    const fs::path d = fresh_dir("cli_run");
+    {
+        std::ofstream scene(d / "block.json");
+        scene << R"({"object": {"phantom": {"shape": "block", "size_mm": [8, 4, 4]}, "levels": 1},
+                    "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 4, 4]]}],
+                    "output": {"dir": "results", "mesh_every_n_frames": 2}})";
+    }
+    const auto r = run_voxsculpt("run " + quote((d / "block.json").string()) + " --frames 5");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const fs::path out = d / "results"; // relative to the scene's folder
+    std::ifstream in(out / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    ASSERT_EQ(stats["frames"].size(), 5u);
+    for (const char* key : {"step_ms", "cg_iterations", "residual", "kinetic_energy_j", "elastic_energy_j",
+                            "max_displacement_mm"})
+        EXPECT_TRUE(stats["frames"][0].contains(key)) << key;
+    EXPECT_EQ(stats["summary"]["frames"], 5);
+    // The block hangs from its left end and sags under gravity.
+    EXPECT_GT(stats["summary"]["final_max_displacement_mm"].get<double>(), 0.0);
+    EXPECT_TRUE(fs::exists(out / "frame_00002.obj"));
+    EXPECT_TRUE(fs::exists(out / "frame_00004.obj"));
+    EXPECT_FALSE(fs::exists(out / "frame_00005.obj"));
+    const auto j = info_json(out / "final.obj");
+    EXPECT_EQ(j["closed"], true);
 }
 
 TEST(Cli, QuietPrintsNothingOnSuccess)
