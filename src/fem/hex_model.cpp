@@ -2,22 +2,96 @@
 
 #include "core/error.hpp"
 #include "grid/hex8.hpp"
+#include "grid/union_find.hpp"
 
 #include <algorithm>
 #include <numeric>
 
 namespace vox::fem {
+namespace {
+
+/// dN_c/dX at local coordinates t in [0, 1]^3 of a box with edges `edge` (m).
+Eigen::Matrix<double, 8, 3> corner_gradients(const Eigen::Vector3d& t, const Eigen::Vector3d& edge)
+{
+    Eigen::Matrix<double, 8, 3> g;
+    auto f = [](int bit, double x) { return bit ? x : 1.0 - x; };
+    auto df = [](int bit) { return bit ? 1.0 : -1.0; };
+    for (int c = 0; c < 8; ++c) {
+        const int bx = c & 1, by = (c >> 1) & 1, bz = (c >> 2) & 1;
+        g(c, 0) = df(bx) * f(by, t.y()) * f(bz, t.z()) / edge.x();
+        g(c, 1) = f(bx, t.x()) * df(by) * f(bz, t.z()) / edge.y();
+        g(c, 2) = f(bx, t.x()) * f(by, t.y()) * df(bz) / edge.z();
+    }
+    return g;
+}
+
+} // namespace
 
 HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level)
 {
-    if (level < 1 || level > grid.max_level())
-        throw InputError("the simulated level must be 1 .. " + std::to_string(grid.max_level()) + ", got " +
+    if (level < 0 || level > grid.max_level())
+        throw InputError("the simulated level must be 0 .. " + std::to_string(grid.max_level()) + ", got " +
                          std::to_string(level));
-    const grid::Level& lv = grid.level(level);
     const Eigen::Matrix4d& t = grid.voxels().index_to_world();
+    m_frame = t.topLeftCorner<3, 3>() * (grid.voxels().voxel_size_m() * 1e3).cwiseInverse().asDiagonal();
+    if (level == 0)
+        build_voxel_level(grid);
+    else
+        build_grid_level(grid, level);
+    add_mass_floor(grid);
+}
+
+void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
+{
+    // Every voxel is an element; corners are shared through connected faces (the closure of face
+    // sharing, as on every other level), numbered by union-find over 8 corner slots per voxel.
+    const grid::FineVoxels& v = grid.voxels();
+    const Eigen::Vector3d h = v.voxel_size_m();
+    grid::UnionFind sets(8 * std::size_t{v.slots()});
+    for (std::uint32_t a = 0; a < v.slots(); ++a) {
+        if (!v.alive(a)) continue;
+        for (int axis = 0; axis < 3; ++axis) {
+            const std::uint32_t b = v.connected_neighbour(a, axis);
+            if (b == grid::FineVoxels::missing) continue;
+            for (int c = 0; c < 8; ++c)
+                if ((c >> axis) & 1) sets.unite(8 * a + static_cast<std::uint32_t>(c), 8 * b + static_cast<std::uint32_t>(c ^ (1 << axis)));
+        }
+    }
+    for (const grid::VoxelMaterial& m : grid.materials()) m_full_stiffness.push_back(grid::hex8_stiffness(h, m.lame));
+    std::vector<Matrix8d> mass;
+    for (const grid::VoxelMaterial& m : grid.materials()) mass.push_back(grid::hex8_mass(h, m.density_kg_m3));
+    const Eigen::Matrix<double, 8, 3> gradient = corner_gradients(Eigen::Vector3d::Constant(0.5), h);
+    const Eigen::Matrix4d& t = v.index_to_world();
+
+    std::vector<std::uint32_t> dense(8 * std::size_t{v.slots()}, grid::no_index);
+    for (std::uint32_t a = 0; a < v.slots(); ++a) {
+        if (!v.alive(a)) continue;
+        HexElement el;
+        el.grid_element = a;
+        const auto material = static_cast<std::size_t>(v.material(a));
+        el.stiffness = &m_full_stiffness[material];
+        el.mass = mass[material];
+        el.gradient = gradient;
+        for (int c = 0; c < 8; ++c) {
+            const Eigen::Vector3d corner = grid::BranchedGrid::cell_corner_index(v.coord(a), 0, c);
+            el.rest.segment<3>(3 * c) = corner.cwiseProduct(h);
+            std::uint32_t& id = dense[sets.find(8 * a + static_cast<std::uint32_t>(c))];
+            if (id == grid::no_index) {
+                id = static_cast<std::uint32_t>(m_rest_world.size());
+                m_rest_world.push_back((t.topLeftCorner<3, 3>() * corner + t.topRightCorner<3, 1>()) * 1e-3);
+                m_nodal_mass.push_back(0.0);
+            }
+            el.dof_node[c] = id;
+            m_nodal_mass[id] += el.mass.row(c).sum();
+        }
+        m_elements.push_back(el);
+    }
+}
+
+void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
+{
+    const grid::Level& lv = grid.level(level);
     const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
-    const Eigen::Vector3d spacing_mm = h * 1e3;
-    m_frame = t.topLeftCorner<3, 3>() * spacing_mm.cwiseInverse().asDiagonal();
     const double cell = static_cast<double>(1 << level);
 
     // Dense numbering of the nodes the alive elements use.
@@ -68,17 +142,15 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level)
             q1 += Eigen::Vector3d(static_cast<double>(m.moments[1]), static_cast<double>(m.moments[3]),
                                   static_cast<double>(m.moments[9]));
         }
-        const Eigen::Vector3d centre = q1 / q0 / cell;
-        for (int c = 0; c < 8; ++c) {
-            const int bx = c & 1, by = (c >> 1) & 1, bz = (c >> 2) & 1;
-            auto f = [](int bit, double x) { return bit ? x : 1.0 - x; };
-            auto df = [](int bit) { return bit ? 1.0 : -1.0; };
-            el.gradient(c, 0) = df(bx) * f(by, centre.y()) * f(bz, centre.z()) / (cell * h.x());
-            el.gradient(c, 1) = f(bx, centre.x()) * df(by) * f(bz, centre.z()) / (cell * h.y());
-            el.gradient(c, 2) = f(bx, centre.x()) * f(by, centre.y()) * df(bz) / (cell * h.z());
-        }
+        el.gradient = corner_gradients(q1 / q0 / cell, cell * h);
         m_elements.push_back(el);
     }
+}
+
+void HexModel::add_mass_floor(const grid::BranchedGrid& grid)
+{
+    const Eigen::Vector3d h = grid.voxels().voxel_size_m();
+    const double cell = static_cast<double>(1 << m_level);
     double density = 0.0;
     for (const grid::VoxelMaterial& m : grid.materials()) density = std::max(density, m.density_kg_m3);
     const double floor = 1e-3 * density * (cell * cell * cell) * h.prod() / 8.0;

@@ -20,12 +20,12 @@ struct HexElement {
     Matrix8d mass = Matrix8d::Zero();          ///< kg, scalar consistent mass (times I3 per axis)
     Eigen::Matrix<double, 8, 3> gradient;      ///< dN_c/dX at the material centroid, 1/m, index-aligned frame
     Vector24d rest;                            ///< corner rest positions, m, index-aligned frame
-    std::uint32_t grid_element = 0;            ///< the branched-grid element it models
+    std::uint32_t grid_element = 0;            ///< the branched-grid element it models (level 0: voxel slot)
 };
 
 class HexModel {
 public:
-    /// Builds the model of `level` (1 .. grid.max_level()) of `grid`.
+    /// Builds the model of `level` of `grid`: 0 (every voxel an element) .. grid.max_level().
     HexModel(const grid::BranchedGrid& grid, int level);
 
     [[nodiscard]] int level() const { return m_level; }
@@ -33,7 +33,8 @@ public:
     [[nodiscard]] const std::vector<HexElement>& elements() const { return m_elements; }
     /// Rest positions of the nodes, world frame, m.
     [[nodiscard]] const std::vector<Eigen::Vector3d>& rest_positions() const { return m_rest_world; }
-    /// Grid node id of each dense node, and the dense index of each grid node id (or no_index).
+    /// Grid node id of each dense node, and the dense index of each grid node id (or no_index);
+    /// empty at level 0, whose nodes exist only in this model.
     [[nodiscard]] const std::vector<std::uint32_t>& grid_node() const { return m_grid_node; }
     [[nodiscard]] const std::vector<std::uint32_t>& dense_node() const { return m_dense_node; }
     /// Orthonormal part of the index-to-world map: world = frame * index-aligned (a reflection
@@ -49,6 +50,10 @@ public:
     [[nodiscard]] double total_mass() const;
 
 private:
+    void build_voxel_level(const grid::BranchedGrid& grid);
+    void build_grid_level(const grid::BranchedGrid& grid, int level);
+    void add_mass_floor(const grid::BranchedGrid& grid);
+
     int m_level = 1;
     std::vector<HexElement> m_elements;
     std::vector<Matrix24d> m_partial_stiffness; ///< owned by partial elements
