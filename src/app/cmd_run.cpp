@@ -99,10 +99,16 @@ void add_run_command(CLI::App& app)
         const grid::LabelGrid labels = io::load_scene_object(scene);
         io::check_constraints(scene, labels);
         const io::MaterialTable table = io::material_table(scene);
+        // Coarser levels than the simulated one serve the multigrid preconditioner.
+        const int coarsest = std::min(6, level + 3);
         const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }),
-                                   table.materials, level);
+                                   table.materials, coarsest);
         const fem::HexModel model(g, level);
         fem::ImplicitSolver solver(model, solver_options(scene.solver));
+        // Measured: the V-cycle cuts the quasi-static cantilever's CG iterations 50 to 700 fold, but
+        // for implicit steps of soft tissue its set-up costs more than the Jacobi iterations it saves.
+        if (level < coarsest && scene.solver.mode == io::SolverMode::static_equilibrium)
+            solver.use_multigrid(std::make_unique<fem::Multigrid>(g, model, coarsest));
         solver.set_gravity(scene.gravity_m_s2);
         for (const io::Constraint& c : scene.constraints) {
             const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);

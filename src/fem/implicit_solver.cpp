@@ -147,12 +147,21 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         residual = 0.0;
         return 0;
     }
+    if (m_multigrid) m_multigrid->update(m_matrix, m_fixed);
+    auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {
+        if (m_multigrid)
+            m_multigrid->apply(res, out);
+        else
+            out = res.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+    };
+    auto scaled_norm = [&](const Eigen::VectorXd& res) { return res.cwiseProduct(inv_sqrt_d).norm() / b_norm; };
     Eigen::VectorXd r = rhs - m_matrix * x;
-    Eigen::VectorXd z = r.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+    Eigen::VectorXd z(n);
+    precondition(r, z);
     Eigen::VectorXd p = z, q(n);
     double rz = r.dot(z);
     int it = 0;
-    residual = std::sqrt(std::max(rz, 0.0)) / b_norm;
+    residual = scaled_norm(r);
     while (residual > m_options.cg_tolerance && it < m_options.cg_max_iterations) {
         q.noalias() = m_matrix * p;
         const double pq = p.dot(q);
@@ -160,11 +169,11 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         const double alpha = rz / pq;
         x += alpha * p;
         r -= alpha * q;
-        z = r.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+        precondition(r, z);
         const double rz_next = r.dot(z);
         p = z + (rz_next / rz) * p;
         rz = rz_next;
-        residual = std::sqrt(std::max(rz, 0.0)) / b_norm;
+        residual = scaled_norm(r);
         ++it;
     }
     return it;

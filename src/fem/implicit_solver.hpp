@@ -7,10 +7,12 @@
 // iterations until the force residual meets the tolerance, so further frames change nothing.
 
 #include "fem/hex_model.hpp"
+#include "fem/multigrid.hpp"
 
 #include <Eigen/Sparse>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,9 @@ public:
     /// Extra external forces per node, N (point forces, tool contact); zero by default.
     [[nodiscard]] std::vector<Eigen::Vector3d>& external_forces() { return m_external; }
 
+    /// Preconditions the CG solves with a multigrid V-cycle instead of Jacobi.
+    void use_multigrid(std::unique_ptr<Multigrid> multigrid) { m_multigrid = std::move(multigrid); }
+
     StepStats step();
 
     [[nodiscard]] const std::vector<Eigen::Vector3d>& positions() const { return m_x; }
@@ -76,6 +81,7 @@ private:
     Eigen::SparseMatrix<double, Eigen::RowMajor> m_matrix;
     std::vector<int> m_slot;            ///< per element, 576 positions in m_matrix's values
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
+    std::unique_ptr<Multigrid> m_multigrid;
 };
 
 } // namespace vox::fem
