@@ -6,6 +6,7 @@
 // reader): a bad vertex or index must stop the import, not change the shape.
 
 #include "io/mesh.hpp"
+#include "io/text_parsing.hpp"
 
 #include "core/error.hpp"
 #include "io/mesh_readers.hpp"
@@ -18,17 +19,9 @@
 namespace vox::io {
 namespace {
 
-std::string lower_extension(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
 TriangleMesh read_by_format(const std::string& path)
 {
-    const std::string ext = lower_extension(path);
+    const std::string ext = detail::lower_extension(path);
     if (ext == ".off") return detail::read_off(path);
     if (ext == ".stl") return detail::read_stl(path);
     if (ext == ".obj") return detail::read_obj(path);

@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "io/text_parsing.hpp"
 
 #include <Eigen/Geometry>
 
@@ -13,14 +14,6 @@
 
 namespace vox::io {
 namespace {
-
-std::string extension(const std::string& path)
-{
-    const auto dot = path.find_last_of('.');
-    std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
 
 template <class T> void put(std::ofstream& out, T value) { out.write(reinterpret_cast<const char*>(&value), sizeof(T)); }
 
@@ -82,14 +75,14 @@ void write_stl(std::ofstream& out, std::span<const Eigen::Vector3d> p, std::span
 
 bool is_writable_mesh_path(const std::string& path)
 {
-    const std::string ext = extension(path);
+    const std::string ext = detail::lower_extension(path);
     return ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".off";
 }
 
 void write_mesh(const std::string& path, std::span<const Eigen::Vector3d> positions,
                 std::span<const Eigen::Vector3i> triangles, std::span<const std::int32_t> labels)
 {
-    const std::string ext = extension(path);
+    const std::string ext = detail::lower_extension(path);
     if (!is_writable_mesh_path(path))
         throw file_error(path, "unknown mesh format '" + ext + "' (expected .obj, .ply, .stl or .off)");
     write_atomically(path, [&](const std::filesystem::path& tmp) {

@@ -6,6 +6,7 @@
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
 #include "io/mesh_voxelizer.hpp"
+#include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
 #include <algorithm>
@@ -13,19 +14,9 @@
 #include <cmath>
 
 namespace vox::io {
-namespace {
-std::string lower_extension(const std::string& path)
-{
-    const auto dot = path.find_last_of('.');
-    std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-} // namespace
-
 bool is_mesh_path(const std::string& path)
 {
-    const std::string ext = lower_extension(path);
+    const std::string ext = detail::lower_extension(path);
     return ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".off";
 }
 
@@ -46,7 +37,7 @@ grid::LabelGrid import_object(const std::string& path, const ImportOptions& opti
     }
     if (options.voxel_mm || options.mm_per_unit != 1.0)
         throw file_error(path, "--voxel-size and --scale apply to meshes; a volume keeps its own voxels");
-    if (lower_extension(path) == ".vdb") {
+    if (detail::lower_extension(path) == ".vdb") {
         check_input_file(path); // the same "no such file", "is a folder", "is empty" as every reader
         return select_labels(grid::LabelGrid::load(path), options.selection, path);
     }

@@ -53,6 +53,11 @@ inline constexpr std::string_view k_white_space = " \t\r\n\v\f";
 /// Shortest text that reads back as `v` ("0.5", "30000", "1e-06", "-1").
 [[nodiscard]] std::string number_text(double v);
 
+/// `s` in lower case (ASCII).
+[[nodiscard]] std::string lower_case(std::string s);
+/// The last extension of `path` in lower case, with its dot (".nii" for "A.NII"), or "".
+[[nodiscard]] std::string lower_extension(const std::string& path);
+
 /// The fields of a text header by key, and the byte offset just past the header in its file.
 struct HeaderFields {
     std::map<std::string, std::string, std::less<>> fields;
