@@ -64,18 +64,18 @@ std::set<std::set<std::tuple<int, int, int>>> reference_elements(const LabelGrid
         std::set<std::tuple<int, int, int>> left = voxels;
         while (!left.empty()) {
             std::set<std::tuple<int, int, int>> component;
-            std::queue<std::tuple<int, int, int>> todo;
-            todo.push(*left.begin());
+            std::queue<std::tuple<int, int, int>> frontier;
+            frontier.push(*left.begin());
             left.erase(left.begin());
-            while (!todo.empty()) {
-                auto [x, y, z] = todo.front();
-                todo.pop();
+            while (!frontier.empty()) {
+                auto [x, y, z] = frontier.front();
+                frontier.pop();
                 component.insert({x, y, z});
                 const int d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
                 for (const auto& o : d) {
                     auto it = left.find({x + o[0], y + o[1], z + o[2]});
                     if (it != left.end()) {
-                        todo.push(*it);
+                        frontier.push(*it);
                         left.erase(it);
                     }
                 }

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "io/mesh_info.hpp"
+#include "io/tetrahedron.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -20,16 +21,6 @@ using test::expect_refused;
 /// A tetrahedron (0,0,0) (10,0,0) (0,10,0) (0,0,10) with outward faces, volume 1000/6.
 const char* const k_tetra_vertices = "v 0 0 0\nv 10 0 0\nv 0 10 0\nv 0 0 10\n";
 
-void expect_tetrahedron(const TriangleMesh& mesh)
-{
-    const MeshInfo info = mesh_info(mesh);
-    EXPECT_EQ(info.vertices, 4u);
-    EXPECT_EQ(info.triangles, 4u);
-    EXPECT_TRUE(info.closed);
-    EXPECT_TRUE(info.consistently_oriented);
-    EXPECT_NEAR(info.enclosed_volume_mm3, 1000.0 / 6.0, 1e-9);
-}
-
 TEST(ObjReader, EveryCornerFormAndIgnoredRecords)
 {
     const test::ScratchDir dir;
@@ -41,7 +32,7 @@ TEST(ObjReader, EveryCornerFormAndIgnoredRecords)
                             "f 2//2 3//2 4//2\n"    // i//k
                             "f 1/1/1 4/2/1 3/3/1\n" // i/j/k
                             "l 1 2\n";
-    expect_tetrahedron(read_mesh(dir.write("tetra.obj", obj)));
+    test::expect_tetrahedron(read_mesh(dir.write("tetra.obj", obj)));
 }
 
 TEST(ObjReader, NegativeIndicesCountBackFromTheLatestVertex)
@@ -49,7 +40,7 @@ TEST(ObjReader, NegativeIndicesCountBackFromTheLatestVertex)
     const test::ScratchDir dir;
     // After 4 vertices, -4 is vertex 1 and -1 is vertex 4.
     const std::string obj = std::string(k_tetra_vertices) + "f -4 -2 -3\nf -4 -3 -1\nf -3 -2 -1\nf -4 -1 -2\n";
-    expect_tetrahedron(read_mesh(dir.write("relative.obj", obj)));
+    test::expect_tetrahedron(read_mesh(dir.write("relative.obj", obj)));
 }
 
 TEST(ObjReader, PolygonsAreFanTriangulatedAndWIsIgnored)
@@ -70,14 +61,14 @@ TEST(ObjReader, ByteOrderMarkIsSkipped)
 {
     const test::ScratchDir dir;
     const std::string obj = "\xEF\xBB\xBF" + std::string(k_tetra_vertices) + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
-    expect_tetrahedron(read_mesh(dir.write("bom.obj", obj)));
+    test::expect_tetrahedron(read_mesh(dir.write("bom.obj", obj)));
 }
 
 TEST(ObjReader, FacesMayComeBeforeTheirVertices)
 {
     const test::ScratchDir dir;
     const std::string obj = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n" + std::string(k_tetra_vertices);
-    expect_tetrahedron(read_mesh(dir.write("faces_first.obj", obj)));
+    test::expect_tetrahedron(read_mesh(dir.write("faces_first.obj", obj)));
 }
 
 TEST(ObjReader, NonFiniteVertexIsRefusedNotDropped)

@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "io/mesh_info.hpp"
+#include "io/tetrahedron.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -25,16 +26,6 @@ using test::error_of;
 /// The tetrahedron (0,0,0) (10,0,0) (0,10,0) (0,0,10), faces outward.
 const double k_points[4][3] = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {0, 0, 10}};
 const int k_faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
-
-void expect_tetrahedron(const TriangleMesh& mesh)
-{
-    const MeshInfo info = mesh_info(mesh);
-    EXPECT_EQ(info.vertices, 4u);
-    EXPECT_EQ(info.triangles, 4u);
-    EXPECT_TRUE(info.closed);
-    EXPECT_TRUE(info.consistently_oriented);
-    EXPECT_NEAR(info.enclosed_volume_mm3, 1000.0 / 6.0, 1e-9);
-}
 
 /// Appends the bytes of `value` in the given byte order.
 template <class T> void put(std::string& out, T value, bool big_endian)
@@ -94,8 +85,8 @@ const std::string k_ascii_faces = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
 TEST(PlyReader, BinaryBothByteOrdersWithSkippedPropertiesAndElements)
 {
     const test::ScratchDir dir;
-    expect_tetrahedron(read_mesh(dir.write("le.ply", binary_tetrahedron(false))));
-    expect_tetrahedron(read_mesh(dir.write("be.ply", binary_tetrahedron(true))));
+    test::expect_tetrahedron(read_mesh(dir.write("le.ply", binary_tetrahedron(false))));
+    test::expect_tetrahedron(read_mesh(dir.write("be.ply", binary_tetrahedron(true))));
 }
 
 TEST(PlyReader, AsciiWithSkippedPropertiesAndElements)
@@ -108,7 +99,7 @@ TEST(PlyReader, AsciiWithSkippedPropertiesAndElements)
                             "element edge 1\r\nproperty list uchar int corners\r\nend_header\r\n"
                             "0 0 0 0.5\r\n10 0 0 0.5\r\n0 10 0 0.5\r\n0 0 10 0.5\r\n\r\n"
                             "1 3 0 2 1\r\n1 3 0 1 3\r\n1 3 1 2 3\r\n1 3 0 3 2\r\n2 0 1\r\n";
-    expect_tetrahedron(read_mesh(dir.write("crlf.ply", ply)));
+    test::expect_tetrahedron(read_mesh(dir.write("crlf.ply", ply)));
 }
 
 TEST(PlyReader, PolygonsAreFanTriangulated)
@@ -217,7 +208,7 @@ TEST(PlyReader, MalformedFilesNameTheProblem)
 TEST(PlyReader, TrailingLineBreakAfterBinaryDataIsAccepted)
 {
     const test::ScratchDir dir;
-    expect_tetrahedron(read_mesh(dir.write("newline.ply", binary_tetrahedron(false) + "\n")));
+    test::expect_tetrahedron(read_mesh(dir.write("newline.ply", binary_tetrahedron(false) + "\n")));
 }
 
 } // namespace

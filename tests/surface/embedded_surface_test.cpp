@@ -62,16 +62,16 @@ std::size_t voxel_pieces(const FineVoxels& v)
     for (std::uint32_t s = 0; s < v.slots(); ++s) {
         if (!v.alive(s) || seen[s]) continue;
         ++pieces;
-        std::queue<std::uint32_t> todo;
-        todo.push(s);
+        std::queue<std::uint32_t> frontier;
+        frontier.push(s);
         seen[s] = true;
-        while (!todo.empty()) {
-            const std::uint32_t a = todo.front();
-            todo.pop();
+        while (!frontier.empty()) {
+            const std::uint32_t a = frontier.front();
+            frontier.pop();
             v.for_each_link(a, [&](std::uint32_t b, int) {
                 if (!seen[b]) {
                     seen[b] = true;
-                    todo.push(b);
+                    frontier.push(b);
                 }
             });
         }
