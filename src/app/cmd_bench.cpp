@@ -8,6 +8,7 @@
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
 #include "fem/implicit_solver.hpp"
+#include "fem/multigrid.hpp"
 #include "grid/phantom.hpp"
 #include "io/selection.hpp"
 #include "io/volume_reader.hpp"
@@ -52,7 +53,7 @@ Solution solve_static(const grid::LabelGrid& labels, const grid::VoxelMaterial& 
     solver.set_gravity({0, 0, -9.81});
     for (std::uint32_t n = 0; n < model.node_count(); ++n)
         if (held_mm(model.rest_positions()[n] * 1e3)) solver.fix(n, 7);
-    solver.use_multigrid(std::make_unique<fem::Multigrid>(g, model, coarsest));
+    solver.set_preconditioner(std::make_unique<fem::Multigrid>(g, model, coarsest));
     const fem::StepStats s = solver.step();
 
     Solution out;

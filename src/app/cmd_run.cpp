@@ -8,6 +8,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "fem/implicit_solver.hpp"
+#include "fem/multigrid.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -108,7 +109,7 @@ void add_run_command(CLI::App& app)
         // Measured: the V-cycle cuts the quasi-static cantilever's CG iterations 50 to 700 fold, but
         // for implicit steps of soft tissue its set-up costs more than the Jacobi iterations it saves.
         if (level < coarsest && scene.solver.mode == io::SolverMode::static_equilibrium)
-            solver.use_multigrid(std::make_unique<fem::Multigrid>(g, model, coarsest));
+            solver.set_preconditioner(std::make_unique<fem::Multigrid>(g, model, coarsest));
         solver.set_gravity(scene.gravity_m_s2);
         for (const io::Constraint& c : scene.constraints) {
             const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);

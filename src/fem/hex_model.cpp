@@ -27,7 +27,7 @@ Eigen::Matrix<double, 8, 3> corner_gradients(const Eigen::Vector3d& t, const Eig
 
 } // namespace
 
-HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level)
+HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level), m_materials(grid.materials())
 {
     if (level < 0 || level > grid.max_level())
         throw InputError("the simulated level must be 0 .. " + std::to_string(grid.max_level()) + ", got " +
@@ -72,6 +72,10 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
         el.stiffness = &m_full_stiffness[material];
         el.mass = mass[material];
         el.gradient = gradient;
+        el.material = v.material(a);
+        el.volume_m3 = h.prod();
+        const Eigen::Vector3d centre = v.coord(a).cast<double>();
+        el.centroid = (t.topLeftCorner<3, 3>() * centre + t.topRightCorner<3, 1>()) * 1e-3;
         for (int c = 0; c < 8; ++c) {
             const Eigen::Vector3d corner = grid::BranchedGrid::cell_corner_index(v.coord(a), 0, c);
             el.rest.segment<3>(3 * c) = corner.cwiseProduct(h);
@@ -93,6 +97,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
     const grid::Level& lv = grid.level(level);
     const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
     const double cell = static_cast<double>(1 << level);
+    const Eigen::Matrix4d& index_to_world = grid.voxels().index_to_world();
 
     // Dense numbering of the nodes the alive elements use.
     m_dense_node.assign(lv.node_users.size(), grid::no_index);
@@ -136,13 +141,23 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
         // Centroid of the element's material (first moments over zeroth, summed over materials),
         // in the cell's local coordinates t in [0, 1]^3.
         double q0 = 0.0;
+        std::uint32_t voxels = 0, most = 0;
         Eigen::Vector3d q1 = Eigen::Vector3d::Zero();
         for (const grid::MaterialMoments& m : g.content) {
             q0 += static_cast<double>(m.moments[0]);
+            voxels += m.voxels;
             q1 += Eigen::Vector3d(static_cast<double>(m.moments[1]), static_cast<double>(m.moments[3]),
                                   static_cast<double>(m.moments[9]));
+            if (m.voxels > most) {
+                most = m.voxels;
+                el.material = m.material;
+            }
         }
-        el.gradient = corner_gradients(q1 / q0 / cell, cell * h);
+        const Eigen::Vector3d local = q1 / q0 / cell;
+        el.gradient = corner_gradients(local, cell * h);
+        el.volume_m3 = voxels * h.prod();
+        const Eigen::Vector3d centre = grid::BranchedGrid::cell_corner_index(g.cell, level, 0) + cell * local;
+        el.centroid = (index_to_world.topLeftCorner<3, 3>() * centre + index_to_world.topRightCorner<3, 1>()) * 1e-3;
         m_elements.push_back(el);
     }
 }

@@ -21,6 +21,9 @@ struct HexElement {
     Eigen::Matrix<double, 8, 3> gradient;      ///< dN_c/dX at the material centroid, 1/m, index-aligned frame
     Vector24d rest;                            ///< corner rest positions, m, index-aligned frame
     std::uint32_t grid_element = 0;            ///< the branched-grid element it models (level 0: voxel slot)
+    std::int32_t material = 0;                 ///< the material holding most of its volume
+    double volume_m3 = 0.0;                    ///< of its material
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero(); ///< of its material at rest, world frame, m
 };
 
 class HexModel {
@@ -48,6 +51,8 @@ public:
     /// them wherever its residual stops caring. Kg per node (0 for most).
     [[nodiscard]] const std::vector<double>& added_mass() const { return m_added_mass; }
     [[nodiscard]] double total_mass() const;
+    /// The grid's materials (index = HexElement::material).
+    [[nodiscard]] const std::vector<grid::VoxelMaterial>& materials() const { return m_materials; }
 
 private:
     void build_voxel_level(const grid::BranchedGrid& grid);
@@ -63,6 +68,7 @@ private:
     std::vector<double> m_nodal_mass;
     std::vector<double> m_added_mass;
     Eigen::Matrix3d m_frame = Eigen::Matrix3d::Identity();
+    std::vector<grid::VoxelMaterial> m_materials;
 };
 
 } // namespace vox::fem

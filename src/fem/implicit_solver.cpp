@@ -3,6 +3,8 @@
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +22,10 @@ void SolverOptions::validate() const
     if (newton_max_iterations < 1) bad("newton_max_iterations must be at least 1");
 }
 
+namespace {
+
+} // namespace
+
 ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& options)
     : m_model(model), m_options(options)
 {
@@ -29,6 +35,27 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_v.assign(n, Eigen::Vector3d::Zero());
     m_external.assign(n, Eigen::Vector3d::Zero());
     m_fixed.assign(3 * n, 0);
+    m_rotation.assign(model.elements().size(), Eigen::Quaterniond::Identity());
+    m_node_rotation.assign(n, Eigen::Quaterniond::Identity());
+    m_element_energy.assign(model.elements().size(), 0.0);
+    m_stiffness_scale.assign(model.elements().size(), 1.0);
+    m_behaviour.resize(model.materials().size());
+    // Which (element, corner) pairs touch each node: the row-wise assembly gathers from them.
+    m_incidence_start.assign(n + 1, 0);
+    for (const HexElement& e : model.elements())
+        for (std::uint32_t node : e.dof_node) ++m_incidence_start[node + 1];
+    for (std::size_t i = 0; i < n; ++i) m_incidence_start[i + 1] += m_incidence_start[i];
+    m_incidence.resize(m_incidence_start.back());
+    std::vector<std::uint32_t> fill(m_incidence_start.begin(), m_incidence_start.end() - 1);
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+        for (std::uint32_t c = 0; c < 8; ++c) m_incidence[fill[model.elements()[e].dof_node[c]]++] = 8 * e + c;
+    m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
+    m_element_force.assign(model.elements().size(), Vector24d::Zero());
+    m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
+    if (m_options.matrix_free) {
+        m_element_product.assign(model.elements().size(), Vector24d::Zero());
+        return; // no matrix
+    }
 
     // The matrix pattern: 3 x 3 blocks for every pair of nodes sharing an element; each element
     // keeps the positions of its 576 entries so assembly is a plain accumulation.
@@ -46,18 +73,25 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_slot.resize(model.elements().size() * 576);
     const int* outer = m_matrix.outerIndexPtr();
     const int* inner = m_matrix.innerIndexPtr();
+    auto position = [&](int row, int col) {
+        return static_cast<int>(std::lower_bound(inner + outer[row], inner + outer[row + 1], col) - inner);
+    };
     std::size_t k = 0;
     for (const HexElement& e : model.elements())
         for (int c = 0; c < 8; ++c)
-            for (int i = 0; i < 3; ++i) {
-                const int row = 3 * static_cast<int>(e.dof_node[c]) + i;
+            for (int i = 0; i < 3; ++i)
                 for (int d = 0; d < 8; ++d)
-                    for (int j = 0; j < 3; ++j) {
-                        const int col = 3 * static_cast<int>(e.dof_node[d]) + j;
-                        m_slot[k++] = static_cast<int>(std::lower_bound(inner + outer[row], inner + outer[row + 1], col) - inner);
-                    }
-            }
-    m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
+                    for (int j = 0; j < 3; ++j)
+                        m_slot[k++] = position(3 * static_cast<int>(e.dof_node[c]) + i, 3 * static_cast<int>(e.dof_node[d]) + j);
+    m_diagonal_slot.resize(3 * n);
+    for (std::size_t i = 0; i < 3 * n; ++i) m_diagonal_slot[i] = position(static_cast<int>(i), static_cast<int>(i));
+}
+
+void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
+{
+    if (p && m_options.matrix_free)
+        throw InputError(std::string("solver: the ") + p->name() + " preconditioner needs an assembled matrix; it cannot run matrix-free");
+    m_preconditioner = std::move(p);
 }
 
 void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
@@ -66,49 +100,157 @@ void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
         if (axes & (1u << a)) m_fixed[3 * node + static_cast<std::size_t>(a)] = 1;
 }
 
-double ImplicitSolver::assemble(double m_scale, double k_scale)
+void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
 {
-    std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + m_matrix.nonZeros(), 0.0);
-    m_internal.setZero();
-    double energy = 0.0;
-    double* values = m_matrix.valuePtr();
-    const auto& elements = m_model.elements();
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-        const HexElement& el = elements[e];
-        Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-        for (int c = 0; c < 8; ++c) f += (m_x[el.dof_node[c]] - m_x[el.dof_node[0]]) * el.gradient.row(c);
-        const Eigen::Matrix3d r = polar_rotation(f);
-        // Displacements relative to corner 0: K ignores translations, and far from the origin
-        // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
-        const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
-        const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
-        Vector24d u;
-        for (int c = 0; c < 8; ++c)
-            u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
-        const Matrix24d& k = *el.stiffness;
-        const Vector24d fl = k * u;
-        energy += 0.5 * u.dot(fl);
-        for (int c = 0; c < 8; ++c) m_internal.segment<3>(3 * el.dof_node[c]) += r * fl.segment<3>(3 * c);
+    m_behaviour = std::move(behaviour);
+    m_behaviour.resize(std::max(m_behaviour.size(), m_model.materials().size()));
+    const bool plastic = std::any_of(m_behaviour.begin(), m_behaviour.end(), [](const MaterialBehaviour& b) { return b.plastic(); });
+    if (plastic && m_plastic.empty()) m_plastic.assign(m_model.elements().size(), Eigen::Matrix3d::Zero());
+    if (!plastic) m_plastic.clear();
+    for (std::uint32_t e = 0; e < m_water.size(); ++e) set_water(e, m_water[e]);
+}
 
-        const int* slot = &m_slot[576 * e];
-        for (int c = 0; c < 8; ++c)
-            for (int d = 0; d < 8; ++d) {
-                const Eigen::Matrix3d block = r * k.block<3, 3>(3 * c, 3 * d) * r.transpose();
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j)
-                        values[slot[24 * (3 * c + i) + 3 * d + j]] +=
-                            k_scale * block(i, j) + (i == j ? m_scale * el.mass(c, d) : 0.0);
-            }
+void ImplicitSolver::set_water(std::uint32_t element, double water)
+{
+    if (m_water.empty()) m_water.assign(m_model.elements().size(), 0.0);
+    m_water[element] = std::clamp(std::isfinite(water) ? water : 0.0, 0.0, 1.0);
+    const auto material = static_cast<std::size_t>(m_model.elements()[element].material);
+    const double ratio = material < m_behaviour.size() ? m_behaviour[material].wet_stiffness_ratio : 1.0;
+    m_stiffness_scale[element] = 1.0 - (1.0 - ratio) * m_water[element];
+}
+
+double ImplicitSolver::plastic_correction(std::size_t e, const Vector24d& u, Vector24d& force)
+{
+    // One-point plasticity at the material centroid (where the rotation is taken): total strain
+    // eps = sym(sum_c u_c grad N_c^T), plastic strain creeping towards the elastic excess; the
+    // plastic stress sigma_p = D eps_p acts on the nodes as -V sigma_p grad N_c.
+    const HexElement& el = m_model.elements()[e];
+    const MaterialBehaviour& b = m_behaviour[static_cast<std::size_t>(el.material)];
+    const grid::Lame& lame = m_model.materials()[static_cast<std::size_t>(el.material)].lame;
+    Eigen::Matrix3d& plastic = m_plastic[e];
+    const double scale = m_stiffness_scale[e];
+    Eigen::Matrix3d grad_u = Eigen::Matrix3d::Zero();
+    for (int c = 0; c < 8; ++c) grad_u.noalias() += u.segment<3>(3 * c) * el.gradient.row(c);
+    const Eigen::Matrix3d strain = 0.5 * (grad_u + grad_u.transpose());
+    if (m_update_plastic) {
+        const double water = m_water.empty() ? 0.0 : m_water[e];
+        const double yield = b.yield_strain * (1.0 - (1.0 - b.wet_yield_ratio) * water);
+        const Eigen::Matrix3d elastic = strain - plastic;
+        if (elastic.norm() > yield) plastic += std::min(1.0, m_options.dt_s * b.creep_per_s) * elastic;
+        if (const double norm = plastic.norm(); norm > b.max_strain) plastic *= b.max_strain / norm;
     }
-    if (m_scale != 0.0)
-        for (std::size_t n = 0; n < m_x.size(); ++n)
-            if (m_model.added_mass()[n] > 0.0)
-                for (int i = 0; i < 3; ++i) {
-                    const auto d = static_cast<Eigen::Index>(3 * n + static_cast<std::size_t>(i));
-                    m_matrix.coeffRef(d, d) += m_scale * m_model.added_mass()[n];
+    auto stress = [&](const Eigen::Matrix3d& eps) {
+        return (2.0 * lame.mu * eps + lame.lambda * eps.trace() * Eigen::Matrix3d::Identity()).eval();
+    };
+    const Eigen::Matrix3d sigma_p = scale * stress(plastic);
+    for (int c = 0; c < 8; ++c) force.segment<3>(3 * c) -= el.volume_m3 * sigma_p * el.gradient.row(c).transpose();
+    // Energy of the elastic strain eps - eps_p, relative to the linear part already counted.
+    return el.volume_m3 * (-(strain.cwiseProduct(sigma_p)).sum() + 0.5 * plastic.cwiseProduct(sigma_p).sum());
+}
+
+double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
+{
+    const Eigen::Matrix3d& frame = m_model.frame();
+    const auto& elements = m_model.elements();
+    // Element pass: rotation, corotated displacements, elastic forces and energy.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+            const HexElement& el = elements[e];
+            // Displacements relative to corner 0: K ignores translations, and far from the origin
+            // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
+            const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
+            Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+            for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
+            extract_rotation(frame.transpose() * f, m_rotation[e]);
+            const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
+            m_element_rotation[e] = r;
+            const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
+            Vector24d u;
+            for (int c = 0; c < 8; ++c)
+                u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
+            const double scale = m_stiffness_scale[e];
+            Vector24d fl = scale * ((*el.stiffness) * u);
+            m_element_energy[e] = 0.5 * u.dot(fl);
+            if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
+                m_element_energy[e] += plastic_correction(e, u, fl);
+            for (int c = 0; c < 8; ++c) m_element_force[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
+        }
+    });
+    // Node pass: each node gathers its forces and writes its own three matrix rows, so threads
+    // never write the same entry and every write stays within a few cache lines.
+    double* values = m_matrix.valuePtr();
+    const bool lumped = m_options.lumped_mass;
+    m_m_scale = m_scale;
+    m_k_scale = k_scale;
+    if (matrix) m_diagonal.resize(static_cast<Eigen::Index>(3 * m_x.size()));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+            Eigen::Vector3d force = Eigen::Vector3d::Zero();
+            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k)
+                force += m_element_force[m_incidence[k] / 8].segment<3>(3 * (m_incidence[k] % 8));
+            m_internal.segment<3>(static_cast<Eigen::Index>(3 * n)) = force;
+            if (!matrix) continue;
+            const double diagonal_mass = lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n];
+            if (m_options.matrix_free) { // only the diagonal, for the Jacobi preconditioner
+                Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * diagonal_mass);
+                for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                    const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                    const Eigen::Matrix3d& r = m_element_rotation[e];
+                    const Eigen::Matrix3d block = r * elements[e].stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * static_cast<int>(c)) * r.transpose();
+                    d += k_scale * m_stiffness_scale[e] * block.diagonal();
+                    if (!lumped) d.array() += m_scale * elements[e].mass(c, c);
                 }
+                m_diagonal.segment<3>(static_cast<Eigen::Index>(3 * n)) = d;
+                continue;
+            }
+            const int* outer = m_matrix.outerIndexPtr();
+            std::fill(values + outer[3 * n], values + outer[3 * n + 3], 0.0); // this node's three rows
+            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                const HexElement& el = elements[e];
+                const Eigen::Matrix3d& r = m_element_rotation[e];
+                const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
+                const int* slot = &m_slot[576 * std::size_t{e} + 72 * c];
+                for (int d = 0; d < 8; ++d) {
+                    Eigen::Matrix3d block = rk * el.stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * d) * r.transpose();
+                    if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
+                    for (int i = 0; i < 3; ++i)
+                        for (int j = 0; j < 3; ++j) values[slot[24 * i + 3 * d + j]] += block(i, j);
+                }
+            }
+            for (std::size_t i = 0; i < 3; ++i) values[m_diagonal_slot[3 * n + i]] += m_scale * diagonal_mass;
+            for (std::size_t i = 0; i < 3; ++i) m_diagonal[static_cast<Eigen::Index>(3 * n + i)] = values[m_diagonal_slot[3 * n + i]];
+        }
+    });
+    m_update_plastic = false;
+    double energy = 0.0;
+    for (double e : m_element_energy) energy += e;
     return energy;
 }
+
+void ImplicitSolver::mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const
+{
+    out.resize(static_cast<Eigen::Index>(3 * v.size()));
+    const auto& elements = m_model.elements();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, v.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+            if (m_options.lumped_mass) {
+                sum = m_model.nodal_mass()[n] * v[n];
+            } else {
+                for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                    const HexElement& el = elements[m_incidence[k] / 8];
+                    const std::uint32_t c = m_incidence[k] % 8;
+                    for (int d = 0; d < 8; ++d) sum += el.mass(c, d) * v[el.dof_node[d]];
+                }
+                sum += m_model.added_mass()[n] * v[n];
+            }
+            out.segment<3>(static_cast<Eigen::Index>(3 * n)) = sum;
+        }
+    });
+}
+
+double ImplicitSolver::elastic_energy() { return assemble(0.0, 0.0, false); }
 
 Eigen::VectorXd ImplicitSolver::external_force() const
 {
@@ -121,25 +263,99 @@ Eigen::VectorXd ImplicitSolver::external_force() const
 void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 {
     // Held degrees of freedom: identity rows and columns, zero right-hand side.
-    for (Eigen::Index row = 0; row < m_matrix.outerSize(); ++row)
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m_matrix, row); it; ++it)
-            if (m_fixed[static_cast<std::size_t>(row)] || m_fixed[static_cast<std::size_t>(it.col())])
-                it.valueRef() = (row == it.col()) ? 1.0 : 0.0;
+    if (!m_options.matrix_free)
+        for (Eigen::Index row = 0; row < m_matrix.outerSize(); ++row)
+            for (SystemMatrix::InnerIterator it(m_matrix, row); it; ++it)
+                if (m_fixed[static_cast<std::size_t>(row)] || m_fixed[static_cast<std::size_t>(it.col())])
+                    it.valueRef() = (row == it.col()) ? 1.0 : 0.0;
     for (Eigen::Index i = 0; i < rhs.size(); ++i)
-        if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = 0.0;
+        if (m_fixed[static_cast<std::size_t>(i)]) {
+            rhs[i] = 0.0;
+            m_diagonal[i] = 1.0;
+        }
+}
+
+void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    if (m_options.matrix_free) {
+        multiply_element_wise(p, out);
+        return;
+    }
+    const int* outer = m_matrix.outerIndexPtr();
+    const int* inner = m_matrix.innerIndexPtr();
+    const double* values = m_matrix.valuePtr();
+    out.resize(p.size());
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p.size(), 2048), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index row = r.begin(); row != r.end(); ++row) {
+            double sum = 0.0;
+            for (int k = outer[row]; k < outer[row + 1]; ++k) sum += values[k] * p[inner[k]];
+            out[row] = sum;
+        }
+    });
+}
+
+void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    // out = m_scale M p + k_scale sum_e R K R^T p, element by element; held dofs map to themselves
+    // (CG keeps them zero in p).
+    const auto& elements = m_model.elements();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+            const HexElement& el = elements[e];
+            const Eigen::Matrix3d& r = m_element_rotation[e];
+            Vector24d local;
+            for (int c = 0; c < 8; ++c)
+                local.segment<3>(3 * c) = r.transpose() * p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
+            const Vector24d fl = m_stiffness_scale[e] * ((*el.stiffness) * local);
+            for (int c = 0; c < 8; ++c) m_element_product[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
+        }
+    });
+    out.resize(p.size());
+    const bool lumped = m_options.lumped_mass;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+            const auto i = static_cast<Eigen::Index>(3 * n);
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero(), mass = Eigen::Vector3d::Zero();
+            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                sum += m_element_product[e].segment<3>(3 * c);
+                if (!lumped)
+                    for (int d = 0; d < 8; ++d) mass += elements[e].mass(c, d) * p.segment<3>(3 * static_cast<Eigen::Index>(elements[e].dof_node[d]));
+            }
+            mass += (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]) * p.segment<3>(i);
+            out.segment<3>(i) = m_k_scale * sum + m_m_scale * mass;
+            for (int a = 0; a < 3; ++a)
+                if (m_fixed[3 * n + static_cast<std::size_t>(a)]) out[i + a] = p[i + a];
+        }
+    });
+}
+
+void ImplicitSolver::update_node_rotations()
+{
+    // The mean of the elements' quaternions, each taken with the sign nearer the running sum.
+    std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
+    const auto& elements = m_model.elements();
+    for (std::size_t e = 0; e < elements.size(); ++e)
+        for (std::uint32_t n : elements[e].dof_node) {
+            const Eigen::Vector4d q = m_rotation[e].coeffs();
+            sum[n] += sum[n].dot(q) < 0.0 ? -q : q;
+        }
+    for (std::size_t n = 0; n < m_x.size(); ++n)
+        if (sum[n].squaredNorm() > 0.0) m_node_rotation[n].coeffs() = sum[n].normalized();
 }
 
 int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
-    // Conjugate gradients on the Jacobi-scaled system D^-1/2 A D^-1/2 y = D^-1/2 b, x = D^-1/2 y,
-    // stopping when the scaled residual falls below the tolerance relative to the scaled right-hand
-    // side. Unscaled, nodes that carry almost no material (an element holding one voxel of 512)
-    // would barely count in the residual and could move wildly while the solve "converges".
+    // Conjugate gradients stopping when the Jacobi-scaled residual D^-1/2 r falls below the
+    // tolerance relative to the scaled right-hand side. Unscaled, nodes that carry almost no
+    // material (an element holding one voxel of 512) would barely count in the residual and could
+    // move wildly while the solve "converges".
     const Eigen::Index n = rhs.size();
-    Eigen::VectorXd inv_sqrt_d(n);
+    Eigen::VectorXd inv_d(n), inv_sqrt_d(n);
     for (Eigen::Index i = 0; i < n; ++i) {
-        const double d = m_matrix.coeff(i, i);
-        inv_sqrt_d[i] = d > 0.0 ? 1.0 / std::sqrt(d) : 1.0;
+        const double d = m_diagonal[i];
+        inv_d[i] = d > 0.0 ? 1.0 / d : 1.0;
+        inv_sqrt_d[i] = std::sqrt(inv_d[i]);
     }
     const double b_norm = rhs.cwiseProduct(inv_sqrt_d).norm();
     if (b_norm == 0.0) {
@@ -147,23 +363,27 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         residual = 0.0;
         return 0;
     }
-    if (m_multigrid) m_multigrid->update(m_matrix, m_fixed);
+    if (m_preconditioner) {
+        update_node_rotations();
+        m_preconditioner->update(m_matrix, m_fixed, m_node_rotation);
+    }
     auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {
-        if (m_multigrid)
-            m_multigrid->apply(res, out);
+        if (m_preconditioner)
+            m_preconditioner->apply(res, out);
         else
-            out = res.cwiseProduct(inv_sqrt_d).cwiseProduct(inv_sqrt_d);
+            out = res.cwiseProduct(inv_d);
     };
     auto scaled_norm = [&](const Eigen::VectorXd& res) { return res.cwiseProduct(inv_sqrt_d).norm() / b_norm; };
-    Eigen::VectorXd r = rhs - m_matrix * x;
-    Eigen::VectorXd z(n);
+    Eigen::VectorXd r(n), z(n), q(n);
+    multiply(x, q);
+    r = rhs - q;
     precondition(r, z);
-    Eigen::VectorXd p = z, q(n);
+    Eigen::VectorXd p = z;
     double rz = r.dot(z);
     int it = 0;
     residual = scaled_norm(r);
     while (residual > m_options.cg_tolerance && it < m_options.cg_max_iterations) {
-        q.noalias() = m_matrix * p;
+        multiply(p, q);
         const double pq = p.dot(q);
         if (!(pq > 0.0)) break; // not positive definite along p: stop rather than diverge
         const double alpha = rz / pq;
@@ -176,34 +396,44 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         residual = scaled_norm(r);
         ++it;
     }
+    if (m_preconditioner) m_preconditioner->report_iterations(it);
     return it;
 }
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+} // namespace
 
 StepStats ImplicitSolver::step()
 {
     const auto start = std::chrono::steady_clock::now();
     StepStats s;
     const double dt = m_options.dt_s;
+    m_update_plastic = !m_plastic.empty(); // plastic strain creeps once per step, at its start
     const auto n = static_cast<Eigen::Index>(3 * m_x.size());
     const Eigen::VectorXd f_ext = external_force();
     Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
     Eigen::Map<Eigen::VectorXd> x(m_x.front().data(), n);
 
     if (!m_options.quasi_static) {
-        assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt);
+        auto t = std::chrono::steady_clock::now();
+        assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt, true);
         // M v from the element mass matrices (the assembled matrix holds M + dt C + dt^2 K).
-        Eigen::VectorXd rhs = dt * (f_ext - m_internal);
-        for (const HexElement& el : m_model.elements())
-            for (int c = 0; c < 8; ++c)
-                for (int d = 0; d < 8; ++d) rhs.segment<3>(3 * el.dof_node[c]) += el.mass(c, d) * m_v[el.dof_node[d]];
-        for (std::size_t i = 0; i < m_x.size(); ++i)
-            rhs.segment<3>(static_cast<Eigen::Index>(3 * i)) += m_model.added_mass()[i] * m_v[i];
+        Eigen::VectorXd rhs;
+        mass_times(m_v, rhs);
+        rhs += dt * (f_ext - m_internal);
         apply_constraints(rhs);
+        s.assembly_ms += ms_since(t);
+        t = std::chrono::steady_clock::now();
         Eigen::VectorXd next = v;
         for (Eigen::Index i = 0; i < n; ++i)
             if (m_fixed[static_cast<std::size_t>(i)]) next[i] = 0.0;
         s.cg_iterations = solve(rhs, next, s.residual);
         s.converged = s.residual <= m_options.cg_tolerance;
+        s.solve_ms += ms_since(t);
         v = next;
         x += dt * v;
     } else {
@@ -214,9 +444,11 @@ StepStats ImplicitSolver::step()
         scale = std::sqrt(scale);
         s.converged = false;
         for (int it = 0; it < m_options.newton_max_iterations; ++it) {
-            assemble(0.0, 1.0);
+            auto t = std::chrono::steady_clock::now();
+            assemble(0.0, 1.0, true);
             Eigen::VectorXd rhs = f_ext - m_internal;
             apply_constraints(rhs);
+            s.assembly_ms += ms_since(t);
             s.residual = scale > 0.0 ? rhs.norm() / scale : rhs.norm();
             if (s.residual <= m_options.cg_tolerance) {
                 s.converged = true;
@@ -224,30 +456,30 @@ StepStats ImplicitSolver::step()
             }
             Eigen::VectorXd dx = Eigen::VectorXd::Zero(n);
             double cg_residual = 0.0;
+            t = std::chrono::steady_clock::now();
             s.cg_iterations += solve(rhs, dx, cg_residual);
+            s.solve_ms += ms_since(t);
             x += dx;
             ++s.newton_iterations;
         }
     }
-    // Energies and displacement at the new state.
-    s.elastic_energy_j = assemble(0.0, 0.0);
-    for (const HexElement& el : m_model.elements())
-        for (int c = 0; c < 8; ++c)
-            for (int d = 0; d < 8; ++d) s.kinetic_energy_j += 0.5 * el.mass(c, d) * m_v[el.dof_node[c]].dot(m_v[el.dof_node[d]]);
-    for (std::size_t i = 0; i < m_x.size(); ++i) s.kinetic_energy_j += 0.5 * m_model.added_mass()[i] * m_v[i].squaredNorm();
+    s.step_ms = ms_since(start);
+    // Energies and displacement at the new state (not part of the step's time).
+    s.elastic_energy_j = elastic_energy();
+    Eigen::VectorXd mv;
+    mass_times(m_v, mv);
+    s.kinetic_energy_j = 0.5 * v.dot(mv);
     for (std::size_t i = 0; i < m_x.size(); ++i)
         s.max_displacement_m = std::max(s.max_displacement_m, (m_x[i] - m_model.rest_positions()[i]).norm());
-    s.step_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return s;
 }
 
 Eigen::Vector3d ImplicitSolver::momentum() const
 {
+    Eigen::VectorXd mv;
+    mass_times(m_v, mv);
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (const HexElement& el : m_model.elements())
-        for (int c = 0; c < 8; ++c)
-            for (int d = 0; d < 8; ++d) p += el.mass(c, d) * m_v[el.dof_node[d]];
-    for (std::size_t i = 0; i < m_x.size(); ++i) p += m_model.added_mass()[i] * m_v[i];
+    for (std::size_t n = 0; n < m_x.size(); ++n) p += mv.segment<3>(static_cast<Eigen::Index>(3 * n));
     return p;
 }
 

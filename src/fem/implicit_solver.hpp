@@ -1,13 +1,13 @@
 #pragma once
 // Corotational linear hexahedral FEM, integrated by linearised implicit Euler, one step per frame:
 //   (M + dt C + dt^2 K) v' = M v + dt (f_ext - f_int(x)),   x' = x + dt v',
-// with K = R K_0 R^T per element (R from the polar decomposition of F at the material centroid),
-// Rayleigh damping C = alpha M + beta K, and a Jacobi-preconditioned conjugate-gradient solve warm
-// started from v. The quasi-static mode instead solves K(x) dx = f_ext - f_int(x) by Newton
+// with K = R K_0 R^T per element (R the rotational part of F at the material centroid), Rayleigh
+// damping C = alpha M + beta K, and a preconditioned conjugate-gradient solve warm started from v
+// (Jacobi unless a preconditioner is given). The quasi-static mode instead solves K(x) dx = f_ext - f_int(x) by Newton
 // iterations until the force residual meets the tolerance, so further frames change nothing.
 
 #include "fem/hex_model.hpp"
-#include "fem/multigrid.hpp"
+#include "fem/preconditioner.hpp"
 
 #include <Eigen/Sparse>
 
@@ -25,13 +25,36 @@ struct SolverOptions {
     double rayleigh_mass_per_s = 0.0; ///< alpha in C = alpha M + beta K, 1/s
     double rayleigh_stiffness_s = 0.0;///< beta, s
     bool quasi_static = false;
+    /// Row-sum (lumped) mass instead of the consistent mass: the same total mass and momentum, a
+    /// diagonal M, and a much better conditioned implicit system (consistent hexahedral mass alone
+    /// spreads its eigenvalues 27-fold).
+    bool lumped_mass = true;
+    /// Apply the system matrix element by element instead of assembling it: cheaper when CG takes
+    /// few iterations (SOFA's way); needs the Jacobi preconditioner.
+    bool matrix_free = false;
     int newton_max_iterations = 20;   ///< quasi-static mode
     /// Throws InputError naming the offending option.
     void validate() const;
 };
 
+/// What a material does beyond linear elasticity (index = grid material index).
+struct MaterialBehaviour {
+    /// Müller & Gross 2004 plasticity: when the elastic strain's Frobenius norm exceeds
+    /// yield_strain, creep_per_s * dt of it turns plastic each step; the plastic strain's norm
+    /// stays at most max_strain. yield_strain 0: elastic.
+    double yield_strain = 0.0;
+    double creep_per_s = 0.0;
+    double max_strain = 0.0;
+    /// At water content w, stiffness and yield are scaled by 1 - (1 - ratio) w.
+    double wet_stiffness_ratio = 1.0;
+    double wet_yield_ratio = 1.0;
+    [[nodiscard]] bool plastic() const { return yield_strain > 0.0; }
+};
+
 struct StepStats {
     double step_ms = 0.0;
+    double assembly_ms = 0.0;         ///< rotations, matrix and forces (every Newton iteration summed)
+    double solve_ms = 0.0;            ///< preconditioner set-up and CG
     int cg_iterations = 0;            ///< summed over Newton iterations in the quasi-static mode
     int newton_iterations = 0;
     double residual = 0.0;            ///< relative: CG residual (dynamic) or force residual (static)
@@ -52,8 +75,10 @@ public:
     /// Extra external forces per node, N (point forces, tool contact); zero by default.
     [[nodiscard]] std::vector<Eigen::Vector3d>& external_forces() { return m_external; }
 
-    /// Preconditions the CG solves with a multigrid V-cycle instead of Jacobi.
-    void use_multigrid(std::unique_ptr<Multigrid> multigrid) { m_multigrid = std::move(multigrid); }
+    /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
+    /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
+    void set_preconditioner(std::unique_ptr<Preconditioner> p);
+    [[nodiscard]] const char* preconditioner_name() const { return m_preconditioner ? m_preconditioner->name() : "Jacobi"; }
 
     StepStats step();
 
@@ -65,12 +90,35 @@ public:
     [[nodiscard]] Eigen::Vector3d momentum() const;
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }
 
+    /// Inelastic behaviour per material; plastic state is kept only when some material is plastic.
+    void set_materials(std::vector<MaterialBehaviour> behaviour);
+    /// Water content of an element in [0, 1] (clamped); softens it by its material's law.
+    void set_water(std::uint32_t element, double water);
+    [[nodiscard]] double water(std::uint32_t element) const { return m_water.empty() ? 0.0 : m_water[element]; }
+    /// Plastic strain of an element (index-aligned frame); zero without plasticity.
+    [[nodiscard]] Eigen::Matrix3d plastic_strain(std::uint32_t element) const
+    {
+        return m_plastic.empty() ? Eigen::Matrix3d::Zero() : m_plastic[element];
+    }
+    [[nodiscard]] bool has_plasticity() const { return !m_plastic.empty(); }
+
+    /// Elastic energy at the current positions, J (updates the element rotations).
+    double elastic_energy();
+
 private:
-    /// Rotations, rotated stiffness into the matrix (scaled by `k_scale`, plus `m_scale` M),
-    /// elastic forces and energy at the current positions.
-    double assemble(double m_scale, double k_scale);
+    /// Element rotations, elastic forces (m_internal) and energy at the current positions; with
+    /// `matrix`, also m_matrix = m_scale M + k_scale K(x).
+    double assemble(double m_scale, double k_scale, bool matrix);
+    /// Adds the plastic forces of element e to `force` (local frame), letting its plastic strain
+    /// creep first when a step starts; returns the energy correction, J.
+    double plastic_correction(std::size_t e, const Vector24d& u, Vector24d& force);
+    /// out = M v (lumped or consistent, with the added mass floor).
+    void mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const;
     Eigen::VectorXd external_force() const;
     void apply_constraints(Eigen::VectorXd& rhs);
+    void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    void update_node_rotations();
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
 
     const HexModel& m_model;
@@ -78,10 +126,26 @@ private:
     std::vector<Eigen::Vector3d> m_x, m_v, m_external;
     std::vector<unsigned char> m_fixed; ///< per dof
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
-    Eigen::SparseMatrix<double, Eigen::RowMajor> m_matrix;
+    SystemMatrix m_matrix;
     std::vector<int> m_slot;            ///< per element, 576 positions in m_matrix's values
+    std::vector<int> m_diagonal_slot;   ///< per dof, its diagonal's position in m_matrix's values
+    std::vector<std::uint32_t> m_incidence_start;     ///< per node, into m_incidence
+    std::vector<std::uint32_t> m_incidence;           ///< 8 element + corner, grouped by node
+    std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
+    std::vector<Vector24d> m_element_force;           ///< per element, rotated elastic forces, N
+    mutable std::vector<Vector24d> m_element_product; ///< matrix-free products, per element
+    Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
+    double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K
+    std::vector<Eigen::Quaterniond> m_rotation;       ///< per element, index-aligned frame (warm start)
+    std::vector<Eigen::Quaterniond> m_node_rotation;  ///< per node, mean of its elements'
+    std::vector<double> m_element_energy;
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
-    std::unique_ptr<Multigrid> m_multigrid;
+    std::unique_ptr<Preconditioner> m_preconditioner;
+    std::vector<MaterialBehaviour> m_behaviour;
+    std::vector<double> m_water;            ///< per element; empty while everything is dry
+    std::vector<double> m_stiffness_scale;  ///< per element, from the water content
+    std::vector<Eigen::Matrix3d> m_plastic; ///< per element; empty without plastic materials
+    bool m_update_plastic = false;          ///< the next assembly starts a step: let strain creep
 };
 
 } // namespace vox::fem

@@ -88,7 +88,7 @@ Multigrid::Multigrid(const grid::BranchedGrid& grid, const HexModel& model, int 
     }
 }
 
-void Multigrid::update(const Matrix& a, const std::vector<unsigned char>& fixed)
+void Multigrid::update(const Matrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>&)
 {
     m_matrix.resize(level_count());
     m_inverse_diagonal.resize(level_count());

@@ -6,6 +6,7 @@
 // solve on the coarsest level. One symmetric V-cycle is the preconditioner of the CG solve.
 
 #include "fem/hex_model.hpp"
+#include "fem/preconditioner.hpp"
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -15,9 +16,9 @@
 
 namespace vox::fem {
 
-class Multigrid {
+class Multigrid final : public Preconditioner {
 public:
-    using Matrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+    using Matrix = SystemMatrix;
 
     /// Prolongations from `model`'s level up to `coarsest_level` (at most grid.max_level()),
     /// stopping early once a level has at most `direct_dofs` degrees of freedom.
@@ -26,11 +27,13 @@ public:
     [[nodiscard]] std::size_t level_count() const { return m_prolongation.size() + 1; }
 
     /// Rebuilds the coarse matrices for the fine matrix `a` (held dofs: identity rows and columns,
-    /// flagged in `fixed`). Call after every assembly.
-    void update(const Matrix& a, const std::vector<unsigned char>& fixed);
+    /// flagged in `fixed`) by Galerkin products. Call after every assembly.
+    void update(const Matrix& a, const std::vector<unsigned char>& fixed,
+                const std::vector<Eigen::Quaterniond>& node_rotation) override;
 
     /// z = (one V-cycle) r.
-    void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+    void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
+    [[nodiscard]] const char* name() const override { return "multigrid"; }
 
 private:
     void cycle(std::size_t level, const Eigen::VectorXd& r, Eigen::VectorXd& z) const;

@@ -153,6 +153,8 @@ Bound at_least(double lo) { return {lo, inf, false, false}; }
 Bound closed_range(double lo, double hi) { return {lo, hi, false, false}; }
 Bound open_range(double lo, double hi) { return {lo, hi, true, true}; }
 
+Bound half_open_range(double lo, double hi) { return {lo, hi, true, false}; }
+
 void JsonNode::fail(std::string_view problem) const { throw located_error(m_context->source, m_path, problem); }
 
 void JsonNode::fail_type(std::string_view expected) const

@@ -92,6 +92,8 @@ struct Bound {
 [[nodiscard]] Bound closed_range(double lo, double hi);
 /// (lo, hi).
 [[nodiscard]] Bound open_range(double lo, double hi);
+/// (lo, hi].
+[[nodiscard]] Bound half_open_range(double lo, double hi);
 
 /// A JSON value and its key path in the document. Non-owning: the value and the context must
 /// outlive the node.

@@ -29,6 +29,11 @@ namespace {
 constexpr NameTable<SolverType, 2> solver_types{{{"dbg", SolverType::dbg}, {"isxfem", SolverType::isxfem}}};
 constexpr NameTable<SolverMode, 2> solver_modes{
     {{"dynamic", SolverMode::dynamic}, {"static", SolverMode::static_equilibrium}}};
+constexpr NameTable<PreconditionerChoice, 4> preconditioners{{{"auto", PreconditionerChoice::automatic},
+                                                              {"jacobi", PreconditionerChoice::jacobi},
+                                                              {"cholesky", PreconditionerChoice::cholesky},
+                                                              {"multigrid", PreconditionerChoice::multigrid}}};
+constexpr NameTable<bool, 2> mass_kinds{{{"lumped", true}, {"consistent", false}}};
 constexpr NameTable<ConstraintType, 2> constraint_types{
     {{"fixed", ConstraintType::fixed}, {"slide", ConstraintType::slide}}};
 constexpr NameTable<ToolShape, 4> tool_shapes{{{"blade", ToolShape::blade},
@@ -216,7 +221,24 @@ SceneObject read_object(JsonReader r)
         }
         o.scale_mm_per_unit = r.optional("scale_mm_per_unit", o.scale_mm_per_unit, positive);
     }
-    o.levels = r.optional("levels", o.levels, closed_range(0, 6));
+    if (const std::optional<JsonNode> levels = r.optional_node("levels")) {
+        if (levels->value().is_string()) {
+            if (as<std::string>(*levels) != "auto") levels->fail("expected an integer 0 to 6 or \"auto\"");
+            o.auto_levels = true;
+        } else {
+            o.levels = as<int>(*levels, closed_range(0, 6));
+        }
+    }
+    const std::optional<JsonNode> budget = r.optional_node("step_budget_ms");
+    const std::optional<JsonNode> error = r.optional_node("max_error");
+    if (budget) o.step_budget_ms = as<double>(*budget, positive);
+    if (error) o.max_error = as<double>(*error, open_range(0.0, 1.0));
+    if (o.auto_levels && budget.has_value() == error.has_value()) {
+        (budget ? *budget : r.required_node("levels")).fail("\"levels\": \"auto\" needs exactly one of step_budget_ms and max_error");
+    }
+    if (!o.auto_levels && (budget || error)) {
+        (budget ? *budget : *error).fail("only meaningful with \"levels\": \"auto\"");
+    }
     r.finish("for a " + std::string(kind) + " object");
     return o;
 }
@@ -227,6 +249,21 @@ Material read_material(JsonReader r, Material m)
     m.youngs_modulus_pa = r.optional("youngs_modulus_pa", m.youngs_modulus_pa, positive);
     m.poisson_ratio = r.optional("poisson_ratio", m.poisson_ratio, open_range(-1.0, 0.5));
     m.density_kg_m3 = r.optional("density_kg_m3", m.density_kg_m3, positive);
+    if (const std::optional<JsonNode> node = r.optional_node("plasticity")) {
+        JsonReader p(*node);
+        Plasticity plastic = m.plasticity.value_or(Plasticity{});
+        plastic.yield_strain = p.optional("yield_strain", plastic.yield_strain, positive);
+        plastic.creep_per_s = p.optional("creep_per_s", plastic.creep_per_s, at_least(0.0));
+        plastic.max_strain = p.optional("max_strain", plastic.max_strain, positive);
+        p.finish();
+        m.plasticity = plastic;
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("wetting")) {
+        JsonReader w(*node);
+        m.wetting.stiffness_ratio = w.optional("stiffness_ratio", m.wetting.stiffness_ratio, half_open_range(0.0, 1.0));
+        m.wetting.yield_ratio = w.optional("yield_ratio", m.wetting.yield_ratio, half_open_range(0.0, 1.0));
+        w.finish();
+    }
     r.finish();
     return m;
 }
@@ -289,6 +326,12 @@ SolverSettings read_solver(JsonReader r)
     s.rayleigh_mass_per_s = r.optional("rayleigh_mass_per_s", s.rayleigh_mass_per_s, at_least(0.0));
     s.rayleigh_stiffness_s = r.optional("rayleigh_stiffness_s", s.rayleigh_stiffness_s, at_least(0.0));
     s.newton_max_iterations = r.optional("newton_max_iterations", s.newton_max_iterations, at_least(1));
+    if (const std::optional<JsonNode> node = r.optional_node("preconditioner")) {
+        s.preconditioner = choose_enum(*node, preconditioners);
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("mass")) {
+        s.lumped_mass = choose_enum(*node, mass_kinds);
+    }
     r.finish();
     return s;
 }
@@ -330,6 +373,15 @@ Load read_load(JsonReader r)
     l.force_n = finite_vector(r.required_node("force_n"));
     r.finish();
     return l;
+}
+
+WetRegion read_wet_region(JsonReader r)
+{
+    WetRegion w;
+    std::tie(w.box_min_mm, w.box_max_mm) = read_box(r.required_node("box_mm"));
+    w.water = r.optional("water", w.water, closed_range(0.0, 1.0));
+    r.finish();
+    return w;
 }
 
 ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
@@ -429,6 +481,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     const std::optional<JsonNode> gravity = root.optional_node("gravity_m_s2");
     const std::optional<JsonNode> constraints = root.optional_node("constraints");
     const std::optional<JsonNode> loads = root.optional_node("loads");
+    const std::optional<JsonNode> wet_regions = root.optional_node("wet_regions");
     const std::optional<JsonNode> tools = root.optional_node("tools");
     const std::optional<JsonNode> script = root.optional_node("script");
     const std::optional<JsonNode> output = root.optional_node("output");
@@ -455,6 +508,11 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     if (loads) {
         for (const JsonNode& node : loads->elements()) {
             scene.loads.push_back(read_load(JsonReader(node)));
+        }
+    }
+    if (wet_regions) {
+        for (const JsonNode& node : wet_regions->elements()) {
+            scene.wet_regions.push_back(read_wet_region(JsonReader(node)));
         }
     }
     if (tools) {

@@ -50,6 +50,28 @@ struct SceneObject {
     /// the level of the branched-grid paper's liver (Jerabkova et al. 2010, section 4: about 13,000
     /// voxels, three coarsening levels, 104 elements).
     int levels = 3;
+    /// "levels": "auto": the run picks the level itself, by step_budget_ms (the finest level
+    /// whose measured step fits) or max_error (the coarsest level whose deflection differs from
+    /// the next finer level's by at most this fraction); exactly one of the two is given.
+    bool auto_levels = false;
+    std::optional<double> step_budget_ms;
+    std::optional<double> max_error;
+};
+
+/// Müller & Gross (2004) plasticity: when the elastic strain's norm exceeds yield_strain, a part
+/// creep_per_s * dt of it becomes plastic each step; the plastic strain's norm stays at most
+/// max_strain. Absent: the material is elastic.
+struct Plasticity {
+    double yield_strain = 0.01;  ///< > 0
+    double creep_per_s = 20.0;   ///< >= 0; creep_per_s * dt_s above 1 acts as 1
+    double max_strain = 0.5;     ///< > 0
+};
+
+/// How water softens a material: at water content w in [0, 1], stiffness and plastic yield are
+/// scaled by 1 - (1 - ratio) w (linear between dry, w = 0, and soaked, w = 1).
+struct Wetting {
+    double stiffness_ratio = 0.2; ///< in (0, 1]
+    double yield_ratio = 0.5;     ///< in (0, 1]
 };
 
 /// Linear elastic material, SI units.
@@ -60,7 +82,18 @@ struct Material {
     double poisson_ratio = 0.45;
     /// Mass density, kg/m^3 (> 0).
     double density_kg_m3 = 1000.0;
+    std::optional<Plasticity> plasticity;
+    Wetting wetting;
 };
+
+/// Water content given to the elements whose material centroid lies in a box.
+struct WetRegion {
+    Eigen::Vector3d box_min_mm, box_max_mm;
+    double water = 1.0; ///< in [0, 1]
+};
+
+/// The preconditioner of the conjugate-gradient solves.
+enum class PreconditionerChoice { automatic, jacobi, cholesky, multigrid };
 
 /// The cutting approach (see DESIGN.md): dynamic branched grid, or tetrahedra with Is-XFEM.
 enum class SolverType { dbg, isxfem };
@@ -91,6 +124,10 @@ struct SolverSettings {
     double rayleigh_stiffness_s = 0.002;
     /// Static mode: Newton iteration cap per frame (>= 1).
     int newton_max_iterations = 20;
+    /// Key "preconditioner": "auto" (default), "jacobi", "cholesky", "multigrid".
+    PreconditionerChoice preconditioner = PreconditionerChoice::automatic;
+    /// Key "mass": "lumped" (default: row sums, diagonal) or "consistent".
+    bool lumped_mass = true;
 };
 
 enum class ConstraintType {
@@ -185,6 +222,8 @@ struct Scene {
     std::vector<Constraint> constraints;
     /// External point forces, constant in time; none by default.
     std::vector<Load> loads;
+    /// Initial water content by region; none by default (dry).
+    std::vector<WetRegion> wet_regions;
     std::vector<ToolSpec> tools;
     /// Tool key frames in time order.
     std::vector<ScriptEntry> script;

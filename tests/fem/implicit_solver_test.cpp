@@ -1,4 +1,5 @@
 #include "fem/implicit_solver.hpp"
+#include "fem/multigrid.hpp"
 
 #include "grid/phantom.hpp"
 
@@ -142,7 +143,7 @@ TEST(Multigrid, PreconditionedSolveMatchesJacobiWithFarFewerIterations)
     o.cg_max_iterations = 20000;
     o.newton_max_iterations = 50;
     ImplicitSolver jacobi(model, o), multigrid(model, o);
-    multigrid.use_multigrid(std::make_unique<Multigrid>(grid, model, 4));
+    multigrid.set_preconditioner(std::make_unique<Multigrid>(grid, model, 4));
     for (ImplicitSolver* s : {&jacobi, &multigrid}) {
         s->set_gravity({0, 0, -9.81});
         for (std::uint32_t n : nodes_at(model, 0, -0.0005)) s->fix(n, 7);

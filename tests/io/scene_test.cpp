@@ -510,7 +510,7 @@ void PrintTo(const BadScene& b, std::ostream* os) { *os << b.name; }
 
 const BadScene bad_scenes[] = {
     BadScene{"unknown_key", "toolz",
-             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, loads, tools, script, "
+             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, loads, wet_regions, tools, script, "
              "output)"},
     BadScene{"unknown_phantom_key", "object.phantom.radius_mm",
              "unknown key for a beam phantom (known keys: shape, voxel_mm, size_mm)"},
