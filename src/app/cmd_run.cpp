@@ -7,8 +7,8 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
-#include "fem/implicit_solver.hpp"
-#include "fem/multigrid.hpp"
+#include "app/level_choice.hpp"
+#include "app/scene_simulation.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -24,12 +24,6 @@
 
 namespace vox::app {
 namespace {
-
-bool in_box(const Eigen::Vector3d& p_mm, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
-{
-    const double tol = 1e-9 * (1.0 + lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff());
-    return (p_mm.array() >= lo.array() - tol).all() && (p_mm.array() <= hi.array() + tol).all();
-}
 
 /// Where each tool is at time t (linear between its script entries; before the first and after
 /// the last it stays put), world mm.
@@ -54,25 +48,9 @@ std::vector<Eigen::Vector3d> tool_positions(const io::Scene& scene, double t)
     return out;
 }
 
-fem::SolverOptions solver_options(const io::SolverSettings& s)
+void write_surface(const std::filesystem::path& path, const SceneSimulation& sim)
 {
-    fem::SolverOptions o;
-    o.dt_s = s.dt_s;
-    o.cg_tolerance = s.cg_tolerance;
-    o.cg_max_iterations = s.cg_max_iterations;
-    o.rayleigh_mass_per_s = s.rayleigh_mass_per_s;
-    o.rayleigh_stiffness_s = s.rayleigh_stiffness_s;
-    o.quasi_static = s.mode == io::SolverMode::static_equilibrium;
-    o.newton_max_iterations = s.newton_max_iterations;
-    return o;
-}
-
-void write_surface(const std::filesystem::path& path, const surface::EmbeddedSurface& surf, const grid::BranchedGrid& g,
-                   const fem::HexModel& model, const fem::ImplicitSolver& solver)
-{
-    std::vector<Eigen::Vector3d> nodes(g.level(model.level()).node_users.size(), Eigen::Vector3d::Zero());
-    for (std::size_t i = 0; i < model.node_count(); ++i) nodes[model.grid_node()[i]] = solver.positions()[i] * 1e3;
-    const surface::SurfaceMesh m = surf.mesh(g, nodes);
+    const surface::SurfaceMesh m = sim.surface().mesh(sim.solver().positions());
     io::write_mesh(path.string(), m.positions, m.triangles, m.labels);
 }
 
@@ -95,50 +73,46 @@ void add_run_command(CLI::App& app)
         const io::Scene scene = io::load_scene(args->scene);
         if (scene.solver.type != io::SolverType::dbg)
             throw scene.error("solver.type", "\"isxfem\" runs are not available yet; use \"dbg\"");
-        const int level = scene.object.levels;
-        if (level < 1) throw scene.error("object.levels", "run simulates levels 1 to 6; level 0 is not available yet");
         const grid::LabelGrid labels = io::load_scene_object(scene);
-        io::check_constraints(scene, labels);
-        const io::MaterialTable table = io::material_table(scene);
-        // Coarser levels than the simulated one serve the multigrid preconditioner.
-        const int coarsest = std::min(6, level + 3);
-        const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }),
-                                   table.materials, coarsest);
-        const fem::HexModel model(g, level);
-        fem::ImplicitSolver solver(model, solver_options(scene.solver));
-        // Measured: the V-cycle cuts the quasi-static cantilever's CG iterations 50 to 700 fold, but
-        // for implicit steps of soft tissue its set-up costs more than the Jacobi iterations it saves.
-        if (level < coarsest && scene.solver.mode == io::SolverMode::static_equilibrium)
-            solver.set_preconditioner(std::make_unique<fem::Multigrid>(g, model, coarsest));
-        solver.set_gravity(scene.gravity_m_s2);
-        for (const io::Constraint& c : scene.constraints) {
-            const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
-            for (std::uint32_t n = 0; n < model.node_count(); ++n)
-                if (in_box(model.rest_positions()[n] * 1e3, c.box_min_mm, c.box_max_mm)) solver.fix(n, axes);
+        // Coarser levels than the simulated one serve the multigrid preconditioner; "auto" tries them all.
+        const int max_level = scene.object.auto_levels ? 6 : std::min(6, std::max(scene.object.levels, 1) + 3);
+        const grid::BranchedGrid g = build_scene_grid(scene, labels, max_level);
+        LevelChoice choice;
+        choice.level = scene.object.levels;
+        if (scene.object.auto_levels) {
+            choice = choose_level(scene, g);
+            log::info("levels auto: {}", choice.reason);
         }
-        for (std::size_t k = 0; k < scene.loads.size(); ++k) {
-            const io::Load& load = scene.loads[k];
-            std::vector<std::uint32_t> caught;
-            for (std::uint32_t n = 0; n < model.node_count(); ++n)
-                if (in_box(model.rest_positions()[n] * 1e3, load.box_min_mm, load.box_max_mm)) caught.push_back(n);
-            if (caught.empty())
-                throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
-            for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
-        }
-        const surface::EmbeddedSurface surf(g, level);
+        const int level = choice.level;
+        SceneSimulation sim(scene, g, level);
+        fem::ImplicitSolver& solver = sim.solver();
+        const fem::HexModel& model = sim.model();
 
         const double dt = scene.solver.dt_s;
         const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
         const int frames = args->frames.value_or(duration > 0 ? static_cast<int>(std::ceil(duration / dt)) : 100);
         const std::filesystem::path out = args->out.empty() ? scene.output.dir : std::filesystem::path(args->out);
         std::filesystem::create_directories(out);
-        log::info("{}: level {}, {} elements, {} degrees of freedom, {} frames of {} s ({})", args->scene, level,
-                  model.elements().size(), solver.dof_count(), frames, dt,
-                  scene.solver.mode == io::SolverMode::static_equilibrium ? "quasi-static" : "implicit Euler");
+        log::info("{}: level {}, {} elements, {} degrees of freedom, {} frames of {} s ({}; {}; {} mass{}{})", args->scene,
+                  level, model.elements().size(), solver.dof_count(), frames, dt,
+                  scene.solver.mode == io::SolverMode::static_equilibrium ? "quasi-static" : "implicit Euler",
+                  sim.linear_solver(), scene.solver.lumped_mass ? "lumped" : "consistent",
+                  solver.has_plasticity() ? ", plastic" : "", scene.wet_regions.empty() ? "" : ", wetted regions");
 
         nlohmann::json stats{{"scene", args->scene},       {"level", level},
                              {"elements", model.elements().size()}, {"dofs", solver.dof_count()},
-                             {"dt_s", dt},                  {"frames", nlohmann::json::array()}};
+                             {"dt_s", dt},                  {"linear_solver", sim.linear_solver()},
+                             {"frames", nlohmann::json::array()}};
+        if (scene.object.auto_levels) {
+            nlohmann::json trials = nlohmann::json::array();
+            for (const LevelTrial& t : choice.trials) {
+                nlohmann::json j{{"level", t.level}, {"dofs", t.dofs}};
+                if (t.error >= 0.0) j["error"] = t.error;
+                else j["step_ms"] = t.step_ms;
+                trials.push_back(j);
+            }
+            stats["level_choice"] = {{"reason", choice.reason}, {"trials", trials}};
+        }
         double total_ms = 0.0, max_ms = 0.0;
         int converged = 0;
         fem::StepStats last;
@@ -157,6 +131,8 @@ void add_run_command(CLI::App& app)
             stats["frames"].push_back({{"frame", f},
                                        {"t_s", f * dt},
                                        {"step_ms", last.step_ms},
+                                       {"assembly_ms", last.assembly_ms},
+                                       {"solve_ms", last.solve_ms},
                                        {"cg_iterations", last.cg_iterations},
                                        {"newton_iterations", last.newton_iterations},
                                        {"residual", last.residual},
@@ -168,7 +144,7 @@ void add_run_command(CLI::App& app)
             if (f % scene.output.mesh_every_n_frames == 0) {
                 char name[32];
                 std::snprintf(name, sizeof name, "frame_%05d.obj", f);
-                write_surface(out / name, surf, g, model, solver);
+                write_surface(out / name, sim);
             }
             progress.update(static_cast<std::uint64_t>(f));
         }
@@ -181,7 +157,11 @@ void add_run_command(CLI::App& app)
                             {"final_max_displacement_mm", last.max_displacement_m * 1e3},
                             {"final_elastic_energy_j", last.elastic_energy_j},
                             {"final_kinetic_energy_j", last.kinetic_energy_j}};
-        write_surface(out / "final.obj", surf, g, model, solver);
+        if (!solver.fallback_note().empty()) {
+            log::warn("{}", solver.fallback_note());
+            stats["linear_solver"] = solver.fallback_note();
+        }
+        write_surface(out / "final.obj", sim);
         write_atomically(out / "stats.json", [&](const std::filesystem::path& tmp) {
             std::ofstream(tmp) << stats.dump(1) << '\n';
         });

@@ -46,7 +46,8 @@ public:
     /// Consistent mass row sums per node plus the floor below, kg: gravity loads are these times g.
     [[nodiscard]] const std::vector<double>& nodal_mass() const { return m_nodal_mass; }
     /// Lumped mass added to nodes whose share of material is tiny (a corner far from the one voxel
-    /// of a partly filled element): each node weighs at least 1e-3 of a full cell's corner mass.
+    /// of a partly filled element): each node weighs at least 1e-3 of a full cell's corner mass. (The
+    /// same fraction of a full cell's stiffness is added to every partial element.)
     /// Without it such nodes have almost no inertia and almost no stiffness, and any solve leaves
     /// them wherever its residual stops caring. Kg per node (0 for most).
     [[nodiscard]] const std::vector<double>& added_mass() const { return m_added_mass; }

@@ -366,6 +366,11 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
     if (m_preconditioner) {
         update_node_rotations();
         m_preconditioner->update(m_matrix, m_fixed, m_node_rotation);
+        if (m_preconditioner->failed()) { // e.g. a factor of a singular K: nothing holds the object
+            m_fallback_note = std::string(m_preconditioner->name()) +
+                              " preconditioner failed (singular matrix: is the object held?); using Jacobi";
+            m_preconditioner.reset();
+        }
     }
     auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {
         if (m_preconditioner)

@@ -79,6 +79,8 @@ public:
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
     void set_preconditioner(std::unique_ptr<Preconditioner> p);
     [[nodiscard]] const char* preconditioner_name() const { return m_preconditioner ? m_preconditioner->name() : "Jacobi"; }
+    /// Set when the given preconditioner could not be built and Jacobi took over; empty otherwise.
+    [[nodiscard]] const std::string& fallback_note() const { return m_fallback_note; }
 
     StepStats step();
 
@@ -141,6 +143,7 @@ private:
     std::vector<double> m_element_energy;
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
     std::unique_ptr<Preconditioner> m_preconditioner;
+    std::string m_fallback_note;
     std::vector<MaterialBehaviour> m_behaviour;
     std::vector<double> m_water;            ///< per element; empty while everything is dry
     std::vector<double> m_stiffness_scale;  ///< per element, from the water content

@@ -25,6 +25,8 @@ public:
     /// decide to rebuild.
     virtual void report_iterations(int /*iterations*/) {}
     [[nodiscard]] virtual const char* name() const = 0;
+    /// True when the last update could not build the preconditioner (a singular matrix).
+    [[nodiscard]] virtual bool failed() const { return false; }
 };
 
 } // namespace vox::fem

@@ -28,7 +28,7 @@ public:
     /// How many times the matrix has been factored, and whether the last attempt failed (a
     /// singular matrix: the caller should fall back to another preconditioner).
     [[nodiscard]] int factorizations() const { return m_factorizations; }
-    [[nodiscard]] bool failed() const { return m_failed; }
+    [[nodiscard]] bool failed() const override { return m_failed; }
 
 private:
     Eigen::Matrix3d m_frame;

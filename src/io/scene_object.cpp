@@ -99,9 +99,11 @@ MaterialTable material_table(const Scene& scene)
 {
     MaterialTable t;
     t.materials.push_back(to_voxel_material(scene.default_material));
+    t.scene_materials.push_back(scene.default_material);
     for (const auto& [label, material] : scene.label_materials) {
         t.label_index[label] = static_cast<std::int32_t>(t.materials.size());
         t.materials.push_back(to_voxel_material(material));
+        t.scene_materials.push_back(material);
     }
     return t;
 }
@@ -110,6 +112,7 @@ MaterialTable default_material_table()
 {
     MaterialTable t;
     t.materials.push_back(to_voxel_material(Material{}));
+    t.scene_materials.push_back(Material{});
     return t;
 }
 

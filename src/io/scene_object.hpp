@@ -36,6 +36,7 @@ namespace vox::io {
 /// label with its own material; `index_of(label)` maps a voxel label to its entry.
 struct MaterialTable {
     std::vector<grid::VoxelMaterial> materials;
+    std::vector<Material> scene_materials; ///< the scene's entries, in the same order
     std::map<std::int32_t, std::int32_t> label_index;
     [[nodiscard]] std::int32_t index_of(std::int32_t label) const
     {
