@@ -17,6 +17,7 @@ public:
 
     /// Displacement of every surface vertex slot (free slots: zero), m, from node positions (m).
     [[nodiscard]] std::vector<Eigen::Vector3d> displacements(const std::vector<Eigen::Vector3d>& node_positions) const;
+    [[nodiscard]] const surface::EmbeddedSurface& embedded() const { return m_surface; }
     /// The deformed surface, world mm.
     [[nodiscard]] surface::SurfaceMesh mesh(const std::vector<Eigen::Vector3d>& node_positions) const;
 

@@ -15,7 +15,9 @@ void RestCholesky::update(const SystemMatrix& a, const std::vector<unsigned char
         if (m_factorizations == 0 || m_fixed != fixed) m_factor.analyzePattern(column_major);
         m_factor.factorize(column_major);
         ++m_factorizations;
-        m_failed = m_factor.info() != Eigen::Success;
+        // A singular K (nothing holds the object) may still factor, with pivots at round-off level.
+        m_failed = m_factor.info() != Eigen::Success ||
+                   !(m_factor.vectorD().minCoeff() > 1e-10 * m_factor.vectorD().cwiseAbs().maxCoeff());
         m_factored_rotation = node_rotation;
         m_fixed = fixed;
         m_stale = false;
