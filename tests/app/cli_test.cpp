@@ -141,6 +141,59 @@ TEST(Cli, RunWritesStatsAndDeformedSurfaces)
     EXPECT_EQ(j["closed"], true);
 }
 
+namespace {
+/// Writes `scene` into `dir`/NAME.json, runs it and returns its stats.json.
+nlohmann::json run_scene(const fs::path& dir, const std::string& name, const std::string& scene, const std::string& options)
+{
+    std::ofstream(dir / (name + ".json")) << scene;
+    const auto r = run_voxsculpt("run " + quote((dir / (name + ".json")).string()) + " --out " + quote((dir / name).string()) + " " + options);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(dir / name / "stats.json");
+    return nlohmann::json::parse(in);
+}
+} // namespace
+
+TEST(Cli, RunAtLevelZeroAndWithAutomaticLevels)
+{
+    const fs::path d = fresh_dir("cli_run_levels");
+    const std::string object = R"("phantom": {"shape": "block", "size_mm": [8, 4, 4]})";
+    const std::string rest = R"(, "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 9, 9]]}]})";
+    const nlohmann::json zero = run_scene(d, "zero", "{\"object\": {" + object + R"(, "levels": 0})" + rest, "--frames 3");
+    EXPECT_EQ(zero["level"], 0);
+    EXPECT_EQ(zero["elements"], 128); // every voxel an element
+    EXPECT_EQ(info_json(d / "zero" / "final.obj")["closed"], true);
+
+    // A budget every level meets: the finest level, 0, wins.
+    const nlohmann::json fast =
+        run_scene(d, "budget", "{\"object\": {" + object + R"(, "levels": "auto", "step_budget_ms": 10000})" + rest, "--frames 1");
+    EXPECT_EQ(fast["level"], 0);
+    EXPECT_NE(fast["level_choice"]["reason"].get<std::string>().find("finest"), std::string::npos);
+    EXPECT_GE(fast["level_choice"]["trials"].size(), 2u);
+
+    // An error target any level meets: the coarsest level compared wins.
+    const nlohmann::json loose =
+        run_scene(d, "error", "{\"object\": {" + object + R"(, "levels": "auto", "max_error": 0.99})" + rest, "--frames 1");
+    EXPECT_GE(loose["level"].get<int>(), 1);
+    EXPECT_NE(loose["level_choice"]["reason"].get<std::string>().find("coarsest"), std::string::npos);
+}
+
+TEST(Cli, AWetObjectSagsByItsSofteningLaw)
+{
+    // Quasi-static cantilever under gravity, dry against soaked (stiffness ratio 0.2): small
+    // deflections scale with 1 / E, so the soaked one sags five times as far.
+    const fs::path d = fresh_dir("cli_run_wet");
+    const std::string scene = R"({"object": {"phantom": {"shape": "block", "size_mm": [16, 4, 4]}, "levels": 1},
+        "materials": {"default": {"youngs_modulus_pa": 1e7, "wetting": {"stiffness_ratio": 0.2}}},
+        "solver": {"mode": "static", "cg_tolerance": 1e-9},
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 9, 9]]}])";
+    const nlohmann::json dry = run_scene(d, "dry", scene + "}", "--frames 1");
+    const nlohmann::json wet =
+        run_scene(d, "wet", scene + R"(, "wet_regions": [{"box_mm": [[-1, -1, -1], [16, 4, 4]]}]})", "--frames 1");
+    const double ratio = wet["summary"]["final_max_displacement_mm"].get<double>() /
+                         dry["summary"]["final_max_displacement_mm"].get<double>();
+    EXPECT_NEAR(ratio, 5.0, 0.05);
+}
+
 TEST(Cli, QuietPrintsNothingOnSuccess)
 {
     const fs::path d = fresh_dir("cli_quiet");

@@ -480,6 +480,36 @@ TEST(SceneParse, RelativeFolderIsMadeAbsolute)
     EXPECT_EQ(s.output.dir, (fs::current_path() / "some/folder/out").lexically_normal());
 }
 
+TEST(SceneParse, SolverMaterialAndLevelChoiceKeys)
+{
+    const fs::path path = write_temp("scene_new_keys.json", R"({
+        "object": {"phantom": {"shape": "beam"}, "levels": "auto", "max_error": 0.1},
+        "materials": {"default": {"plasticity": {"yield_strain": 0.02}, "wetting": {"stiffness_ratio": 0.3}}},
+        "solver": {"preconditioner": "multigrid", "mass": "consistent"},
+        "wet_regions": [{"box_mm": [[0, 0, 0], [10, 10, 10]], "water": 0.25}, {"box_mm": [[0, 0, 0], [1, 1, 1]]}]
+    })");
+    const Scene s = load_scene(path);
+    EXPECT_TRUE(s.object.auto_levels);
+    EXPECT_EQ(s.object.max_error, 0.1);
+    EXPECT_FALSE(s.object.step_budget_ms.has_value());
+    ASSERT_TRUE(s.default_material.plasticity.has_value());
+    EXPECT_EQ(s.default_material.plasticity->yield_strain, 0.02);
+    EXPECT_EQ(s.default_material.plasticity->creep_per_s, 20.0); // documented defaults
+    EXPECT_EQ(s.default_material.plasticity->max_strain, 0.5);
+    EXPECT_EQ(s.default_material.wetting.stiffness_ratio, 0.3);
+    EXPECT_EQ(s.default_material.wetting.yield_ratio, 0.5);
+    EXPECT_EQ(s.solver.preconditioner, vox::io::PreconditionerChoice::multigrid);
+    EXPECT_FALSE(s.solver.lumped_mass);
+    ASSERT_EQ(s.wet_regions.size(), 2u);
+    EXPECT_EQ(s.wet_regions[0].water, 0.25);
+    EXPECT_EQ(s.wet_regions[1].water, 1.0);
+
+    const Scene plain = parse_scene(minimal_scene(), "/tmp", "plain.json");
+    EXPECT_FALSE(plain.default_material.plasticity.has_value()); // elastic unless asked
+    EXPECT_TRUE(plain.solver.lumped_mass);
+    EXPECT_EQ(plain.solver.preconditioner, vox::io::PreconditionerChoice::automatic);
+}
+
 TEST(SceneParse, CommentsAreAllowed)
 {
     const fs::path path = write_temp("scene_with_comments.json", R"({
@@ -565,7 +595,14 @@ const BadScene bad_scenes[] = {
     BadScene{"youngs_zero", "materials.default.youngs_modulus_pa", "must be > 0, got 0"},
     BadScene{"gravity_type", "gravity_m_s2", "expected an array of 3 numbers, got \"down\""},
     BadScene{"mesh_every_zero", "output.mesh_every_n_frames", "must be >= 1, got 0"},
-    BadScene{"output_dir_empty", "output.dir", "expected a path, got an empty string"}};
+    BadScene{"output_dir_empty", "output.dir", "expected a path, got an empty string"},
+    BadScene{"levels_word", "object.levels", "expected an integer 0 to 6 or \"auto\""},
+    BadScene{"auto_without_target", "object.levels", "needs exactly one of step_budget_ms and max_error"},
+    BadScene{"budget_without_auto", "object.step_budget_ms", "only meaningful with \"levels\": \"auto\""},
+    BadScene{"plastic_yield", "materials.default.plasticity.yield_strain", "must be > 0, got -0.1"},
+    BadScene{"wet_ratio_zero", "materials.default.wetting.stiffness_ratio", "must be in (0, 1], got 0"},
+    BadScene{"water_above_one", "wet_regions[0].water", "must be in [0, 1], got 1.5"},
+    BadScene{"preconditioner", "solver.preconditioner", "expected one of \"auto\", \"jacobi\""}};
 
 class SceneBadFile : public testing::TestWithParam<BadScene> {};
 
