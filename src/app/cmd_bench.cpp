@@ -7,7 +7,9 @@
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "app/bench_stability.hpp"
 #include "app/scene_simulation.hpp"
+#include "core/error.hpp"
 #include "io/scene_object.hpp"
 
 #include <CLI/CLI.hpp>
@@ -233,6 +235,19 @@ void add_bench_command(CLI::App& app)
     tradeoff->add_option("--out", *out, "Folder for tradeoff.md and tradeoff.svg (default docs)");
     tradeoff->add_flag("--skip-liver", *skip_liver, "Only the beam (faster)");
     tradeoff->callback([out, skip_liver] { run_tradeoff(*out, !*skip_liver); });
+
+    auto stability_out = std::make_shared<std::string>("docs");
+    auto quick = std::make_shared<bool>(false);
+    CLI::App* stability = bench->add_subcommand(
+        "stability", "The solver at the extremes (Poisson ratio, stiffness, time step, 1/512 fill, twist, inversion, 100 N kick)");
+    stability->add_option("--out", *stability_out, "Folder for stability.md and stability.json (default docs)");
+    stability->add_flag("--quick", *quick, "A short beam only, few steps (the test suite's subset)");
+    stability->callback([stability_out, quick] {
+        const std::vector<StabilityResult> results = run_stability(*quick);
+        write_stability(*stability_out, results);
+        for (const StabilityResult& r : results)
+            if (r.outcome == "diverged") throw InputError("bench stability: " + r.object + ", " + r.variation + ": diverged (" + r.detail + ")");
+    });
 }
 
 } // namespace vox::app

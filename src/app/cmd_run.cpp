@@ -122,6 +122,7 @@ void add_run_command(CLI::App& app)
             total_ms += last.step_ms;
             max_ms = std::max(max_ms, last.step_ms);
             converged += last.converged;
+            if (last.energy_guarded) throw InputError(energy_guard_message(scene, f));
             if (!std::isfinite(last.elastic_energy_j) || !std::isfinite(last.kinetic_energy_j))
                 throw InputError(args->scene + ": the simulation diverged at frame " + std::to_string(f) +
                                  " (non-finite energy); reduce solver.dt_s or check the materials");
@@ -137,6 +138,7 @@ void add_run_command(CLI::App& app)
                                        {"newton_iterations", last.newton_iterations},
                                        {"residual", last.residual},
                                        {"converged", last.converged},
+                                       {"substeps", last.substeps},
                                        {"kinetic_energy_j", last.kinetic_energy_j},
                                        {"elastic_energy_j", last.elastic_energy_j},
                                        {"max_displacement_mm", last.max_displacement_m * 1e3},

@@ -43,6 +43,13 @@ io::PreconditionerChoice resolve(io::PreconditionerChoice choice, std::size_t do
 
 } // namespace
 
+std::string energy_guard_message(const io::Scene& scene, int frame)
+{
+    return scene.source + ": frame " + std::to_string(frame) +
+           ": the step creates energy even split into 32 substeps, so its result cannot be trusted; "
+           "the forces are too large for this object (or solver.dt_s too long): reduce the loads or dt_s";
+}
+
 grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGrid& labels, int max_level)
 {
     const io::MaterialTable table = io::material_table(scene);

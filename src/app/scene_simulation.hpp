@@ -18,6 +18,10 @@ namespace vox::app {
 /// one serve the multigrid preconditioner).
 [[nodiscard]] grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGrid& labels, int max_level);
 
+/// The message of a step that still created energy at 1/32 of dt (fem::StepStats::energy_guarded):
+/// the loads or the time step are beyond what this object and level can follow.
+[[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
+
 class SceneSimulation {
 public:
     /// Throws the scene's InputError when a constraint or load box catches no node at `level`.

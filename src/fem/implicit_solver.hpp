@@ -62,6 +62,8 @@ struct StepStats {
     double elastic_energy_j = 0.0;
     double max_displacement_m = 0.0;
     bool converged = true;
+    int substeps = 0;                 ///< dynamic: halvings taken because a step gained energy
+    bool energy_guarded = false;      ///< a step gained energy even at 1/32 of dt (kept, reported)
 };
 
 class ImplicitSolver {
@@ -122,6 +124,12 @@ private:
     void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void update_node_rotations();
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
+    [[nodiscard]] double kinetic_energy() const;
+    /// One linearised implicit Euler step of `dt`; returns the external forces' work over it and
+    /// sets `energy_before` to the kinetic plus elastic energy at its start.
+    double linear_step(double dt, StepStats& s, double& energy_before);
+    /// A step of `dt` that must not create energy; halves itself (recursively) when it does.
+    void advance(double dt, int depth, StepStats& s);
 
     const HexModel& m_model;
     SolverOptions m_options;
@@ -149,6 +157,8 @@ private:
     std::vector<double> m_stiffness_scale;  ///< per element, from the water content
     std::vector<Eigen::Matrix3d> m_plastic; ///< per element; empty without plastic materials
     bool m_update_plastic = false;          ///< the next assembly starts a step: let strain creep
+    double m_step_dt = 0.0;                 ///< the (sub)step being taken, s
+    double m_last_dt = 0.0;                 ///< of the last dynamic solve
 };
 
 } // namespace vox::fem

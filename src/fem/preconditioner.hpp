@@ -24,6 +24,8 @@ public:
     /// Told how many iterations the last solve took, so a preconditioner built at another state can
     /// decide to rebuild.
     virtual void report_iterations(int /*iterations*/) {}
+    /// The matrix has changed beyond what update() tracks (a new time step): rebuild next time.
+    virtual void invalidate() {}
     [[nodiscard]] virtual const char* name() const = 0;
     /// True when the last update could not build the preconditioner (a singular matrix).
     [[nodiscard]] virtual bool failed() const { return false; }

@@ -23,6 +23,7 @@ public:
                 const std::vector<Eigen::Quaterniond>& node_rotation) override;
     void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
     void report_iterations(int iterations) override { m_stale = m_stale || iterations > m_refactor_iterations; }
+    void invalidate() override { m_stale = true; }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
     /// How many times the matrix has been factored, and whether the last attempt failed (a

@@ -194,6 +194,27 @@ TEST(Cli, AWetObjectSagsByItsSofteningLaw)
     EXPECT_NEAR(ratio, 5.0, 0.05);
 }
 
+TEST(Cli, StabilityQuickSubsetNeverDiverges)
+{
+    // The test suite's share of `voxsculpt bench stability`: every case stable or refused with a
+    // message; the material, time-step, twist and inversion sweeps all stable.
+    const fs::path d = fresh_dir("cli_stability");
+    const auto r = run_voxsculpt("bench stability --quick --out " + quote(d.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(d / "stability.json");
+    const nlohmann::json cases = nlohmann::json::parse(in);
+    ASSERT_GE(cases.size(), 20u);
+    for (const nlohmann::json& c : cases) {
+        const std::string outcome = c["outcome"], name = c["case"];
+        EXPECT_TRUE(outcome == "stable" || outcome == "refused") << name << ": " << outcome;
+        if (outcome == "refused") {
+            EXPECT_NE(name.find("100 N"), std::string::npos) << name;
+            EXPECT_FALSE(c["detail"].get<std::string>().empty());
+        }
+    }
+    EXPECT_TRUE(fs::exists(d / "stability.md"));
+}
+
 TEST(Cli, QuietPrintsNothingOnSuccess)
 {
     const fs::path d = fresh_dir("cli_quiet");
