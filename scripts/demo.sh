@@ -45,6 +45,12 @@ for scene in "$data"/scenes/*.json; do
   echo "checked $(basename "$scene"): $(sed -n 2p "$out/$(basename "$scene" .json)-check.txt")"
 done
 
+step "Simulation: a soft cantilever swinging under gravity (implicit Euler, 50 frames)"
+"$vox" run "$data/scenes/beam.json" --frames 50 --out "$out/run-beam"
+
+step "Simulation: a clay slab under two weights, plastic, its right half wet (100 frames)"
+"$vox" run "$data/scenes/clay.json" --frames 100 --out "$out/run-clay"
+
 step "Outputs"
 ls -l "$out"
 echo "demo outputs are in $out"
