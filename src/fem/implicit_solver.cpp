@@ -256,7 +256,8 @@ Eigen::VectorXd ImplicitSolver::external_force() const
 {
     Eigen::VectorXd f(static_cast<Eigen::Index>(3 * m_x.size()));
     for (std::size_t n = 0; n < m_x.size(); ++n)
-        f.segment<3>(static_cast<Eigen::Index>(3 * n)) = m_model.nodal_mass()[n] * m_gravity + m_external[n];
+        f.segment<3>(static_cast<Eigen::Index>(3 * n)) =
+            (m_model.nodal_mass()[n] - m_model.added_mass()[n]) * m_gravity + m_external[n]; // real material only
     return f;
 }
 
