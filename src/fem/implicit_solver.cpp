@@ -112,6 +112,7 @@ void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
 
 void ImplicitSolver::set_water(std::uint32_t element, double water)
 {
+    m_element_pass_current = false;
     if (m_water.empty()) m_water.assign(m_model.elements().size(), 0.0);
     m_water[element] = std::clamp(std::isfinite(water) ? water : 0.0, 0.0, 1.0);
     const auto material = static_cast<std::size_t>(m_model.elements()[element].material);
@@ -152,30 +153,35 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
 {
     const Eigen::Matrix3d& frame = m_model.frame();
     const auto& elements = m_model.elements();
-    // Element pass: rotation, corotated displacements, elastic forces and energy.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t e = range.begin(); e != range.end(); ++e) {
-            const HexElement& el = elements[e];
-            // Displacements relative to corner 0: K ignores translations, and far from the origin
-            // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
-            const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
-            Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-            for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
-            extract_rotation(frame.transpose() * f, m_rotation[e]);
-            const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
-            m_element_rotation[e] = r;
-            const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
-            Vector24d u;
-            for (int c = 0; c < 8; ++c)
-                u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
-            const double scale = m_stiffness_scale[e];
-            Vector24d fl = scale * ((*el.stiffness) * u);
-            m_element_energy[e] = 0.5 * u.dot(fl);
-            if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
-                m_element_energy[e] += plastic_correction(e, u, fl);
-            for (int c = 0; c < 8; ++c) m_element_force[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
-        }
-    });
+    // Element pass: rotation, corotated displacements, elastic forces and energy. A dynamic step
+    // ends with this pass at its new positions (the energy check); the next step starts from the
+    // same positions and reuses it, unless plastic strain is due to creep first.
+    if (!(m_element_pass_current && m_plastic.empty())) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t e = range.begin(); e != range.end(); ++e) {
+                const HexElement& el = elements[e];
+                // Displacements relative to corner 0: K ignores translations, and far from the origin
+                // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
+                const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
+                Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+                for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
+                extract_rotation(frame.transpose() * f, m_rotation[e]);
+                const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
+                m_element_rotation[e] = r;
+                const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
+                Vector24d u;
+                for (int c = 0; c < 8; ++c)
+                    u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
+                const double scale = m_stiffness_scale[e];
+                Vector24d fl = scale * ((*el.stiffness) * u);
+                m_element_energy[e] = 0.5 * u.dot(fl);
+                if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
+                    m_element_energy[e] += plastic_correction(e, u, fl);
+                for (int c = 0; c < 8; ++c) m_element_force[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
+            }
+        });
+    }
+    m_element_pass_current = true;
     // Node pass: each node gathers its forces and writes its own three matrix rows, so threads
     // never write the same entry and every write stays within a few cache lines.
     double* values = m_matrix.valuePtr();
@@ -448,6 +454,7 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     s.solve_ms += ms_since(t);
     v = next;
     x += dt * v;
+    m_element_pass_current = false;
     return dt * f_ext.dot(v); // work of the external forces over the step
 }
 
@@ -472,6 +479,7 @@ void ImplicitSolver::advance(double dt, int depth, StepStats& s)
         return;
     }
     m_x = x0;
+    m_element_pass_current = false;
     m_v = v0;
     m_plastic = plastic0;
     ++s.substeps;
@@ -517,6 +525,7 @@ StepStats ImplicitSolver::step()
             s.cg_iterations += solve(rhs, dx, cg_residual);
             s.solve_ms += ms_since(t);
             x += dx;
+            m_element_pass_current = false;
             ++s.newton_iterations;
         }
     }

@@ -87,7 +87,11 @@ public:
     StepStats step();
 
     [[nodiscard]] const std::vector<Eigen::Vector3d>& positions() const { return m_x; }
-    [[nodiscard]] std::vector<Eigen::Vector3d>& positions() { return m_x; }
+    [[nodiscard]] std::vector<Eigen::Vector3d>& positions()
+    {
+        m_element_pass_current = false; // the caller may move nodes
+        return m_x;
+    }
     [[nodiscard]] const std::vector<Eigen::Vector3d>& velocities() const { return m_v; }
     [[nodiscard]] std::vector<Eigen::Vector3d>& velocities() { return m_v; }
     /// Total linear momentum, kg m/s.
@@ -159,6 +163,7 @@ private:
     bool m_update_plastic = false;          ///< the next assembly starts a step: let strain creep
     double m_step_dt = 0.0;                 ///< the (sub)step being taken, s
     double m_last_dt = 0.0;                 ///< of the last dynamic solve
+    bool m_element_pass_current = false;    ///< rotations and element forces match m_x
 };
 
 } // namespace vox::fem
