@@ -473,7 +473,7 @@ void ImplicitSolver::advance(double dt, int depth, StepStats& s)
     s.kinetic_energy_j = kinetic_energy();
     s.elastic_energy_j = elastic_energy();
     const double after = s.kinetic_energy_j + s.elastic_energy_j;
-    const double slack = 1e-2 * (before + std::abs(work)) + 1e-15;
+    const double slack = 1e-3 * (before + std::abs(work)) + 1e-15;
     if (!(after > before + work + slack) || depth == max_depth) {
         s.energy_guarded = s.energy_guarded || depth == max_depth;
         return;
