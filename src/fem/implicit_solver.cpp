@@ -57,34 +57,51 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
         return; // no matrix
     }
 
-    // The matrix pattern: 3 x 3 blocks for every pair of nodes sharing an element; each element
-    // keeps the positions of its 576 entries so assembly is a plain accumulation.
-    std::vector<Eigen::Triplet<double>> pattern;
-    pattern.reserve(model.elements().size() * 576);
-    for (const HexElement& e : model.elements())
+    // The matrix pattern: a 3 x 3 block for every pair of nodes sharing an element. Built from
+    // each node's sorted neighbour list (never from triplets: on the liver at level 1 those
+    // would be 235 million). Node a's three rows hold the same columns, so an entry's position
+    // is outer[3a] + i * row_length + 3 * rank + j, rank being b's place among a's neighbours;
+    // each element keeps the ranks of its 64 corner pairs.
+    std::vector<std::uint32_t> neighbour_start(n + 1, 0), neighbours;
+    {
+        std::vector<std::uint32_t> list;
+        for (std::size_t a = 0; a < n; ++a) {
+            list.clear();
+            for (std::uint32_t k = m_incidence_start[a]; k < m_incidence_start[a + 1]; ++k)
+                for (std::uint32_t b : model.elements()[m_incidence[k] / 8].dof_node) list.push_back(b);
+            std::sort(list.begin(), list.end());
+            list.erase(std::unique(list.begin(), list.end()), list.end());
+            neighbours.insert(neighbours.end(), list.begin(), list.end());
+            neighbour_start[a + 1] = static_cast<std::uint32_t>(neighbours.size());
+        }
+    }
+    m_matrix.resize(static_cast<Eigen::Index>(3 * n), static_cast<Eigen::Index>(3 * n));
+    m_matrix.resizeNonZeros(static_cast<Eigen::Index>(9 * neighbours.size()));
+    int* outer = m_matrix.outerIndexPtr();
+    int* inner = m_matrix.innerIndexPtr();
+    outer[0] = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+        const std::uint32_t degree = neighbour_start[a + 1] - neighbour_start[a];
+        for (std::size_t i = 0; i < 3; ++i) {
+            int position = outer[3 * a + i];
+            for (std::uint32_t k = neighbour_start[a]; k < neighbour_start[a + 1]; ++k)
+                for (int j = 0; j < 3; ++j) inner[position++] = 3 * static_cast<int>(neighbours[k]) + j;
+            outer[3 * a + i + 1] = outer[3 * a + i] + static_cast<int>(3 * degree);
+        }
+    }
+    std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + m_matrix.nonZeros(), 0.0);
+    auto rank = [&](std::uint32_t a, std::uint32_t b) {
+        return static_cast<std::uint16_t>(std::lower_bound(neighbours.begin() + neighbour_start[a], neighbours.begin() + neighbour_start[a + 1], b) -
+                                          (neighbours.begin() + neighbour_start[a]));
+    };
+    m_rank.resize(model.elements().size() * 64);
+    for (std::size_t e = 0; e < model.elements().size(); ++e)
         for (int c = 0; c < 8; ++c)
             for (int d = 0; d < 8; ++d)
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j)
-                        pattern.emplace_back(3 * static_cast<int>(e.dof_node[c]) + i, 3 * static_cast<int>(e.dof_node[d]) + j, 0.0);
-    m_matrix.resize(static_cast<Eigen::Index>(3 * n), static_cast<Eigen::Index>(3 * n));
-    m_matrix.setFromTriplets(pattern.begin(), pattern.end());
-    m_matrix.makeCompressed();
-    m_slot.resize(model.elements().size() * 576);
-    const int* outer = m_matrix.outerIndexPtr();
-    const int* inner = m_matrix.innerIndexPtr();
-    auto position = [&](int row, int col) {
-        return static_cast<int>(std::lower_bound(inner + outer[row], inner + outer[row + 1], col) - inner);
-    };
-    std::size_t k = 0;
-    for (const HexElement& e : model.elements())
-        for (int c = 0; c < 8; ++c)
-            for (int i = 0; i < 3; ++i)
-                for (int d = 0; d < 8; ++d)
-                    for (int j = 0; j < 3; ++j)
-                        m_slot[k++] = position(3 * static_cast<int>(e.dof_node[c]) + i, 3 * static_cast<int>(e.dof_node[d]) + j);
-    m_diagonal_slot.resize(3 * n);
-    for (std::size_t i = 0; i < 3 * n; ++i) m_diagonal_slot[i] = position(static_cast<int>(i), static_cast<int>(i));
+                m_rank[64 * e + 8 * static_cast<std::size_t>(c) + static_cast<std::size_t>(d)] =
+                    rank(model.elements()[e].dof_node[c], model.elements()[e].dof_node[d]);
+    m_diagonal_rank.resize(n);
+    for (std::uint32_t a = 0; a < n; ++a) m_diagonal_rank[a] = rank(a, a);
 }
 
 void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
@@ -211,21 +228,26 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
             }
             const int* outer = m_matrix.outerIndexPtr();
             std::fill(values + outer[3 * n], values + outer[3 * n + 3], 0.0); // this node's three rows
+            const int row_length = outer[3 * n + 1] - outer[3 * n];
             for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
                 const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
                 const HexElement& el = elements[e];
                 const Eigen::Matrix3d& r = m_element_rotation[e];
                 const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
-                const int* slot = &m_slot[576 * std::size_t{e} + 72 * c];
+                const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
                 for (int d = 0; d < 8; ++d) {
                     Eigen::Matrix3d block = rk * el.stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * d) * r.transpose();
                     if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
+                    double* at = values + outer[3 * n] + 3 * ranks[d];
                     for (int i = 0; i < 3; ++i)
-                        for (int j = 0; j < 3; ++j) values[slot[24 * i + 3 * d + j]] += block(i, j);
+                        for (int j = 0; j < 3; ++j) at[i * row_length + j] += block(i, j);
                 }
             }
-            for (std::size_t i = 0; i < 3; ++i) values[m_diagonal_slot[3 * n + i]] += m_scale * diagonal_mass;
-            for (std::size_t i = 0; i < 3; ++i) m_diagonal[static_cast<Eigen::Index>(3 * n + i)] = values[m_diagonal_slot[3 * n + i]];
+            double* diagonal = values + outer[3 * n] + 3 * m_diagonal_rank[n];
+            for (int i = 0; i < 3; ++i) {
+                diagonal[i * row_length + i] += m_scale * diagonal_mass;
+                m_diagonal[static_cast<Eigen::Index>(3 * n) + i] = diagonal[i * row_length + i];
+            }
         }
     });
     m_update_plastic = false;

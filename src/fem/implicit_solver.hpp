@@ -141,8 +141,8 @@ private:
     std::vector<unsigned char> m_fixed; ///< per dof
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     SystemMatrix m_matrix;
-    std::vector<int> m_slot;            ///< per element, 576 positions in m_matrix's values
-    std::vector<int> m_diagonal_slot;   ///< per dof, its diagonal's position in m_matrix's values
+    std::vector<std::uint16_t> m_rank;          ///< per element and corner pair (c, d): d's node among c's node's neighbours
+    std::vector<std::uint16_t> m_diagonal_rank; ///< per node: its own place among its neighbours
     std::vector<std::uint32_t> m_incidence_start;     ///< per node, into m_incidence
     std::vector<std::uint32_t> m_incidence;           ///< 8 element + corner, grouped by node
     std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
