@@ -36,8 +36,15 @@ void add_check_command(CLI::App& app)
             std::printf("  label %d: %llu voxels, E = %g Pa, nu = %g, rho = %g kg/m^3\n", label,
                         static_cast<unsigned long long>(n), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3);
         }
-        std::printf("level %d: %zu occupied cells of %d^3 voxels\n", level, grid::occupied_cells(labels, level).size(),
-                    1 << level);
+        if (scene.object.auto_levels) {
+            if (scene.object.step_budget_ms)
+                std::printf("level: auto, the finest whose step fits %g ms\n", *scene.object.step_budget_ms);
+            else
+                std::printf("level: auto, the coarsest within %g %% of the next finer level\n", 100 * scene.object.max_error.value_or(0.0));
+        } else {
+            std::printf("level %d: %zu occupied cells of %d^3 voxels\n", level, grid::occupied_cells(labels, level).size(),
+                        1 << level);
+        }
         std::printf("solver: %s, dt %g s, CG tolerance %g, at most %d iterations\n",
                     scene.solver.type == io::SolverType::dbg ? "dbg" : "isxfem", scene.solver.dt_s,
                     scene.solver.cg_tolerance, scene.solver.cg_max_iterations);

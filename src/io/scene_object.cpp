@@ -47,7 +47,8 @@ grid::LabelGrid build_scene_object(const Scene& scene)
 void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
 {
     if (scene.constraints.empty()) return;
-    const int level = scene.object.levels;
+    // "auto": the run checks again at the level it picks; here the voxel corners (level 0).
+    const int level = scene.object.auto_levels ? 0 : scene.object.levels;
     const std::vector<grid::Coord> cells = grid::occupied_cells(labels, level);
     for (std::size_t c = 0; c < scene.constraints.size(); ++c) {
         const Constraint& con = scene.constraints[c];
