@@ -1,7 +1,7 @@
 #include "fem/implicit_solver.hpp"
 #include "fem/multigrid.hpp"
 
-#include "grid/phantom.hpp"
+#include "fem/block_grid.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -13,16 +13,9 @@ using namespace vox::fem;
 
 namespace {
 
-constexpr double k_e = 1e5, k_nu = 0.3, k_rho = 1000.0;
-
-grid::BranchedGrid block_grid(const Eigen::Vector3d& size_mm, double voxel_mm, int levels)
-{
-    grid::PhantomSpec s = grid::default_phantom(grid::PhantomShape::block);
-    s.size_mm = size_mm;
-    s.voxel_mm = voxel_mm;
-    return grid::BranchedGrid(grid::FineVoxels(grid::make_phantom(s), [](std::int32_t) { return 0; }),
-                              {{grid::lame_from_young_poisson(k_e, k_nu), k_rho}}, levels);
-}
+using test::block_grid;
+using test::k_e;
+using test::k_nu;
 
 /// Nodes whose rest coordinate `axis` equals `value` (m) to 1e-9.
 std::vector<std::uint32_t> nodes_at(const HexModel& m, int axis, double value)
@@ -37,7 +30,7 @@ std::vector<std::uint32_t> nodes_at(const HexModel& m, int axis, double value)
 
 TEST(ImplicitSolver, RigidMotionsStoreNoEnergy)
 {
-    const auto grid = block_grid({8, 4, 4}, 1, 2);
+    const auto grid = block_grid({8, 4, 4}, 2);
     const HexModel model(grid, 1);
     SolverOptions o;
     o.quasi_static = true;
@@ -56,7 +49,7 @@ TEST(ImplicitSolver, UniaxialCompressionMatchesFLOverEAAndPatchTest)
 {
     // A 12 x 4 x 4 mm bar, symmetry planes held by slide constraints, a force F on its far end.
     const double h = 1e-3, length = 12e-3, side = 4e-3, force = -0.5;
-    const auto grid = block_grid({12, 4, 4}, 1, 1);
+    const auto grid = block_grid({12, 4, 4}, 1);
     for (int level : {0, 1}) {
     SCOPED_TRACE(testing::Message() << "level " << level);
     const HexModel model(grid, level);
@@ -96,7 +89,7 @@ TEST(ImplicitSolver, UniaxialCompressionMatchesFLOverEAAndPatchTest)
 
 TEST(ImplicitSolver, MomentumIsConservedWithoutLoadsAndDamping)
 {
-    const auto grid = block_grid({6, 4, 4}, 1, 2);
+    const auto grid = block_grid({6, 4, 4}, 2);
     const HexModel model(grid, 1);
     SolverOptions o;
     o.cg_tolerance = 1e-12;
@@ -112,7 +105,7 @@ TEST(ImplicitSolver, MomentumIsConservedWithoutLoadsAndDamping)
 
 TEST(ImplicitSolver, DampingMakesEnergyDecay)
 {
-    const auto grid = block_grid({8, 4, 4}, 1, 2);
+    const auto grid = block_grid({8, 4, 4}, 2);
     const HexModel model(grid, 1);
     SolverOptions o;
     o.rayleigh_mass_per_s = 2.0;
@@ -135,7 +128,7 @@ TEST(ImplicitSolver, DampingMakesEnergyDecay)
 TEST(Multigrid, PreconditionedSolveMatchesJacobiWithFarFewerIterations)
 {
     // A cantilever sagging under gravity, quasi-static: bending makes Jacobi-CG slow.
-    const auto grid = block_grid({64, 8, 8}, 1, 4);
+    const auto grid = block_grid({64, 8, 8}, 4);
     const HexModel model(grid, 1);
     SolverOptions o;
     o.quasi_static = true;

@@ -6,7 +6,7 @@
 #include "fem/implicit_solver.hpp"
 #include "fem/rest_cholesky.hpp"
 
-#include "grid/phantom.hpp"
+#include "fem/block_grid.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,15 +15,9 @@ using namespace vox::fem;
 
 namespace {
 
-constexpr double k_e = 1e5, k_nu = 0.3, k_rho = 1000.0;
-
-grid::BranchedGrid block_grid(const Eigen::Vector3d& size_mm, int levels)
-{
-    grid::PhantomSpec s = grid::default_phantom(grid::PhantomShape::block);
-    s.size_mm = size_mm;
-    return grid::BranchedGrid(grid::FineVoxels(grid::make_phantom(s), [](std::int32_t) { return 0; }),
-                              {{grid::lame_from_young_poisson(k_e, k_nu), k_rho}}, levels);
-}
+using test::block_grid;
+using test::k_e;
+using test::k_nu;
 
 /// Holds the nodes at x = -0.5 mm (the block's first face).
 void clamp(const HexModel& model, ImplicitSolver& solver)
