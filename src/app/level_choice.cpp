@@ -1,11 +1,13 @@
 #include "app/level_choice.hpp"
 
 #include "app/scene_simulation.hpp"
+#include "core/error.hpp"
 #include "core/log.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 namespace vox::app {
 namespace {
@@ -29,6 +31,10 @@ std::string percent(double fraction)
 
 LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, double budget_ms)
 {
+    // A budget is for interactive stepping: time dynamic steps even for a static scene (a
+    // converged static frame costs next to nothing and would make every level "fit").
+    io::Scene dynamic = scene;
+    dynamic.solver.mode = io::SolverMode::dynamic;
     LevelChoice out;
     const int finest = finest_level(grid);
     double previous_ms = 0.0;
@@ -39,17 +45,25 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, do
         const std::size_t elements = level == 0 ? grid.voxels().alive_count() : grid.level(level).elements.size();
         if (previous_elements && previous_ms * static_cast<double>(elements) / static_cast<double>(previous_elements) > 20 * budget_ms)
             break;
-        SceneSimulation sim(scene, grid, level);
-        sim.solver().step(); // warm-up: first factorisations, caches
+        // A scene whose boxes catch nothing at a coarse level can still run at a finer one.
+        std::unique_ptr<SceneSimulation> sim;
+        try {
+            sim = std::make_unique<SceneSimulation>(dynamic, grid, level);
+        } catch (const InputError& e) {
+            log::info("levels auto: level {} skipped: {}", level, e.what());
+            continue;
+        }
+        sim->solver().step(); // warm-up: first factorisations, caches
         std::vector<double> ms;
-        for (int k = 0; k < 3; ++k) ms.push_back(sim.solver().step().step_ms);
+        for (int k = 0; k < 3; ++k) ms.push_back(sim->solver().step().step_ms);
         std::sort(ms.begin(), ms.end());
-        out.trials.push_back({level, sim.solver().dof_count(), ms[1], -1.0});
-        log::info("levels auto: level {} steps in {:.2f} ms ({} DOFs)", level, ms[1], sim.solver().dof_count());
+        out.trials.push_back({level, sim->solver().dof_count(), ms[1], -1.0});
+        log::info("levels auto: level {} steps in {:.2f} ms ({} DOFs)", level, ms[1], sim->solver().dof_count());
         if (ms[1] > budget_ms) break;
         previous_ms = ms[1];
         previous_elements = elements;
     }
+    if (out.trials.empty()) throw scene.error("object.levels", "no level can simulate this scene (see the messages above)");
     const auto fits = std::find_if(out.trials.rbegin(), out.trials.rend(), [&](const LevelTrial& t) { return t.step_ms <= budget_ms; });
     if (fits == out.trials.rend()) {
         out.level = out.trials.front().level;
@@ -84,9 +98,19 @@ LevelChoice by_error(const io::Scene& scene, const grid::BranchedGrid& grid, dou
                                               "a free object has no equilibrium to compare");
     LevelChoice out;
     const int finest = finest_level(grid);
+    // Start at the coarsest level the scene's boxes can use.
     std::size_t dofs = 0;
-    std::vector<Eigen::Vector3d> coarse = static_displacements(scene, grid, grid.max_level(), dofs);
-    for (int level = grid.max_level(); level > finest; --level) {
+    int start = grid.max_level();
+    std::vector<Eigen::Vector3d> coarse;
+    for (; start > finest; --start) {
+        try {
+            coarse = static_displacements(scene, grid, start, dofs);
+            break;
+        } catch (const InputError& e) {
+            log::info("levels auto: level {} skipped: {}", start, e.what());
+        }
+    }
+    for (int level = start; level > finest; --level) {
         std::size_t finer_dofs = 0;
         const std::vector<Eigen::Vector3d> finer = static_displacements(scene, grid, level - 1, finer_dofs);
         double diff = 0.0, norm = 0.0;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace vox::fem {
 
@@ -21,10 +22,6 @@ void SolverOptions::validate() const
     if (!(rayleigh_mass_per_s >= 0.0) || !(rayleigh_stiffness_s >= 0.0)) bad("Rayleigh damping must not be negative");
     if (newton_max_iterations < 1) bad("newton_max_iterations must be at least 1");
 }
-
-namespace {
-
-} // namespace
 
 ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& options)
     : m_model(model), m_options(options)
@@ -75,6 +72,9 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
             neighbour_start[a + 1] = static_cast<std::uint32_t>(neighbours.size());
         }
     }
+    if (9 * neighbours.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        throw InputError("solver: the model has too many node couplings (" + std::to_string(9 * neighbours.size()) +
+                         " matrix entries) for an assembled matrix; use a coarser level or \"preconditioner\": \"jacobi\"");
     m_matrix.resize(static_cast<Eigen::Index>(3 * n), static_cast<Eigen::Index>(3 * n));
     m_matrix.resizeNonZeros(static_cast<Eigen::Index>(9 * neighbours.size()));
     int* outer = m_matrix.outerIndexPtr();
@@ -119,6 +119,7 @@ void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
 
 void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
 {
+    m_element_pass_current = false; // cached forces may hold plastic corrections
     m_behaviour = std::move(behaviour);
     m_behaviour.resize(std::max(m_behaviour.size(), m_model.materials().size()));
     const bool plastic = std::any_of(m_behaviour.begin(), m_behaviour.end(), [](const MaterialBehaviour& b) { return b.plastic(); });
@@ -425,6 +426,11 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         r -= alpha * q;
         precondition(r, z);
         const double rz_next = r.dot(z);
+        if (!(rz_next > 0.0)) { // a semidefinite preconditioner (or r = 0): nothing more to gain
+            residual = scaled_norm(r);
+            ++it;
+            break;
+        }
         p = z + (rz_next / rz) * p;
         rz = rz_next;
         residual = scaled_norm(r);
@@ -490,16 +496,21 @@ void ImplicitSolver::advance(double dt, int depth, StepStats& s)
     const std::vector<Eigen::Vector3d> x0 = m_x, v0 = m_v;
     const std::vector<Eigen::Matrix3d> plastic0 = m_plastic;
     m_update_plastic = !m_plastic.empty();
+    const bool converged0 = s.converged;
+    const double residual0 = s.residual;
     double before = 0.0;
     const double work = linear_step(dt, s, before);
     s.kinetic_energy_j = kinetic_energy();
     s.elastic_energy_j = elastic_energy();
     const double after = s.kinetic_energy_j + s.elastic_energy_j;
     const double slack = 1e-3 * (before + std::abs(work)) + 1e-15;
-    if (!(after > before + work + slack) || depth == max_depth) {
-        s.energy_guarded = s.energy_guarded || depth == max_depth;
+    const bool physical = std::isfinite(after) && after <= before + work + slack; // NaN is never physical
+    if (physical || depth == max_depth) {
+        s.energy_guarded = s.energy_guarded || !physical;
         return;
     }
+    s.converged = converged0; // the undone attempt does not count
+    s.residual = residual0;
     m_x = x0;
     m_element_pass_current = false;
     m_v = v0;
@@ -513,17 +524,15 @@ StepStats ImplicitSolver::step()
 {
     const auto start = std::chrono::steady_clock::now();
     StepStats s;
-    const double dt = m_options.dt_s;
-    m_update_plastic = !m_plastic.empty(); // plastic strain creeps once per step, at its start
-    m_step_dt = dt;
-    const auto n = static_cast<Eigen::Index>(3 * m_x.size());
-    const Eigen::VectorXd f_ext = external_force();
-    Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
-    Eigen::Map<Eigen::VectorXd> x(m_x.front().data(), n);
-
     if (!m_options.quasi_static) {
-        advance(dt, 0, s);
+        advance(m_options.dt_s, 0, s);
     } else {
+        m_update_plastic = !m_plastic.empty(); // plastic strain creeps once per frame, at its start
+        m_step_dt = m_options.dt_s;
+        const auto n = static_cast<Eigen::Index>(3 * m_x.size());
+        const Eigen::VectorXd f_ext = external_force();
+        Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
+        Eigen::Map<Eigen::VectorXd> x(m_x.front().data(), n);
         v.setZero();
         double scale = 0.0;
         for (Eigen::Index i = 0; i < n; ++i)

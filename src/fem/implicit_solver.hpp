@@ -80,7 +80,6 @@ public:
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
     void set_preconditioner(std::unique_ptr<Preconditioner> p);
-    [[nodiscard]] const char* preconditioner_name() const { return m_preconditioner ? m_preconditioner->name() : "Jacobi"; }
     /// Set when the given preconditioner could not be built and Jacobi took over; empty otherwise.
     [[nodiscard]] const std::string& fallback_note() const { return m_fallback_note; }
 

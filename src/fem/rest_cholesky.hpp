@@ -26,9 +26,7 @@ public:
     void invalidate() override { m_stale = true; }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
-    /// How many times the matrix has been factored, and whether the last attempt failed (a
-    /// singular matrix: the caller should fall back to another preconditioner).
-    [[nodiscard]] int factorizations() const { return m_factorizations; }
+    /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
     [[nodiscard]] bool failed() const override { return m_failed; }
 
 private:
