@@ -16,5 +16,6 @@ void add_grid_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_ccd_check_command(CLI::App& app);
 
 } // namespace vox::app

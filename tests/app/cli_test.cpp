@@ -215,6 +215,16 @@ TEST(Cli, StabilityQuickSubsetNeverDiverges)
     EXPECT_TRUE(fs::exists(d / "stability.md"));
 }
 
+TEST(Cli, CcdCheckPrintsTheScoreLine)
+{
+    const auto r = run_voxsculpt("ccd-check " + quote(VOX_SOURCE_DIR "/data/ccd-queries/unit-tests/vertex-face/data_0_0.csv") + " --type vf");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "true_positives: 35 false_positives: 0 false_negatives: 0 true_negatives: 90\n");
+    const auto bad = run_voxsculpt("ccd-check " + quote(VOX_SOURCE_DIR "/data/ccd-queries/README.md") + " --type ee");
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(bad.err.find("README.md: line 1"), std::string::npos) << bad.err;
+}
+
 TEST(Cli, QuietPrintsNothingOnSuccess)
 {
     const fs::path d = fresh_dir("cli_quiet");

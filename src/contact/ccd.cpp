@@ -1,0 +1,102 @@
+#include "contact/ccd.hpp"
+
+#include "contact/interval.hpp"
+
+#include <functional>
+
+namespace vox::contact {
+namespace {
+
+/// The input points as intervals (their own rounding included), at both ends of the step.
+struct Motion {
+    std::array<IVec3, 4> start, end;
+};
+
+Motion motion(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, double ulps)
+{
+    auto lift = [ulps](const Eigen::Vector3d& p) {
+        return IVec3{Interval::widened(p.x(), p.x(), ulps), Interval::widened(p.y(), p.y(), ulps),
+                     Interval::widened(p.z(), p.z(), ulps)};
+    };
+    Motion m;
+    for (int i = 0; i < 4; ++i) {
+        m.start[static_cast<std::size_t>(i)] = lift(at0[static_cast<std::size_t>(i)]);
+        m.end[static_cast<std::size_t>(i)] = lift(at1[static_cast<std::size_t>(i)]);
+    }
+    return m;
+}
+
+/// Point i's position over the time interval t: start + t (end - start).
+IVec3 at(const Motion& m, int i, const Interval& t)
+{
+    const IVec3& s = m.start[static_cast<std::size_t>(i)];
+    return s + t * (m.end[static_cast<std::size_t>(i)] - s);
+}
+
+/// True when no contact is possible anywhere in the time interval t.
+using Excluder = std::function<bool(const Interval& t)>;
+
+bool search(const Excluder& excluded, double lo, double hi, int depth, int max_depth)
+{
+    if (excluded(Interval(lo, hi))) return false;
+    if (depth == max_depth) return true;
+    const double mid = 0.5 * (lo + hi);
+    return search(excluded, lo, mid, depth + 1, max_depth) || search(excluded, mid, hi, depth + 1, max_depth);
+}
+
+/// The boxes of the two groups of points (indices [0, split) and [split, 4)) over t do not meet.
+bool boxes_apart(const std::array<IVec3, 4>& p, int split)
+{
+    auto apart = [&](auto member) {
+        double lo_a = std::numeric_limits<double>::infinity(), hi_a = -lo_a, lo_b = lo_a, hi_b = -lo_a;
+        for (int i = 0; i < 4; ++i) {
+            const Interval& c = member(p[static_cast<std::size_t>(i)]);
+            double& lo = i < split ? lo_a : lo_b;
+            double& hi = i < split ? hi_a : hi_b;
+            lo = std::min(lo, c.lo);
+            hi = std::max(hi, c.hi);
+        }
+        return hi_a < lo_b || hi_b < lo_a;
+    };
+    return apart([](const IVec3& v) -> const Interval& { return v.x; }) || apart([](const IVec3& v) -> const Interval& { return v.y; }) ||
+           apart([](const IVec3& v) -> const Interval& { return v.z; });
+}
+
+} // namespace
+
+bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+{
+    const Motion m = motion(at0, at1, options.input_ulps);
+    const Excluder excluded = [&m](const Interval& t) {
+        const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
+        if (boxes_apart(p, 1)) return true;
+        const IVec3 b = p[2] - p[1], c = p[3] - p[1], q = p[0] - p[1];
+        const IVec3 n = cross(b, c);
+        if (!dot(q, n).contains_zero()) return true; // never coplanar in t
+        // Inside the triangle: q on the inner side of each edge (sign against the normal).
+        if (dot(cross(b, q), n).below_zero()) return true;
+        if (dot(cross(q, c), n).below_zero()) return true;
+        return dot(cross(c - b, q - b), n).below_zero();
+    };
+    return search(excluded, 0.0, 1.0, 0, options.max_depth);
+}
+
+bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+{
+    const Motion m = motion(at0, at1, options.input_ulps);
+    const Excluder excluded = [&m](const Interval& t) {
+        const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
+        if (boxes_apart(p, 2)) return true;
+        const IVec3 ea = p[1] - p[0], eb = p[3] - p[2], d = p[2] - p[0];
+        const IVec3 n = cross(ea, eb);
+        if (!dot(d, n).contains_zero()) return true; // never coplanar in t
+        // Crossing point a0 + s ea = b0 + u eb with s, u in [0, 1]: s |n|^2 = (d x eb) . n,
+        // u |n|^2 = (d x ea) . n.
+        const Interval nn = dot(n, n);
+        const Interval s = dot(cross(d, eb), n), u = dot(cross(d, ea), n);
+        return s.below_zero() || (nn - s).below_zero() || u.below_zero() || (nn - u).below_zero();
+    };
+    return search(excluded, 0.0, 1.0, 0, options.max_depth);
+}
+
+} // namespace vox::contact

@@ -1,0 +1,33 @@
+#pragma once
+// Continuous collision detection of two primitives moving linearly over a time step t in [0, 1]:
+// vertex-face (a point against a triangle) and edge-edge. Conservative: a query that has a
+// contact is never answered false; a query answered true may have none (a false positive).
+//
+// The contact conditions, written on relative positions that are linear in t: the four points are
+// coplanar (the cubic coplanarity equation, Provot 1997; Tang et al. 2010) and, at the same time,
+// the point lies inside the triangle / the two segments cross (sign conditions of degree 4 in t).
+// Instead of solving the cubic in floating point, which misses roots at tangencies and on
+// degenerate (always coplanar) motions, every condition is bounded over a time interval by
+// interval arithmetic with outward widening (error bounds on each operation, and on the inputs'
+// own rounding): an interval is discarded only when some condition provably fails throughout it,
+// else halved, down to a minimum width at which the query is reported as a contact.
+
+#include <Eigen/Core>
+
+#include <array>
+
+namespace vox::contact {
+
+struct CcdOptions {
+    int max_depth = 24;        ///< halvings of [0, 1] before a surviving interval counts as contact
+    double input_ulps = 1.0;   ///< each input coordinate is taken as x (1 +- input_ulps eps)
+};
+
+/// `at0` = {vertex, face corner 0, 1, 2} at t = 0, `at1` the same at t = 1.
+[[nodiscard]] bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
+                                   const CcdOptions& options = {});
+/// `at0` = {edge a end 0, a end 1, edge b end 0, b end 1} at t = 0, `at1` at t = 1.
+[[nodiscard]] bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
+                                 const CcdOptions& options = {});
+
+} // namespace vox::contact

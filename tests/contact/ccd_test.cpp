@@ -1,0 +1,118 @@
+// Continuous collision detection: hand-made motions with known answers, the benchmark query files
+// with ground truth (no false negatives allowed), and malformed query files.
+
+#include "contact/ccd_queries.hpp"
+#include "core/error.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace vox::contact;
+using Eigen::Vector3d;
+using Points = std::array<Vector3d, 4>;
+
+namespace {
+const Points triangle_at0{Vector3d(0.2, 0.2, 1.0), Vector3d(0, 0, 0), Vector3d(1, 0, 0), Vector3d(0, 1, 0)};
+
+Points moved(Points p, const Vector3d& vertex_end)
+{
+    p[0] = vertex_end;
+    return p;
+}
+} // namespace
+
+TEST(Ccd, VertexThroughTheFaceHits)
+{
+    EXPECT_TRUE(vertex_face_ccd(triangle_at0, moved(triangle_at0, {0.2, 0.2, -1.0})));
+    // Stopping exactly on the face at t = 1 still counts.
+    EXPECT_TRUE(vertex_face_ccd(triangle_at0, moved(triangle_at0, {0.2, 0.2, 0.0})));
+    // Through an edge and through a corner.
+    EXPECT_TRUE(vertex_face_ccd(moved(triangle_at0, {0.5, 0.0, 1.0}), moved(triangle_at0, {0.5, 0.0, -1.0})));
+    EXPECT_TRUE(vertex_face_ccd(moved(triangle_at0, {0.0, 0.0, 1.0}), moved(triangle_at0, {0.0, 0.0, -1.0})));
+}
+
+TEST(Ccd, VertexBesideOrShortOfTheFaceMisses)
+{
+    EXPECT_FALSE(vertex_face_ccd(moved(triangle_at0, {0.8, 0.8, 1.0}), moved(triangle_at0, {0.8, 0.8, -1.0})));
+    EXPECT_FALSE(vertex_face_ccd(triangle_at0, moved(triangle_at0, {0.2, 0.2, 1e-9})));
+    // Sliding in the face's plane for the whole step: inside touches, outside does not.
+    EXPECT_TRUE(vertex_face_ccd(moved(triangle_at0, {0.1, 0.1, 0}), moved(triangle_at0, {0.3, 0.3, 0})));
+    EXPECT_FALSE(vertex_face_ccd(moved(triangle_at0, {1.1, 1.1, 0}), moved(triangle_at0, {1.3, 1.3, 0})));
+}
+
+TEST(Ccd, MovingFaceSweepsOverAStillVertex)
+{
+    const Points at0{Vector3d(0.25, 0.25, 0.5), Vector3d(0, 0, 1), Vector3d(1, 0, 1), Vector3d(0, 1, 1)};
+    const Points at1{Vector3d(0.25, 0.25, 0.5), Vector3d(0, 0, 0), Vector3d(1, 0, 0), Vector3d(0, 1, 0)};
+    EXPECT_TRUE(vertex_face_ccd(at0, at1));
+}
+
+TEST(Ccd, EdgesCrossingOrApart)
+{
+    // Edge a along x at z = 1 moving down through edge b along y at z = 0.
+    const Points at0{Vector3d(-1, 0, 1), Vector3d(1, 0, 1), Vector3d(0, -1, 0), Vector3d(0, 1, 0)};
+    const Points at1{Vector3d(-1, 0, -1), Vector3d(1, 0, -1), Vector3d(0, -1, 0), Vector3d(0, 1, 0)};
+    EXPECT_TRUE(edge_edge_ccd(at0, at1));
+    // The same motion shifted past b's end.
+    Points miss0 = at0, miss1 = at1;
+    for (Points* p : {&miss0, &miss1}) {
+        (*p)[2].y() += 3;
+        (*p)[3].y() += 3;
+    }
+    EXPECT_FALSE(edge_edge_ccd(miss0, miss1));
+    // Parallel edges passing one above the other without meeting.
+    const Points par0{Vector3d(0, 0, 1), Vector3d(1, 0, 1), Vector3d(0, 1, 0), Vector3d(1, 1, 0)};
+    const Points par1{Vector3d(0, 0, 0.5), Vector3d(1, 0, 0.5), Vector3d(0, 1, 0), Vector3d(1, 1, 0)};
+    EXPECT_FALSE(edge_edge_ccd(par0, par1));
+}
+
+TEST(Ccd, BenchmarkQueriesHaveNoFalseNegatives)
+{
+    const std::filesystem::path root = VOX_SOURCE_DIR "/data/ccd-queries/unit-tests";
+    std::size_t queries = 0;
+    for (const char* kind : {"vertex-face", "edge-edge"})
+        for (const auto& entry : std::filesystem::directory_iterator(root / kind)) {
+            const auto q = read_ccd_queries(entry.path());
+            queries += q.size();
+            const CcdScore s = score_ccd(q, std::string(kind) == "vertex-face");
+            EXPECT_EQ(s.false_negatives, 0u) << entry.path();
+            EXPECT_EQ(s.true_positives + s.false_positives + s.false_negatives + s.true_negatives, q.size());
+            EXPECT_GT(s.true_negatives, 0u) << entry.path() << ": a test that says yes to everything proves nothing";
+        }
+    EXPECT_EQ(queries, 324u);
+}
+
+TEST(Ccd, MalformedQueryFilesNameTheFileAndLine)
+{
+    const auto dir = vox::test::fresh_dir("ccd_bad");
+    auto refused = [&](const std::string& name, const std::string& text, const std::string& problem) {
+        const auto path = dir / name;
+        std::ofstream(path) << text;
+        try {
+            static_cast<void>(read_ccd_queries(path));
+            ADD_FAILURE() << name << " was accepted";
+        } catch (const vox::InputError& e) {
+            const std::string message = e.what();
+            EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+            EXPECT_NE(message.find(problem), std::string::npos) << message;
+        }
+    };
+    std::string eight;
+    for (int i = 0; i < 8; ++i) eight += "1,1,2,1,3,1,0\n";
+    refused("short.csv", eight.substr(0, eight.size() - 14), "the last one is cut short");
+    refused("fields.csv", "1,1,2,1,3,1\n", "line 1: expected 7 comma-separated integers");
+    refused("fraction.csv", "1,1,2.5,1,3,1,0\n", "line 1: coordinate 2 is not a fraction");
+    refused("zero.csv", "1,0,2,1,3,1,0\n", "line 1: zero denominator");
+    refused("truth.csv", "1,1,2,1,3,1,2\n", "ground truth must be 0 or 1");
+    refused("empty.csv", "", "holds no query");
+    // Denominators beyond 64 bits are read (as doubles).
+    std::ofstream(dir / "big.csv") << [] {
+        std::string s;
+        for (int i = 0; i < 8; ++i) s += "1,36893488147419103232,2,1,3,1,0\n";
+        return s;
+    }();
+    EXPECT_EQ(read_ccd_queries(dir / "big.csv").size(), 1u);
+}
