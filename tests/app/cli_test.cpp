@@ -225,6 +225,16 @@ TEST(Cli, CcdCheckPrintsTheScoreLine)
     EXPECT_NE(bad.err.find("README.md: line 1"), std::string::npos) << bad.err;
 }
 
+TEST(Cli, DevicesListsOrExplains)
+{
+    // Never a silent empty list: either device lines or the reason there are none.
+    const auto r = run_voxsculpt("devices");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const bool listed = r.out.find(':') == 4; // "vvvv:pppp ..."
+    EXPECT_TRUE(listed || r.out.find("no HID devices") != std::string::npos || r.out.find("udev rule") != std::string::npos)
+        << r.out;
+}
+
 TEST(Cli, QuietPrintsNothingOnSuccess)
 {
     const fs::path d = fresh_dir("cli_quiet");
