@@ -1,0 +1,38 @@
+#pragma once
+// Recordings of a haptic session: one row per 1 ms tick with the device pose and buttons read and
+// the force sent (docs/recording-format.md). Numbers are written with 17 significant digits, so a
+// replay reads back exactly what was recorded and reproduces the same run bit for bit.
+
+#include "haptics/device.hpp"
+
+#include <filesystem>
+#include <vector>
+
+namespace vox::haptics {
+
+struct RecordedTick {
+    DeviceState state;
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+/// Writes atomically (a temporary file renamed into place).
+void write_recording(const std::filesystem::path& path, const std::vector<RecordedTick>& ticks);
+/// Throws InputError naming the file and line for anything malformed (header, field count,
+/// non-numbers, non-finite values, time going backwards).
+[[nodiscard]] std::vector<RecordedTick> read_recording(const std::filesystem::path& path);
+
+/// Plays a recording back: the state of the last tick at or before the asked time.
+class ReplayDevice final : public Device {
+public:
+    explicit ReplayDevice(std::vector<RecordedTick> ticks);
+    [[nodiscard]] std::string name() const override { return "replay"; }
+    [[nodiscard]] const DeviceLimits& limits() const override { return m_limits; }
+    bool read(double t_s, DeviceState& state) noexcept override;
+
+private:
+    std::vector<RecordedTick> m_ticks;
+    DeviceLimits m_limits;
+    std::size_t m_cursor = 0;
+};
+
+} // namespace vox::haptics
