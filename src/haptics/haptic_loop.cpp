@@ -1,0 +1,79 @@
+#include "haptics/haptic_loop.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <chrono>
+
+namespace vox::haptics {
+
+HapticLoop::HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity)
+    : m_device(device), m_model(std::move(model)), m_safety(safety)
+{
+    m_timings.period_error_ms.resize(capacity);
+    m_timings.force_us.resize(capacity);
+}
+
+HapticLoop::~HapticLoop() { stop(); }
+
+Eigen::Vector3d HapticLoop::tick(double t_s) noexcept
+{
+    m_device.read(t_s, m_state);
+    double age = 0.0;
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    try {
+        f = m_model(m_state, age);
+    } catch (...) { // a model that throws yields no force rather than ending the loop
+        age = 1e9;
+    }
+    f = m_safety.filter(f, t_s, age);
+    m_device.send(f, Eigen::Vector3d::Zero());
+    return f;
+}
+
+void HapticLoop::start()
+{
+    if (m_running.exchange(true)) return;
+    m_recorded = 0;
+    m_thread = std::thread([this] { run(); });
+}
+
+void HapticLoop::stop()
+{
+    if (!m_running.exchange(false)) return;
+    if (m_thread.joinable()) m_thread.join();
+    m_timings.period_error_ms.resize(m_recorded);
+    m_timings.force_us.resize(m_recorded);
+}
+
+void HapticLoop::run()
+{
+    sched_param p{};
+    p.sched_priority = sched_get_priority_max(SCHED_FIFO);
+    m_timings.realtime_priority = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+    using clock = std::chrono::steady_clock;
+    const auto period = std::chrono::microseconds(1000);
+    const auto start = clock::now();
+    auto deadline = start + period, previous = start;
+    while (m_running.load(std::memory_order_relaxed)) {
+        // Sleep until shortly before the deadline, then spin: sleeping alone wakes up late.
+        std::this_thread::sleep_until(deadline - std::chrono::microseconds(150));
+        while (clock::now() < deadline) {
+        }
+        const auto now = clock::now();
+        const auto begin = now;
+        tick(std::chrono::duration<double>(now - start).count());
+        const auto end = clock::now();
+        if (m_recorded < m_timings.force_us.size()) {
+            m_timings.period_error_ms[m_recorded] =
+                std::abs(std::chrono::duration<double, std::milli>(now - previous).count() - 1.0);
+            m_timings.force_us[m_recorded] = std::chrono::duration<double, std::micro>(end - begin).count();
+            ++m_recorded;
+        }
+        previous = now;
+        deadline += period;
+        if (deadline < now) deadline = now + period; // fell behind by a whole period: do not burst
+    }
+}
+
+} // namespace vox::haptics
