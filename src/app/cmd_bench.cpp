@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "app/bench_haptics.hpp"
 #include "app/bench_stability.hpp"
 #include "app/scene_simulation.hpp"
 #include "core/error.hpp"
@@ -235,6 +236,11 @@ void add_bench_command(CLI::App& app)
     tradeoff->add_option("--out", *out, "Folder for tradeoff.md and tradeoff.svg (default docs)");
     tradeoff->add_flag("--skip-liver", *skip_liver, "Only the beam (faster)");
     tradeoff->callback([out, skip_liver] { run_tradeoff(*out, !*skip_liver); });
+
+    auto seconds = std::make_shared<double>(10.0);
+    CLI::App* haptics = bench->add_subcommand("haptics", "Period error and force time of the 1 kHz loop beside a running simulation");
+    haptics->add_option("--seconds", *seconds, "How long to run (default 10)")->check(CLI::Range(0.5, 3600.0));
+    haptics->callback([seconds] { run_haptics_bench(*seconds); });
 
     auto stability_out = std::make_shared<std::string>("docs");
     auto quick = std::make_shared<bool>(false);
