@@ -62,11 +62,30 @@ bool boxes_apart(const std::array<IVec3, 4>& p, int split)
            apart([](const IVec3& v) -> const Interval& { return v.z; });
 }
 
+/// Tang, Curtis, Yoon and Manocha 2010's non-penetration filter for the coplanarity condition:
+/// q(t) . (b(t) x c(t)) is a cubic whose Bernstein coefficients over [0, 1] are the blossoms of
+/// the three linear factors; when all four are of one strict sign the four points are never
+/// coplanar in the step. Returns true when the filter proves that.
+bool never_coplanar(const IVec3& q0, const IVec3& q1, const IVec3& b0, const IVec3& b1, const IVec3& c0, const IVec3& c1)
+{
+    const Interval third = Interval::widened(1.0 / 3.0, 1.0 / 3.0);
+    const Interval k0 = dot(q0, cross(b0, c0));
+    const Interval k3 = dot(q1, cross(b1, c1));
+    const Interval k1 = third * (dot(q1, cross(b0, c0)) + dot(q0, cross(b1, c0)) + dot(q0, cross(b0, c1)));
+    const Interval k2 = third * (dot(q0, cross(b1, c1)) + dot(q1, cross(b0, c1)) + dot(q1, cross(b1, c0)));
+    const bool positive = k0.lo > 0 && k1.lo > 0 && k2.lo > 0 && k3.lo > 0;
+    const bool negative = k0.hi < 0 && k1.hi < 0 && k2.hi < 0 && k3.hi < 0;
+    return positive || negative;
+}
+
 } // namespace
 
 bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
 {
     const Motion m = motion(at0, at1, options.input_ulps);
+    if (never_coplanar(m.start[0] - m.start[1], m.end[0] - m.end[1], m.start[2] - m.start[1], m.end[2] - m.end[1],
+                       m.start[3] - m.start[1], m.end[3] - m.end[1]))
+        return false;
     const Excluder excluded = [&m](const Interval& t) {
         const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
         if (boxes_apart(p, 1)) return true;
@@ -84,6 +103,10 @@ bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array
 bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
 {
     const Motion m = motion(at0, at1, options.input_ulps);
+    // Coplanarity of d = b0 - a0 with ea and eb: the same cubic filter.
+    if (never_coplanar(m.start[2] - m.start[0], m.end[2] - m.end[0], m.start[1] - m.start[0], m.end[1] - m.end[0],
+                       m.start[3] - m.start[2], m.end[3] - m.end[2]))
+        return false;
     const Excluder excluded = [&m](const Interval& t) {
         const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
         if (boxes_apart(p, 2)) return true;
