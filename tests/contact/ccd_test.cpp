@@ -116,3 +116,56 @@ TEST(Ccd, MalformedQueryFilesNameTheFileAndLine)
     }();
     EXPECT_EQ(read_ccd_queries(dir / "big.csv").size(), 1u);
 }
+
+#include "contact/mesh_ccd.hpp"
+
+namespace {
+/// A closed box mesh (12 triangles) of `size` centred at `centre`.
+MovingMesh box(const Vector3d& centre_start, const Vector3d& centre_end, double size)
+{
+    MovingMesh m;
+    for (int c = 0; c < 8; ++c) {
+        const Vector3d corner(c & 1 ? 0.5 : -0.5, c & 2 ? 0.5 : -0.5, c & 4 ? 0.5 : -0.5);
+        m.start.push_back(centre_start + size * corner);
+        m.end.push_back(centre_end + size * corner);
+    }
+    m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    return m;
+}
+
+/// A still floor: an n x n grid of squares over [-1, 1]^2 at z = 0.
+MovingMesh floor_mesh(int n)
+{
+    MovingMesh m;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) m.start.emplace_back(-1.0 + 2.0 * i / n, -1.0 + 2.0 * j / n, 0.0);
+    m.end = m.start;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const int v = j * (n + 1) + i;
+            m.triangles.emplace_back(v, v + 1, v + n + 2);
+            m.triangles.emplace_back(v, v + n + 2, v + n + 1);
+        }
+    return m;
+}
+} // namespace
+
+TEST(MeshCcd, AFallingBoxHitsTheFloorOnlyWhenItReachesIt)
+{
+    const MovingMesh floor = floor_mesh(16);
+    // Falls from 0.5 to 0.2 above the floor: no contact.
+    EXPECT_TRUE(mesh_ccd(box({0.1, 0.1, 0.6}, {0.1, 0.1, 0.3}, 0.2), floor).empty());
+    // Falls until its bottom face is 0.05 below the floor: only the bottom corners (0-3) reach it.
+    const auto hits = mesh_ccd(box({0.1, 0.1, 0.6}, {0.1, 0.1, 0.05}, 0.2), floor);
+    ASSERT_FALSE(hits.empty());
+    std::size_t corners = 0;
+    for (const MeshContact& c : hits)
+        if (c.kind == MeshContact::vertex_a_face_b) {
+            ++corners;
+            EXPECT_LT(c.a, 4u); // bottom corners: z = centre - 0.1
+        }
+    EXPECT_GE(corners, 4u);
+    // Moving sideways far from the floor's edge: nothing.
+    EXPECT_TRUE(mesh_ccd(box({3, 3, 0.05}, {4, 3, -0.05}, 0.05), floor).empty());
+}
