@@ -8,22 +8,24 @@
 
 namespace vox::contact {
 
+void swept_box(const MovingMesh& mesh, std::size_t triangle, Eigen::Vector3d& lo, Eigen::Vector3d& hi)
+{
+    lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    hi = -lo;
+    for (int c = 0; c < 3; ++c)
+        for (const auto* positions : {&mesh.start, &mesh.end}) {
+            const Eigen::Vector3d& p = (*positions)[static_cast<std::size_t>(mesh.triangles[triangle][c])];
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+        }
+}
+
 SweptBvh::SweptBvh(const MovingMesh& mesh)
 {
     const std::size_t n = mesh.triangles.size();
     m_triangle_lo.resize(n);
     m_triangle_hi.resize(n);
-    for (std::size_t t = 0; t < n; ++t) {
-        Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-        for (int c = 0; c < 3; ++c)
-            for (const auto* positions : {&mesh.start, &mesh.end}) {
-                const Eigen::Vector3d& p = (*positions)[static_cast<std::size_t>(mesh.triangles[t][c])];
-                lo = lo.cwiseMin(p);
-                hi = hi.cwiseMax(p);
-            }
-        m_triangle_lo[t] = lo;
-        m_triangle_hi[t] = hi;
-    }
+    for (std::size_t t = 0; t < n; ++t) swept_box(mesh, t, m_triangle_lo[t], m_triangle_hi[t]);
     m_order.resize(n);
     for (std::uint32_t t = 0; t < n; ++t) m_order[t] = t;
     if (n) {
@@ -64,31 +66,39 @@ std::uint32_t SweptBvh::build(std::uint32_t first, std::uint32_t count)
 std::vector<MeshContact> mesh_ccd(const MovingMesh& a, const MovingMesh& b, const CcdOptions& options)
 {
     const SweptBvh tree(b);
-    const SweptBvh own(a); // the boxes of a's triangles
     using Points = std::array<Eigen::Vector3d, 4>;
-    auto vertex_face = [&options](const MovingMesh& mv, int v, const MovingMesh& mf, const Eigen::Vector3i& f) {
-        auto at = [](const std::vector<Eigen::Vector3d>& p, int i) { return p[static_cast<std::size_t>(i)]; };
-        return vertex_face_ccd(Points{at(mv.start, v), at(mf.start, f[0]), at(mf.start, f[1]), at(mf.start, f[2])},
-                               Points{at(mv.end, v), at(mf.end, f[0]), at(mf.end, f[1]), at(mf.end, f[2])}, options);
+    auto at = [](const std::vector<Eigen::Vector3d>& p, std::uint32_t i) { return p[i]; };
+    // A vertex sits in about six triangles and an edge in two, so the same primitive pair comes up
+    // from several triangle pairs: each is tested once. Key: (kind, index, index, end, end).
+    using Key = std::tuple<int, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
+    std::set<Key> tested, found;
+    auto test = [&](const Key& key, auto&& collides) {
+        if (tested.insert(key).second && collides()) found.insert(key);
     };
-    // (kind, first index, second index, first edge end, second edge end): each contact once.
-    std::set<std::tuple<int, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> found;
+    auto vertex_face = [&](const MovingMesh& mv, std::uint32_t v, const MovingMesh& mf, const Eigen::Vector3i& f) {
+        auto c = [&f](int k) { return static_cast<std::uint32_t>(f[k]); };
+        return vertex_face_ccd(Points{at(mv.start, v), at(mf.start, c(0)), at(mf.start, c(1)), at(mf.start, c(2))},
+                               Points{at(mv.end, v), at(mf.end, c(0)), at(mf.end, c(1)), at(mf.end, c(2))}, options);
+    };
     for (std::uint32_t ta = 0; ta < a.triangles.size(); ++ta) {
         const Eigen::Vector3i& fa = a.triangles[ta];
-        tree.query(own.lo(ta), own.hi(ta), [&](std::uint32_t tb) {
+        Eigen::Vector3d lo, hi;
+        swept_box(a, ta, lo, hi);
+        tree.query(lo, hi, [&](std::uint32_t tb) {
             const Eigen::Vector3i& fb = b.triangles[tb];
             for (int i = 0; i < 3; ++i) {
-                if (vertex_face(a, fa[i], b, fb)) found.insert({MeshContact::vertex_a_face_b, static_cast<std::uint32_t>(fa[i]), tb, 0, 0});
-                if (vertex_face(b, fb[i], a, fa)) found.insert({MeshContact::vertex_b_face_a, static_cast<std::uint32_t>(fb[i]), ta, 0, 0});
+                const auto va = static_cast<std::uint32_t>(fa[i]), vb = static_cast<std::uint32_t>(fb[i]);
+                test({MeshContact::vertex_a_face_b, va, tb, 0, 0}, [&] { return vertex_face(a, va, b, fb); });
+                test({MeshContact::vertex_b_face_a, vb, ta, 0, 0}, [&] { return vertex_face(b, vb, a, fa); });
                 for (int j = 0; j < 3; ++j) {
                     auto ea0 = static_cast<std::uint32_t>(fa[i]), ea1 = static_cast<std::uint32_t>(fa[(i + 1) % 3]);
                     auto eb0 = static_cast<std::uint32_t>(fb[j]), eb1 = static_cast<std::uint32_t>(fb[(j + 1) % 3]);
-                    if (ea0 > ea1) std::swap(ea0, ea1); // an edge is shared by two triangles: test it once
+                    if (ea0 > ea1) std::swap(ea0, ea1);
                     if (eb0 > eb1) std::swap(eb0, eb1);
-                    if (found.count({MeshContact::edge_edge, ea0, eb0, ea1, eb1})) continue;
-                    if (edge_edge_ccd(Points{a.start[ea0], a.start[ea1], b.start[eb0], b.start[eb1]},
-                                      Points{a.end[ea0], a.end[ea1], b.end[eb0], b.end[eb1]}, options))
-                        found.insert({MeshContact::edge_edge, ea0, eb0, ea1, eb1});
+                    test({MeshContact::edge_edge, ea0, eb0, ea1, eb1}, [&] {
+                        return edge_edge_ccd(Points{a.start[ea0], a.start[ea1], b.start[eb0], b.start[eb1]},
+                                             Points{a.end[ea0], a.end[ea1], b.end[eb0], b.end[eb1]}, options);
+                    });
                 }
             }
         });

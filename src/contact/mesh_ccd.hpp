@@ -18,14 +18,15 @@ struct MovingMesh {
     std::vector<Eigen::Vector3i> triangles;
 };
 
+/// The box a triangle sweeps over the step (its corners at t = 0 and t = 1).
+void swept_box(const MovingMesh& mesh, std::size_t triangle, Eigen::Vector3d& lo, Eigen::Vector3d& hi);
+
 /// A box tree over a mesh's swept triangles (median split on the longest axis, leaves of up to 4).
 class SweptBvh {
 public:
     explicit SweptBvh(const MovingMesh& mesh);
     /// Calls visit(triangle) for every triangle whose swept box overlaps [lo, hi].
     template <class F> void query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, F&& visit) const;
-    [[nodiscard]] const Eigen::Vector3d& lo(std::uint32_t triangle) const { return m_triangle_lo[triangle]; }
-    [[nodiscard]] const Eigen::Vector3d& hi(std::uint32_t triangle) const { return m_triangle_hi[triangle]; }
 
 private:
     struct Node {
