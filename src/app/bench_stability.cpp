@@ -136,16 +136,17 @@ std::vector<Case> cases(const Object& object)
                            x.z() = 2 * origin.z() * 1e-3 - x.z();
                        }
                    }, {}});
+    // The scene's own load mechanism spreads the force over the nodes in the box; after the first
+    // step it is taken away again.
     const Eigen::Vector3d lo = object.tip_box_lo, hi = object.tip_box_hi;
-    out.push_back({"100 N on the free end for one step", {}, {}, [lo, hi](SceneSimulation& sim, int step) {
-                       std::vector<std::uint32_t> tip;
-                       for (std::uint32_t n = 0; n < sim.model().node_count(); ++n) {
-                           const Eigen::Vector3d p = sim.model().rest_positions()[n] * 1e3;
-                           if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) tip.push_back(n);
-                       }
-                       for (std::uint32_t n : tip)
-                           sim.solver().external_forces()[n] = step == 0 ? Eigen::Vector3d(0, 0, -100.0 / static_cast<double>(tip.size()))
-                                                                         : Eigen::Vector3d::Zero();
+    out.push_back({"100 N on the free end for one step",
+                   [lo, hi](nlohmann::json& s) {
+                       s["loads"] = {{{"box_mm", {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}}}, {"force_n", {0, 0, -100}}}};
+                   },
+                   {},
+                   [](SceneSimulation& sim, int step) {
+                       if (step == 1)
+                           for (Eigen::Vector3d& f : sim.solver().external_forces()) f.setZero();
                    }});
     return out;
 }

@@ -16,15 +16,8 @@ namespace {
 using test::block_grid;
 using test::k_e;
 using test::k_nu;
+using test::nodes_at;
 
-/// Nodes whose rest coordinate `axis` equals `value` (m) to 1e-9.
-std::vector<std::uint32_t> nodes_at(const HexModel& m, int axis, double value)
-{
-    std::vector<std::uint32_t> out;
-    for (std::uint32_t n = 0; n < m.node_count(); ++n)
-        if (std::abs(m.rest_positions()[n][axis] - value) < 1e-9) out.push_back(n);
-    return out;
-}
 
 } // namespace
 

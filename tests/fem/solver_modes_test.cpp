@@ -19,20 +19,18 @@ namespace {
 using test::block_grid;
 using test::k_e;
 using test::k_nu;
+using test::nodes_at;
 
 /// Holds the nodes at x = -0.5 mm (the block's first face).
 void clamp(const HexModel& model, ImplicitSolver& solver)
 {
-    for (std::uint32_t n = 0; n < model.node_count(); ++n)
-        if (std::abs(model.rest_positions()[n].x() + 0.0005) < 1e-9) solver.fix(n, 7);
+    for (std::uint32_t n : nodes_at(model, 0, -0.0005)) solver.fix(n, 7);
 }
 
 /// Pushes the nodes of the far face (x = length - 0.5 mm) with `force` (N) in total.
 void push_end(const HexModel& model, ImplicitSolver& solver, double length_mm, const Eigen::Vector3d& force)
 {
-    std::vector<std::uint32_t> end;
-    for (std::uint32_t n = 0; n < model.node_count(); ++n)
-        if (std::abs(model.rest_positions()[n].x() - (length_mm - 0.5) * 1e-3) < 1e-9) end.push_back(n);
+    const std::vector<std::uint32_t> end = nodes_at(model, 0, (length_mm - 0.5) * 1e-3);
     for (std::uint32_t n : end) solver.external_forces()[n] = force / static_cast<double>(end.size());
 }
 
@@ -206,12 +204,8 @@ TEST(SolverModes, WettingSoftensByItsLaw)
         solver.set_materials({b});
         for (std::uint32_t e = 0; e < model.elements().size(); ++e) solver.set_water(e, water);
         EXPECT_DOUBLE_EQ(solver.water(0), water);
-        for (std::uint32_t n = 0; n < model.node_count(); ++n) {
-            const Eigen::Vector3d p = model.rest_positions()[n];
-            if (std::abs(p.x() + 0.0005) < 1e-9) solver.fix(n, 1);
-            if (std::abs(p.y() + 0.0005) < 1e-9) solver.fix(n, 2);
-            if (std::abs(p.z() + 0.0005) < 1e-9) solver.fix(n, 4);
-        }
+        for (int axis = 0; axis < 3; ++axis)
+            for (std::uint32_t n : nodes_at(model, axis, -0.0005)) solver.fix(n, 1u << axis);
         // Consistent nodal loads of a uniform traction on the end face (2 x 2 mm faces).
         for (std::uint32_t n = 0; n < model.node_count(); ++n) {
             const Eigen::Vector3d p = model.rest_positions()[n];
@@ -223,10 +217,8 @@ TEST(SolverModes, WettingSoftensByItsLaw)
         const StepStats s = solver.step();
         ASSERT_TRUE(s.converged);
         const double expected = force * length / (k_e * (1.0 - 0.8 * water) * area);
-        for (std::uint32_t n = 0; n < model.node_count(); ++n)
-            if (std::abs(model.rest_positions()[n].x() - 0.0115) < 1e-9) {
-                EXPECT_NEAR(solver.positions()[n].x() - model.rest_positions()[n].x(), expected, 1e-6 * expected);
-            }
+        for (std::uint32_t n : nodes_at(model, 0, 0.0115))
+            EXPECT_NEAR(solver.positions()[n].x() - model.rest_positions()[n].x(), expected, 1e-6 * expected);
     }
 }
 
