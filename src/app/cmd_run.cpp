@@ -1,6 +1,7 @@
-// voxsculpt run: a headless simulation of a scene. The tools move kinematically along the script
-// (contact and cutting come with the cutting module); the object deforms under gravity, loads and
-// constraints. Writes DIR/stats.json, DIR/final.obj and DIR/frame_NNNNN.obj.
+// voxsculpt run: a headless simulation of a scene. The tools move kinematically along the script,
+// push the object by penalty contact, cut and wet it (app/tool_session.hpp); the object deforms
+// under gravity, loads, constraints and the tools. Writes DIR/stats.json, DIR/final.obj and
+// DIR/frame_NNNNN.obj.
 
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
@@ -9,6 +10,7 @@
 #include "core/progress.hpp"
 #include "app/level_choice.hpp"
 #include "app/scene_simulation.hpp"
+#include "app/tool_session.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -17,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -25,27 +28,13 @@
 namespace vox::app {
 namespace {
 
-/// Where each tool is at time t (linear between its script entries; before the first and after
-/// the last it stays put), world mm.
-std::vector<Eigen::Vector3d> tool_positions(const io::Scene& scene, double t)
+/// The q-quantile of `values` (nearest rank), 0 when empty.
+double percentile(std::vector<double> values, double q)
 {
-    std::vector<Eigen::Vector3d> out(scene.tools.size(), Eigen::Vector3d::Constant(std::nan("")));
-    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
-        const io::ScriptEntry* before = nullptr;
-        const io::ScriptEntry* after = nullptr;
-        for (const io::ScriptEntry& e : scene.script) {
-            if (e.tool_index != k) continue;
-            if (e.t_s <= t) before = &e;
-            if (e.t_s >= t && !after) after = &e;
-        }
-        if (before && after && after->t_s > before->t_s) {
-            const double a = (t - before->t_s) / (after->t_s - before->t_s);
-            out[k] = (1 - a) * before->position_mm + a * after->position_mm;
-        } else if (before || after) {
-            out[k] = (before ? before : after)->position_mm;
-        }
-    }
-    return out;
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size())));
+    return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
 void write_surface(const std::filesystem::path& path, const SceneSimulation& sim)
@@ -76,7 +65,7 @@ void add_run_command(CLI::App& app)
         const grid::LabelGrid labels = io::load_scene_object(scene);
         // Coarser levels than the simulated one serve the multigrid preconditioner; "auto" tries them all.
         const int max_level = scene.object.auto_levels ? 6 : std::min(6, std::max(scene.object.levels, 1) + 3);
-        const grid::BranchedGrid g = build_scene_grid(scene, labels, max_level);
+        grid::BranchedGrid g = build_scene_grid(scene, labels, max_level);
         LevelChoice choice;
         choice.level = scene.object.levels;
         if (scene.object.auto_levels) {
@@ -85,8 +74,8 @@ void add_run_command(CLI::App& app)
         }
         const int level = choice.level;
         SceneSimulation sim(scene, g, level);
-        fem::ImplicitSolver& solver = sim.solver();
-        const fem::HexModel& model = sim.model();
+        ToolSession tools(scene);
+        // A cut rebuilds the model and solver: always reach them through `sim`.
 
         const double dt = scene.solver.dt_s;
         const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
@@ -94,13 +83,13 @@ void add_run_command(CLI::App& app)
         const std::filesystem::path out = args->out.empty() ? scene.output.dir : std::filesystem::path(args->out);
         std::filesystem::create_directories(out);
         log::info("{}: level {}, {} elements, {} degrees of freedom, {} frames of {} s ({}; {}; {} mass{}{})", args->scene,
-                  level, model.elements().size(), solver.dof_count(), frames, dt,
+                  level, sim.model().elements().size(), sim.solver().dof_count(), frames, dt,
                   scene.solver.mode == io::SolverMode::static_equilibrium ? "quasi-static" : "implicit Euler",
                   sim.linear_solver(), scene.solver.lumped_mass ? "lumped" : "consistent",
-                  solver.has_plasticity() ? ", plastic" : "", scene.wet_regions.empty() ? "" : ", wetted regions");
+                  sim.solver().has_plasticity() ? ", plastic" : "", scene.wet_regions.empty() ? "" : ", wetted regions");
 
         nlohmann::json stats{{"scene", args->scene},       {"level", level},
-                             {"elements", model.elements().size()}, {"dofs", solver.dof_count()},
+                             {"elements", sim.model().elements().size()}, {"dofs", sim.solver().dof_count()},
                              {"dt_s", dt},                  {"linear_solver", sim.linear_solver()},
                              {"frames", nlohmann::json::array()}};
         if (scene.object.auto_levels) {
@@ -115,10 +104,16 @@ void add_run_command(CLI::App& app)
         }
         double total_ms = 0.0, max_ms = 0.0;
         int converged = 0;
+        std::size_t removed = 0, separated = 0;
+        std::vector<double> cutting_ms; // frames that cut: collision + propagation + grid update + remesh
         fem::StepStats last;
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
         for (int f = 1; f <= frames; ++f) {
-            last = solver.step();
+            const ToolFrameStats tf = tools.frame(sim, g, f * dt, dt);
+            removed += tf.removed_voxels;
+            separated += tf.separated_faces;
+            if (tf.removed_voxels + tf.separated_faces > 0) cutting_ms.push_back(tf.cutting_ms());
+            last = sim.solver().step();
             total_ms += last.step_ms;
             max_ms = std::max(max_ms, last.step_ms);
             converged += last.converged;
@@ -126,9 +121,18 @@ void add_run_command(CLI::App& app)
             if (!std::isfinite(last.elastic_energy_j) || !std::isfinite(last.kinetic_energy_j))
                 throw InputError(args->scene + ": the simulation diverged at frame " + std::to_string(f) +
                                  " (non-finite energy); reduce solver.dt_s or check the materials");
-            nlohmann::json tools = nlohmann::json::array();
-            for (const Eigen::Vector3d& p : tool_positions(scene, f * dt))
-                tools.push_back(p.allFinite() ? nlohmann::json{p.x(), p.y(), p.z()} : nlohmann::json(nullptr));
+            nlohmann::json tool_frames = nlohmann::json::array();
+            for (const ToolFrame& t : tf.tools) {
+                if (!t.placed) {
+                    tool_frames.push_back(nullptr);
+                    continue;
+                }
+                tool_frames.push_back({{"position_mm", {t.position_mm.x(), t.position_mm.y(), t.position_mm.z()}},
+                                       {"force_n", {t.force_n.x(), t.force_n.y(), t.force_n.z()}},
+                                       {"pressure_pa", t.pressure_pa},
+                                       {"contact_area_mm2", t.contact_area_mm2},
+                                       {"cut", t.cut}});
+            }
             stats["frames"].push_back({{"frame", f},
                                        {"t_s", f * dt},
                                        {"step_ms", last.step_ms},
@@ -142,7 +146,15 @@ void add_run_command(CLI::App& app)
                                        {"kinetic_energy_j", last.kinetic_energy_j},
                                        {"elastic_energy_j", last.elastic_energy_j},
                                        {"max_displacement_mm", last.max_displacement_m * 1e3},
-                                       {"tool_positions_mm", tools}});
+                                       {"collision_ms", tf.collision_ms},
+                                       {"propagation_ms", tf.propagation_ms},
+                                       {"grid_update_ms", tf.grid_update_ms},
+                                       {"remesh_ms", tf.remesh_ms},
+                                       {"fem_update_ms", tf.fem_update_ms},
+                                       {"removed_voxels", tf.removed_voxels},
+                                       {"separated_faces", tf.separated_faces},
+                                       {"elements", sim.model().elements().size()},
+                                       {"tools", tool_frames}});
             if (f % scene.output.mesh_every_n_frames == 0) {
                 char name[32];
                 std::snprintf(name, sizeof name, "frame_%05d.obj", f);
@@ -156,12 +168,18 @@ void add_run_command(CLI::App& app)
                             {"mean_step_ms", frames ? total_ms / frames : 0.0},
                             {"max_step_ms", max_ms},
                             {"converged_frames", converged},
+                            {"removed_voxels", removed},
+                            {"separated_faces", separated},
+                            {"voxels", g.voxels().alive_count()},
+                            {"cutting_frames", cutting_ms.size()},
+                            {"cutting_ms_p95", percentile(cutting_ms, 0.95)},
+                            {"final_elements", sim.model().elements().size()},
                             {"final_max_displacement_mm", last.max_displacement_m * 1e3},
                             {"final_elastic_energy_j", last.elastic_energy_j},
                             {"final_kinetic_energy_j", last.kinetic_energy_j}};
-        if (!solver.fallback_note().empty()) {
-            log::warn("{}", solver.fallback_note());
-            stats["linear_solver"] = solver.fallback_note();
+        if (!sim.solver().fallback_note().empty()) {
+            log::warn("{}", sim.solver().fallback_note());
+            stats["linear_solver"] = sim.solver().fallback_note();
         }
         write_surface(out / "final.obj", sim);
         write_atomically(out / "stats.json", [&](const std::filesystem::path& tmp) {

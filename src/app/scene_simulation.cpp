@@ -1,7 +1,11 @@
 #include "app/scene_simulation.hpp"
 
+#include "cut/state_transfer.hpp"
 #include "fem/multigrid.hpp"
 #include "fem/rest_cholesky.hpp"
+
+#include <chrono>
+#include <stdexcept>
 
 namespace vox::app {
 namespace {
@@ -58,7 +62,44 @@ grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGri
 }
 
 SceneSimulation::SceneSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
+    : m_scene(scene), m_grid(&grid), m_level(level)
 {
+    build(true);
+    m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
+    m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
+}
+
+CutTimings SceneSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
+                                      std::span<const std::pair<grid::Coord, int>> faces)
+{
+    if (&grid != m_grid) throw std::invalid_argument("SceneSimulation::apply_cut: not the grid it was built on");
+    CutTimings t;
+    auto start = std::chrono::steady_clock::now();
+    auto lap = [&start] {
+        const auto now = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+        start = now;
+        return ms;
+    };
+    const grid::UpdateReport report = grid.update(removed, faces);
+    t.grid_update_ms = lap();
+    m_surface->update(grid, removed, faces, report);
+    t.remesh_ms = lap();
+    std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
+    std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
+    m_model_surface.reset(); // it refers to the old model
+    build(false);
+    cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
+    m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
+    t.fem_update_ms = lap();
+    return t;
+}
+
+void SceneSimulation::build(bool first)
+{
+    const io::Scene& scene = m_scene;
+    const grid::BranchedGrid& grid = *m_grid;
+    const int level = m_level;
     m_model = std::make_unique<fem::HexModel>(grid, level);
     const fem::HexModel& model = *m_model;
     const std::size_t dofs = 3 * model.node_count();
@@ -97,7 +138,7 @@ SceneSimulation::SceneSimulation(const io::Scene& scene, const grid::BranchedGri
         behaviour.push_back(b);
     }
     solver.set_materials(std::move(behaviour));
-    for (std::size_t k = 0; k < scene.wet_regions.size(); ++k) {
+    for (std::size_t k = 0; first && k < scene.wet_regions.size(); ++k) {
         const io::WetRegion& w = scene.wet_regions[k];
         bool caught = false;
         for (std::uint32_t e = 0; e < model.elements().size(); ++e)
@@ -120,7 +161,7 @@ SceneSimulation::SceneSimulation(const io::Scene& scene, const grid::BranchedGri
                 solver.fix(n, axes);
                 caught = true;
             }
-        if (!caught)
+        if (!caught && first)
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
@@ -128,12 +169,11 @@ SceneSimulation::SceneSimulation(const io::Scene& scene, const grid::BranchedGri
         std::vector<std::uint32_t> caught;
         for (std::uint32_t n = 0; n < model.node_count(); ++n)
             if (in_box(model.rest_positions()[n] * 1e3, load.box_min_mm, load.box_max_mm)) caught.push_back(n);
+        if (caught.empty() && !first) continue; // the cut took the loaded material
         if (caught.empty())
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
     }
-    m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
-    m_model_surface = std::make_unique<ModelSurface>(grid, model, *m_surface);
 }
 
 } // namespace vox::app

@@ -2,15 +2,18 @@
 // A scene made ready to simulate at one level: the mechanical model, the solver with the scene's
 // constraints, loads, gravity, materials (plasticity, wetting) and wet regions, its
 // preconditioner, and the surface it moves. `voxsculpt run`, the level choice and the benchmarks
-// all build their simulations here, so they simulate the same thing.
+// all build their simulations here, so they simulate the same thing. A cut changes the grid and
+// the surface locally, then rebuilds the model at the same level carrying the state over.
 
-#include "app/model_surface.hpp"
+#include "cut/model_surface.hpp"
 #include "fem/implicit_solver.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 
 #include <memory>
+#include <span>
 #include <string>
+#include <utility>
 
 namespace vox::app {
 
@@ -22,23 +25,45 @@ namespace vox::app {
 /// the loads or the time step are beyond what this object and level can follow.
 [[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
 
+/// Milliseconds spent applying one cut.
+struct CutTimings {
+    double grid_update_ms = 0.0; ///< BranchedGrid::update
+    double remesh_ms = 0.0;      ///< EmbeddedSurface::update
+    double fem_update_ms = 0.0;  ///< the model, solver and surface embedding rebuilt, state carried over
+};
+
 class SceneSimulation {
 public:
     /// Throws the scene's InputError when a constraint or load box catches no node at `level`.
+    /// Keeps a reference to `grid`.
     SceneSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
 
     [[nodiscard]] const fem::HexModel& model() const { return *m_model; }
     [[nodiscard]] fem::ImplicitSolver& solver() { return *m_solver; }
     [[nodiscard]] const fem::ImplicitSolver& solver() const { return *m_solver; }
-    [[nodiscard]] const ModelSurface& surface() const { return *m_model_surface; }
+    [[nodiscard]] const cut::ModelSurface& surface() const { return *m_model_surface; }
+    [[nodiscard]] const grid::BranchedGrid& grid() const { return *m_grid; }
     /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
     [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
 
+    /// Removes fine voxels and disconnects faces of `grid` (the grid this simulation was built
+    /// on), updates the surface locally and rebuilds the model, carrying positions, velocities,
+    /// water and plastic strain over (cut/state_transfer.hpp).
+    CutTimings apply_cut(grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
+                         std::span<const std::pair<grid::Coord, int>> faces);
+
 private:
+    /// Model, solver, preconditioner, materials, constraints and loads at m_level; `first`: also
+    /// the wet regions, and boxes that catch no node are errors (after a cut they may catch none).
+    void build(bool first);
+
+    io::Scene m_scene;
+    const grid::BranchedGrid* m_grid;
+    int m_level;
     std::unique_ptr<fem::HexModel> m_model;
     std::unique_ptr<fem::ImplicitSolver> m_solver;
     std::unique_ptr<surface::EmbeddedSurface> m_surface;
-    std::unique_ptr<ModelSurface> m_model_surface;
+    std::unique_ptr<cut::ModelSurface> m_model_surface;
     std::string m_linear_solver;
 };
 

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace vox::fem {
 
@@ -32,6 +33,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_v.assign(n, Eigen::Vector3d::Zero());
     m_external.assign(n, Eigen::Vector3d::Zero());
     m_fixed.assign(3 * n, 0);
+    m_contact_of_node.assign(n, -1);
     m_rotation.assign(model.elements().size(), Eigen::Quaterniond::Identity());
     m_node_rotation.assign(n, Eigen::Quaterniond::Identity());
     m_element_energy.assign(model.elements().size(), 0.0);
@@ -102,6 +104,20 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
                     rank(model.elements()[e].dof_node[c], model.elements()[e].dof_node[d]);
     m_diagonal_rank.resize(n);
     for (std::uint32_t a = 0; a < n; ++a) m_diagonal_rank[a] = rank(a, a);
+}
+
+void ImplicitSolver::set_contact(std::vector<NodeContact> contact)
+{
+    for (const NodeContact& c : m_contact) m_contact_of_node[c.node] = -1;
+    m_contact = std::move(contact);
+    m_contact_x0.resize(m_contact.size());
+    for (std::size_t c = 0; c < m_contact.size(); ++c) {
+        const std::uint32_t node = m_contact[c].node;
+        if (node >= m_x.size() || m_contact_of_node[node] >= 0)
+            throw std::invalid_argument("ImplicitSolver::set_contact: node out of range or listed twice");
+        m_contact_of_node[node] = static_cast<std::int32_t>(c);
+        m_contact_x0[c] = m_x[node];
+    }
 }
 
 void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
@@ -224,6 +240,8 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
                     d += k_scale * m_stiffness_scale[e] * block.diagonal();
                     if (!lumped) d.array() += m_scale * elements[e].mass(c, c);
                 }
+                if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
+                    d += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m.diagonal();
                 m_diagonal.segment<3>(static_cast<Eigen::Index>(3 * n)) = d;
                 continue;
             }
@@ -245,6 +263,10 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
                 }
             }
             double* diagonal = values + outer[3 * n] + 3 * m_diagonal_rank[n];
+            if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
+                for (int i = 0; i < 3; ++i)
+                    for (int j = 0; j < 3; ++j)
+                        diagonal[i * row_length + j] += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m(i, j);
             for (int i = 0; i < 3; ++i) {
                 diagonal[i * row_length + i] += m_scale * diagonal_mass;
                 m_diagonal[static_cast<Eigen::Index>(3 * n) + i] = diagonal[i * row_length + i];
@@ -287,6 +309,10 @@ Eigen::VectorXd ImplicitSolver::external_force() const
     for (std::size_t n = 0; n < m_x.size(); ++n)
         f.segment<3>(static_cast<Eigen::Index>(3 * n)) =
             (m_model.nodal_mass()[n] - m_model.added_mass()[n]) * m_gravity + m_external[n]; // real material only
+    for (std::size_t c = 0; c < m_contact.size(); ++c) {
+        const NodeContact& k = m_contact[c];
+        f.segment<3>(static_cast<Eigen::Index>(3 * k.node)) += k.force_n - k.stiffness_n_per_m * (m_x[k.node] - m_contact_x0[c]);
+    }
     return f;
 }
 
@@ -354,6 +380,8 @@ void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::Vect
             }
             mass += (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]) * p.segment<3>(i);
             out.segment<3>(i) = m_k_scale * sum + m_m_scale * mass;
+            if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
+                out.segment<3>(i) += m_contact_scale * (m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m * p.segment<3>(i));
             for (int a = 0; a < 3; ++a)
                 if (m_fixed[3 * n + static_cast<std::size_t>(a)]) out[i + a] = p[i + a];
         }
@@ -463,6 +491,7 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     if (dt != m_last_dt && m_preconditioner) m_preconditioner->invalidate(); // its matrix depends on dt
     m_last_dt = dt;
     m_step_dt = dt;
+    m_contact_scale = dt * dt;
     auto t = std::chrono::steady_clock::now();
     energy_before = kinetic_energy() +
                     assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt, true);
@@ -483,7 +512,12 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     v = next;
     x += dt * v;
     m_element_pass_current = false;
-    return dt * f_ext.dot(v); // work of the external forces over the step
+    // Work of the external forces over the step; a contact force falls linearly along the step
+    // (f - dt K v at its end), so its mean is f - dt K v / 2.
+    double contact_correction = 0.0;
+    for (const NodeContact& c : m_contact)
+        contact_correction += m_v[c.node].dot(c.stiffness_n_per_m * m_v[c.node]);
+    return dt * f_ext.dot(v) - 0.5 * dt * dt * contact_correction;
 }
 
 void ImplicitSolver::advance(double dt, int depth, StepStats& s)
@@ -529,8 +563,9 @@ StepStats ImplicitSolver::step()
     } else {
         m_update_plastic = !m_plastic.empty(); // plastic strain creeps once per frame, at its start
         m_step_dt = m_options.dt_s;
+        m_contact_scale = 1.0;
         const auto n = static_cast<Eigen::Index>(3 * m_x.size());
-        const Eigen::VectorXd f_ext = external_force();
+        Eigen::VectorXd f_ext = external_force();
         Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
         Eigen::Map<Eigen::VectorXd> x(m_x.front().data(), n);
         v.setZero();
@@ -542,6 +577,7 @@ StepStats ImplicitSolver::step()
         for (int it = 0; it < m_options.newton_max_iterations; ++it) {
             auto t = std::chrono::steady_clock::now();
             assemble(0.0, 1.0, true);
+            if (!m_contact.empty()) f_ext = external_force(); // contact forces follow the nodes
             Eigen::VectorXd rhs = f_ext - m_internal;
             apply_constraints(rhs);
             s.assembly_ms += ms_since(t);

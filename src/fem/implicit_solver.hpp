@@ -66,6 +66,13 @@ struct StepStats {
     bool energy_guarded = false;      ///< a step gained energy even at 1/32 of dt (kept, reported)
 };
 
+/// Penalty contact (a tool against the surface) gathered on one node, world frame.
+struct NodeContact {
+    std::uint32_t node = 0;                                   ///< dense node index
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero();        ///< at the positions it was computed at
+    Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero(); ///< -d force / d position: symmetric, positive semidefinite
+};
+
 class ImplicitSolver {
 public:
     ImplicitSolver(const HexModel& model, const SolverOptions& options);
@@ -76,6 +83,12 @@ public:
     void set_gravity(const Eigen::Vector3d& g) { m_gravity = g; }
     /// Extra external forces per node, N (point forces, tool contact); zero by default.
     [[nodiscard]] std::vector<Eigen::Vector3d>& external_forces() { return m_external; }
+
+    /// Contact forces for the following steps, replacing the previous ones. They are taken
+    /// implicitly: at positions x the force is force_n - stiffness (x - x_now), so a stiff penalty
+    /// stays stable at any dt (an explicit penalty force on a light node explodes).
+    void set_contact(std::vector<NodeContact> contact);
+    [[nodiscard]] const std::vector<NodeContact>& contact() const { return m_contact; }
 
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
@@ -108,6 +121,12 @@ public:
         return m_plastic.empty() ? Eigen::Matrix3d::Zero() : m_plastic[element];
     }
     [[nodiscard]] bool has_plasticity() const { return !m_plastic.empty(); }
+    /// Sets an element's plastic strain (carried over when a cut rebuilds the model); ignored
+    /// without plasticity.
+    void set_plastic_strain(std::uint32_t element, const Eigen::Matrix3d& strain)
+    {
+        if (!m_plastic.empty()) m_plastic[element] = strain;
+    }
 
     /// Elastic energy at the current positions, J (updates the element rotations).
     double elastic_energy();
@@ -138,6 +157,10 @@ private:
     SolverOptions m_options;
     std::vector<Eigen::Vector3d> m_x, m_v, m_external;
     std::vector<unsigned char> m_fixed; ///< per dof
+    std::vector<NodeContact> m_contact;
+    std::vector<Eigen::Vector3d> m_contact_x0;  ///< per contact: the node's position when it was set
+    std::vector<std::int32_t> m_contact_of_node; ///< per node: index in m_contact, or -1
+    double m_contact_scale = 0.0;                ///< factor of the contact stiffness in the system matrix
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     SystemMatrix m_matrix;
     std::vector<std::uint16_t> m_rank;          ///< per element and corner pair (c, d): d's node among c's node's neighbours

@@ -40,6 +40,9 @@ constexpr NameTable<ToolShape, 4> tool_shapes{{{"blade", ToolShape::blade},
                                                {"scalpel", ToolShape::scalpel},
                                                {"sphere", ToolShape::sphere},
                                                {"mesh", ToolShape::mesh}}};
+constexpr NameTable<ToolAction, 3> tool_actions{
+    {{"push", ToolAction::push}, {"cut", ToolAction::cut}, {"wet", ToolAction::wet}}};
+constexpr NameTable<CutMode, 2> cut_modes{{{"remove", CutMode::remove}, {"separate", CutMode::separate}}};
 
 // ---------------------------------------------------------------------------------------------
 // The sections of a scene.
@@ -62,6 +65,34 @@ Eigen::Vector3d finite_vector(const JsonNode& node)
         }
     }
     return as<Eigen::Vector3d>(node);
+}
+
+/// [w, x, y, z]: a rotation as a quaternion of 4 finite numbers, normalised; a norm below 1e-9
+/// gives no direction and is refused.
+Eigen::Quaterniond unit_quaternion(const JsonNode& node)
+{
+    if (!node.value().is_array() || node.value().size() != 4) {
+        node.fail_type("an array of 4 numbers [w, x, y, z]");
+    }
+    std::array<double, 4> wxyz{};
+    const std::vector<JsonNode> items = node.elements();
+    for (std::size_t i = 0; i < 4; ++i) {
+        // Checked before as<>, as in finite_vector.
+        if (items[i].value().is_number_float() && !std::isfinite(items[i].value().get<double>())) {
+            items[i].fail("must be a finite number");
+        }
+        wxyz[i] = as<double>(items[i]);
+    }
+    Eigen::Quaterniond q(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
+    double norm = q.norm();
+    if (!std::isfinite(norm)) {
+        norm = q.coeffs().stableNorm(); // components near the largest double overflow the plain sum of squares
+    }
+    if (norm < 1e-9) {
+        node.fail("the quaternion's norm " + number_text(norm) + " is below 1e-9 (it gives no rotation)");
+    }
+    q.coeffs() /= norm;
+    return q;
 }
 
 /// An axis-aligned box [[x, y, z], [x, y, z]]: its min and max corners, world mm.
@@ -413,6 +444,20 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
         t.mesh = existing_file(r.required_node("mesh"));
         break;
     }
+    // Contact and cutting. Every tool takes every key; a key that does not apply to the tool's
+    // action (cut_mode on a push tool) is accepted and has no effect.
+    t.action = default_tool_action(t.shape);
+    if (const std::optional<JsonNode> node = r.optional_node("action")) {
+        t.action = choose_enum(*node, tool_actions);
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("cut_mode")) {
+        t.cut_mode = choose_enum(*node, cut_modes);
+    }
+    t.push_margin_mm = r.optional("push_margin_mm", t.push_margin_mm, closed_range(0.0, 100.0));
+    t.contact_stiffness_n_per_mm =
+        r.optional("contact_stiffness_n_per_mm", t.contact_stiffness_n_per_mm, half_open_range(0.0, 1e4));
+    t.cut_pressure_pa = r.optional("cut_pressure_pa", t.cut_pressure_pa, half_open_range(0.0, 1e9));
+    t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
     r.finish("for a " + as<std::string>(shape) + " tool");
     return t;
 }
@@ -439,6 +484,9 @@ ScriptEntry read_script_entry(JsonReader r, const std::vector<ToolSpec>& tools, 
     }
     e.tool_index = static_cast<std::size_t>(found - tools.begin());
     e.position_mm = r.required<Eigen::Vector3d>("position_mm");
+    if (const std::optional<JsonNode> node = r.optional_node("orientation_wxyz")) {
+        e.orientation = unit_quaternion(*node);
+    }
     r.finish();
     return e;
 }

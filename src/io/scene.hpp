@@ -10,6 +10,7 @@
 #include "io/selection.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <nlohmann/json_fwd.hpp>
 
 #include <array>
@@ -168,7 +169,36 @@ enum class ToolShape {
     mesh,    ///< any closed triangle mesh
 };
 
+/// What a tool does where it meets the object. Every tool pushes with its outer shape (the inner
+/// shape grown by ToolSpec::push_margin_mm); the action says what the inner shape does besides.
+enum class ToolAction {
+    push, ///< deforms the object and never cuts ("push")
+    cut,  ///< the inner shape cuts where it reaches material and the mean contact pressure on the
+          ///< outer shape exceeds ToolSpec::cut_pressure_pa ("cut")
+    wet,  ///< raises the water content of the elements it touches at ToolSpec::wet_rate_per_s ("wet")
+};
+
+/// What a cut does to the fine voxels the inner shape reaches.
+enum class CutMode {
+    remove,   ///< the voxels are taken away: the tool carves ("remove")
+    separate, ///< the voxel faces the inner shape crosses are disconnected: the material parts along
+              ///< the cut and keeps its volume ("separate")
+};
+
+/// The action a tool has when the scene gives none: cut for blades and scalpels, push for spheres
+/// and meshes.
+[[nodiscard]] constexpr ToolAction default_tool_action(ToolShape shape)
+{
+    return shape == ToolShape::blade || shape == ToolShape::scalpel ? ToolAction::cut : ToolAction::push;
+}
+
 /// A tool the script (or a haptic device) moves. Lengths in the tool's own frame, mm.
+///
+/// Contact model (docs/scene-format.md, "tools"): the shape below is the inner (cutting) shape;
+/// the outer (pushing) shape is the inner one grown by push_margin_mm. Where the outer shape
+/// overlaps the object by a depth d it presses with the penalty pressure
+/// contact_stiffness_n_per_mm * d / 1 cm^2. A cut tool cuts only where its inner shape reaches
+/// material and the mean pressure over the outer shape's contact exceeds cut_pressure_pa.
 struct ToolSpec {
     /// Unique, non-empty; the script refers to the tool by it.
     std::string name;
@@ -180,10 +210,28 @@ struct ToolSpec {
     double radius_mm = 0.0;
     /// mesh: the tool's surface mesh (vertices in mm), absolute; it existed when read.
     std::filesystem::path mesh;
+    /// What the tool does; absent from the file: default_tool_action(shape).
+    ToolAction action = default_tool_action(ToolShape::blade);
+    /// cut tools: what the cut does to the voxels (default remove).
+    CutMode cut_mode = CutMode::remove;
+    /// The outer (pushing) shape is the inner (cutting) shape grown by this much, mm, in [0, 100].
+    double push_margin_mm = 1.0;
+    /// Penalty stiffness per cm^2 of contact, N/mm, in (0, 1e4]: a flat face of the outer shape
+    /// pressed 1 mm into the object over 1 cm^2 pushes with this many newtons (pressure
+    /// k * depth / 1 cm^2; the default 5 N/mm is 5e4 Pa per mm of depth).
+    double contact_stiffness_n_per_mm = 5.0;
+    /// cut tools: the mean contact pressure on the outer shape (total contact force over contact
+    /// area), Pa, in (0, 1e9], above which the inner shape may cut.
+    double cut_pressure_pa = 2e4;
+    /// wet tools: how fast the water content (0..1) of the elements touched rises, per second of
+    /// contact, in (0, 1e3]; the content stops at 1.
+    double wet_rate_per_s = 1.0;
 };
 
-/// One key frame of the tool script: where a tool is at a time. Between two key frames of a tool
-/// it moves in a straight line at constant speed; before its first and after its last it stays.
+/// One key frame of the tool script: where a tool is, and how it is turned, at a time. Between two
+/// key frames of a tool it moves in a straight line at constant speed and turns at constant angular
+/// speed about one axis, the shorter way (slerp); before its first and after its last it stays.
+/// io/tool_script.hpp computes the pose at any time.
 struct ScriptEntry {
     /// Simulated time, s (>= 0; entries are in non-decreasing time order).
     double t_s = 0.0;
@@ -193,6 +241,10 @@ struct ScriptEntry {
     std::size_t tool_index = 0;
     /// Position of the tool's origin, world mm.
     Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    /// Key "orientation_wxyz" ([w, x, y, z]): the rotation from the tool's frame to the world
+    /// frame, a unit quaternion (the file's is normalised when read; its norm must be at least
+    /// 1e-9). Default identity: the tool's axes are the world axes.
+    Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
 /// What a run writes, and where.

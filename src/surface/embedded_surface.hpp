@@ -48,6 +48,9 @@ public:
     [[nodiscard]] int level() const { return m_level; }
     [[nodiscard]] std::size_t vertex_count() const { return m_vertex_count; }
     [[nodiscard]] std::size_t triangle_count() const { return m_triangle_count; }
+    /// True when the index-to-world map mirrors: the triangle slots' corner order then gives
+    /// inward normals in world space (mesh() flips them).
+    [[nodiscard]] bool mirrored() const { return m_flip; }
     /// Vertex slots (users == 0: free) and triangle slots (a free one has vertex no_index).
     [[nodiscard]] const std::vector<SurfaceVertex>& vertices() const { return m_vertices; }
     [[nodiscard]] const std::vector<std::array<std::uint32_t, 3>>& triangles() const { return m_triangles; }

@@ -92,7 +92,10 @@ TEST(SceneExamples, Liver)
     EXPECT_EQ(s.tools[0].shape, ToolShape::sphere);
     EXPECT_EQ(s.tools[0].radius_mm, 5.0);
     EXPECT_EQ(s.tools[1].shape, ToolShape::scalpel);
+    EXPECT_EQ(s.tools[0].action, ToolAction::push); // the shapes' default actions
+    EXPECT_EQ(s.tools[1].action, ToolAction::cut);
     ASSERT_EQ(s.script.size(), 5u);
+    EXPECT_EQ(s.script[0].orientation.coeffs(), Eigen::Quaterniond::Identity().coeffs());
     EXPECT_EQ(s.script[2].t_s, s.script[3].t_s); // equal times are allowed
     EXPECT_EQ(s.script[3].tool, "scalpel");
     EXPECT_EQ(s.script[3].tool_index, 1u);
@@ -449,6 +452,228 @@ TEST(SceneParse, BadLoads)
     doc["loads"] = json::array(
         {{{"box_mm", {{0, 0, -std::numeric_limits<double>::infinity()}, {1, 1, 1}}}, {"force_n", {0, 0, 1}}}});
     EXPECT_EQ(scene_error(doc), "s.json: loads[0].box_mm[0][2]: must be a finite number");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tools: contact and cutting keys; script: orientation.
+// ---------------------------------------------------------------------------------------------
+
+/// The minimal scene with `tools` (and a script when given).
+json scene_with_tools(const json& tools, const json& script = json())
+{
+    json doc = minimal_scene();
+    doc["tools"] = tools;
+    if (!script.is_null()) {
+        doc["script"] = script;
+    }
+    return doc;
+}
+
+TEST(SceneDefaults, ToolContactKeysTakeTheDocumentedDefaults)
+{
+    const json tools = json::parse(R"([
+        {"name": "b", "shape": "blade", "size_mm": [40, 1, 20]},
+        {"name": "s", "shape": "scalpel"},
+        {"name": "p", "shape": "sphere", "radius_mm": 5},
+        {"name": "m", "shape": "mesh", "mesh": "../sphere.off"}
+    ])");
+    const Scene s = parse_scene(scene_with_tools(tools), scenes_dir, "tools.json");
+    ASSERT_EQ(s.tools.size(), 4u);
+    // Blades and scalpels cut; spheres and meshes push.
+    EXPECT_EQ(s.tools[0].action, ToolAction::cut);
+    EXPECT_EQ(s.tools[1].action, ToolAction::cut);
+    EXPECT_EQ(s.tools[2].action, ToolAction::push);
+    EXPECT_EQ(s.tools[3].action, ToolAction::push);
+    for (const ToolSpec& t : s.tools) {
+        SCOPED_TRACE(t.name);
+        EXPECT_EQ(t.action, default_tool_action(t.shape));
+        EXPECT_EQ(t.cut_mode, CutMode::remove);
+        EXPECT_EQ(t.push_margin_mm, 1.0);
+        EXPECT_EQ(t.contact_stiffness_n_per_mm, 5.0);
+        EXPECT_EQ(t.cut_pressure_pa, 2e4);
+        EXPECT_EQ(t.wet_rate_per_s, 1.0);
+    }
+
+    // Code that builds a ToolSpec without a file gets the same defaults (for the default shape).
+    const ToolSpec spec;
+    EXPECT_EQ(spec.shape, ToolShape::blade);
+    EXPECT_EQ(spec.action, ToolAction::cut);
+    EXPECT_EQ(spec.cut_mode, CutMode::remove);
+    EXPECT_EQ(spec.push_margin_mm, 1.0);
+    EXPECT_EQ(spec.contact_stiffness_n_per_mm, 5.0);
+    EXPECT_EQ(spec.cut_pressure_pa, 2e4);
+    EXPECT_EQ(spec.wet_rate_per_s, 1.0);
+    EXPECT_EQ(default_tool_action(ToolShape::blade), ToolAction::cut);
+    EXPECT_EQ(default_tool_action(ToolShape::scalpel), ToolAction::cut);
+    EXPECT_EQ(default_tool_action(ToolShape::sphere), ToolAction::push);
+    EXPECT_EQ(default_tool_action(ToolShape::mesh), ToolAction::push);
+}
+
+TEST(SceneParse, ToolContactKeysAreRead)
+{
+    const json tools = json::parse(R"([
+        {"name": "blade", "shape": "blade", "size_mm": [40, 1, 20], "action": "cut", "cut_mode": "separate",
+         "push_margin_mm": 0.5, "contact_stiffness_n_per_mm": 12.5, "cut_pressure_pa": 3e5, "wet_rate_per_s": 0.25},
+        {"name": "sponge", "shape": "sphere", "radius_mm": 4, "action": "wet", "wet_rate_per_s": 2},
+        {"name": "flat", "shape": "scalpel", "action": "push", "push_margin_mm": 0},
+        {"name": "gouge", "shape": "sphere", "radius_mm": 2, "action": "cut", "cut_mode": "remove",
+         "push_margin_mm": 100, "contact_stiffness_n_per_mm": 1e4, "cut_pressure_pa": 1e9, "wet_rate_per_s": 1e3}
+    ])");
+    const Scene s = parse_scene(scene_with_tools(tools), "/tmp", "tools.json");
+    ASSERT_EQ(s.tools.size(), 4u);
+    const ToolSpec& blade = s.tools[0];
+    EXPECT_EQ(blade.action, ToolAction::cut);
+    EXPECT_EQ(blade.cut_mode, CutMode::separate);
+    EXPECT_EQ(blade.push_margin_mm, 0.5);
+    EXPECT_EQ(blade.contact_stiffness_n_per_mm, 12.5);
+    EXPECT_EQ(blade.cut_pressure_pa, 3e5);
+    EXPECT_EQ(blade.wet_rate_per_s, 0.25); // does not apply to a cut tool: accepted all the same
+    EXPECT_EQ(blade.size_mm, Eigen::Vector3d(40, 1, 20));
+
+    const ToolSpec& sponge = s.tools[1];
+    EXPECT_EQ(sponge.action, ToolAction::wet);
+    EXPECT_EQ(sponge.wet_rate_per_s, 2.0);
+    EXPECT_EQ(sponge.cut_pressure_pa, 2e4); // untouched keys keep their defaults
+    EXPECT_EQ(sponge.radius_mm, 4.0);
+
+    // A scalpel may be made a pusher, a sphere a cutter; the range ends are included.
+    EXPECT_EQ(s.tools[2].action, ToolAction::push);
+    EXPECT_EQ(s.tools[2].push_margin_mm, 0.0);
+    const ToolSpec& gouge = s.tools[3];
+    EXPECT_EQ(gouge.action, ToolAction::cut);
+    EXPECT_EQ(gouge.cut_mode, CutMode::remove);
+    EXPECT_EQ(gouge.push_margin_mm, 100.0);
+    EXPECT_EQ(gouge.contact_stiffness_n_per_mm, 1e4);
+    EXPECT_EQ(gouge.cut_pressure_pa, 1e9);
+    EXPECT_EQ(gouge.wet_rate_per_s, 1e3);
+}
+
+TEST(SceneParse, ToolKeysThatDoNotApplyToTheActionAreAccepted)
+{
+    const json tools = json::parse(R"([
+        {"name": "probe", "shape": "sphere", "radius_mm": 5, "action": "push", "cut_mode": "separate",
+         "cut_pressure_pa": 1e3, "wet_rate_per_s": 5}
+    ])");
+    const Scene s = parse_scene(scene_with_tools(tools), "/tmp", "tools.json");
+    EXPECT_EQ(s.tools[0].action, ToolAction::push);
+    EXPECT_EQ(s.tools[0].cut_mode, CutMode::separate);
+    EXPECT_EQ(s.tools[0].cut_pressure_pa, 1e3);
+    EXPECT_EQ(s.tools[0].wet_rate_per_s, 5.0);
+}
+
+TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
+{
+    const auto with_key = [](const char* key, const json& value) {
+        json tool = {{"name", "b"}, {"shape", "blade"}, {"size_mm", {40, 1, 20}}};
+        tool[key] = value;
+        // The faulty tool is the second, so the index in the path is checked too.
+        return scene_error(scene_with_tools(json::array({{{"name", "p"}, {"shape", "sphere"}, {"radius_mm", 5}}, tool})));
+    };
+    EXPECT_EQ(with_key("push_margin_mm", -0.1), "s.json: tools[1].push_margin_mm: must be in [0, 100], got -0.1");
+    EXPECT_EQ(with_key("push_margin_mm", 100.5), "s.json: tools[1].push_margin_mm: must be in [0, 100], got 100.5");
+    EXPECT_EQ(with_key("push_margin_mm", "1"), "s.json: tools[1].push_margin_mm: expected a number, got \"1\"");
+    EXPECT_EQ(with_key("contact_stiffness_n_per_mm", 0),
+              "s.json: tools[1].contact_stiffness_n_per_mm: must be in (0, 10000], got 0");
+    EXPECT_EQ(with_key("contact_stiffness_n_per_mm", 2e4),
+              "s.json: tools[1].contact_stiffness_n_per_mm: must be in (0, 10000], got 20000.0");
+    EXPECT_EQ(with_key("contact_stiffness_n_per_mm", json::array({5})),
+              "s.json: tools[1].contact_stiffness_n_per_mm: expected a number, got [5]");
+    EXPECT_EQ(with_key("cut_pressure_pa", -1), "s.json: tools[1].cut_pressure_pa: must be in (0, 1e+09], got -1");
+    EXPECT_EQ(with_key("cut_pressure_pa", 0.0), "s.json: tools[1].cut_pressure_pa: must be in (0, 1e+09], got 0.0");
+    EXPECT_EQ(with_key("cut_pressure_pa", 2e9),
+              "s.json: tools[1].cut_pressure_pa: must be in (0, 1e+09], got 2000000000.0");
+    EXPECT_EQ(with_key("cut_pressure_pa", true), "s.json: tools[1].cut_pressure_pa: expected a number, got true");
+    EXPECT_EQ(with_key("wet_rate_per_s", 0), "s.json: tools[1].wet_rate_per_s: must be in (0, 1000], got 0");
+    EXPECT_EQ(with_key("wet_rate_per_s", 1001), "s.json: tools[1].wet_rate_per_s: must be in (0, 1000], got 1001");
+    EXPECT_EQ(with_key("wet_rate_per_s", nullptr), "s.json: tools[1].wet_rate_per_s: expected a number, got null");
+    EXPECT_EQ(with_key("action", "slice"),
+              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", got \"slice\"");
+    EXPECT_EQ(with_key("action", "Cut"),
+              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", got \"Cut\"");
+    EXPECT_EQ(with_key("action", 1), "s.json: tools[1].action: expected a string, got 1");
+    EXPECT_EQ(with_key("cut_mode", "split"),
+              "s.json: tools[1].cut_mode: expected one of \"remove\", \"separate\", got \"split\"");
+    EXPECT_EQ(with_key("cut_mode", json::object()), "s.json: tools[1].cut_mode: expected a string, got {}");
+    // A misspelt key is still unknown, and the message lists the new keys among the known ones.
+    EXPECT_EQ(with_key("cut_pressure", 1e4),
+              "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
+              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s)");
+    // NaN cannot be in a file but can be in a document built in code.
+    EXPECT_EQ(with_key("push_margin_mm", std::nan("")).rfind("s.json: tools[1].push_margin_mm: must be in [0, 100]", 0),
+              0u);
+}
+
+TEST(SceneParse, ScriptOrientationIsReadAndNormalised)
+{
+    const json tools = json::parse(R"([{"name": "blade", "shape": "blade", "size_mm": [40, 1, 20]}])");
+    const json script = json::parse(R"([
+        {"t_s": 0, "tool": "blade", "position_mm": [0, 0, 0]},
+        {"t_s": 1, "tool": "blade", "position_mm": [1, 2, 3], "orientation_wxyz": [2, 0, 0, 2]},
+        {"t_s": 2, "tool": "blade", "position_mm": [1, 2, 3], "orientation_wxyz": [0, 0, -3, 0]},
+        {"t_s": 3, "tool": "blade", "position_mm": [1, 2, 3], "orientation_wxyz": [0, 0, 0, -2e-9]}
+    ])");
+    const Scene s = parse_scene(scene_with_tools(tools, script), "/tmp", "script.json");
+    ASSERT_EQ(s.script.size(), 4u);
+    // Absent: identity.
+    EXPECT_EQ(s.script[0].orientation.coeffs(), Eigen::Quaterniond::Identity().coeffs());
+    // [2, 0, 0, 2]: a quarter turn about z, normalised to [1, 0, 0, 1] / sqrt(2).
+    const Eigen::Quaterniond& q = s.script[1].orientation;
+    EXPECT_NEAR(q.norm(), 1.0, 1e-15);
+    EXPECT_NEAR(q.w(), std::sqrt(0.5), 1e-15);
+    EXPECT_EQ(q.x(), 0.0);
+    EXPECT_EQ(q.y(), 0.0);
+    EXPECT_NEAR(q.z(), std::sqrt(0.5), 1e-15);
+    EXPECT_TRUE((q * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-15));
+    EXPECT_EQ(s.script[1].position_mm, Eigen::Vector3d(1, 2, 3)); // position as before
+    // A half turn about -y; the w = 0 quaternion is a rotation like any other.
+    EXPECT_EQ(s.script[2].orientation.coeffs(), Eigen::Vector4d(0, -1, 0, 0)); // Eigen stores x, y, z, w
+    // A tiny quaternion, just above the 1e-9 floor, still gives a direction: a half turn about z.
+    EXPECT_EQ(s.script[3].orientation.coeffs(), Eigen::Vector4d(0, 0, -1, 0));
+}
+
+TEST(SceneParse, BadScriptOrientationNamesTheKeyPath)
+{
+    const json tools = json::parse(R"([{"name": "blade", "shape": "blade", "size_mm": [40, 1, 20]}])");
+    const auto with_orientation = [&](const json& value) {
+        json script = json::parse(R"([
+            {"t_s": 0, "tool": "blade", "position_mm": [0, 0, 0]},
+            {"t_s": 1, "tool": "blade", "position_mm": [0, 0, 0]}
+        ])");
+        script[1]["orientation_wxyz"] = value;
+        return scene_error(scene_with_tools(tools, script));
+    };
+    EXPECT_EQ(with_orientation(json::array({1, 0, 0})),
+              "s.json: script[1].orientation_wxyz: expected an array of 4 numbers [w, x, y, z], got [1,0,0]");
+    EXPECT_EQ(with_orientation(json::array({1, 0, 0, 0, 0})),
+              "s.json: script[1].orientation_wxyz: expected an array of 4 numbers [w, x, y, z], got [1,0,0,0,0]");
+    EXPECT_EQ(with_orientation("identity"),
+              "s.json: script[1].orientation_wxyz: expected an array of 4 numbers [w, x, y, z], got \"identity\"");
+    EXPECT_EQ(with_orientation(json::array({1, 0, "0", 0})),
+              "s.json: script[1].orientation_wxyz[2]: expected a number, got \"0\"");
+    EXPECT_EQ(with_orientation(json::array({0, 0, 0, 0})),
+              "s.json: script[1].orientation_wxyz: the quaternion's norm 0 is below 1e-9 (it gives no rotation)");
+    EXPECT_EQ(with_orientation(json::array({1e-10, 0, 0, 0})),
+              "s.json: script[1].orientation_wxyz: the quaternion's norm 1e-10 is below 1e-9 (it gives no rotation)");
+    // A JSON file cannot hold NaN or infinity; a document built in code can, and is refused.
+    EXPECT_EQ(with_orientation(json::array({1.0, std::nan(""), 0.0, 0.0})),
+              "s.json: script[1].orientation_wxyz[1]: must be a finite number");
+    EXPECT_EQ(with_orientation(json::array({1.0, 0.0, 0.0, -std::numeric_limits<double>::infinity()})),
+              "s.json: script[1].orientation_wxyz[3]: must be a finite number");
+    // Huge but finite components are normalised without overflow.
+    json doc = scene_with_tools(tools, json::array({{{"t_s", 0},
+                                                     {"tool", "blade"},
+                                                     {"position_mm", {0, 0, 0}},
+                                                     {"orientation_wxyz", {1e308, 0, 0, 1e308}}}}));
+    const Scene s = parse_scene(doc, "/tmp", "s.json");
+    EXPECT_NEAR(s.script[0].orientation.w(), std::sqrt(0.5), 1e-15);
+    EXPECT_NEAR(s.script[0].orientation.z(), std::sqrt(0.5), 1e-15);
+    // An unknown key beside it is still refused, and orientation_wxyz is listed as known.
+    json good = scene_with_tools(tools, json::array({{{"t_s", 0}, {"tool", "blade"}, {"position_mm", {0, 0, 0}}}}));
+    good["script"][0]["orientation_wxyz"] = {1, 0, 0, 0};
+    EXPECT_NO_THROW(static_cast<void>(parse_scene(good, "/tmp", "s.json")));
+    json script = json::parse(R"([{"t_s": 0, "tool": "blade", "position_mm": [0, 0, 0], "orientation": [1, 0, 0, 0]}])");
+    EXPECT_EQ(scene_error(scene_with_tools(tools, script)),
+              "s.json: script[0].orientation: unknown key (known keys: t_s, tool, position_mm, orientation_wxyz)");
 }
 
 TEST(SceneParse, PathsResolveAgainstTheSceneFolder)

@@ -1,0 +1,127 @@
+#include "app/tool_session.hpp"
+
+#include "cut/surface_contact.hpp"
+#include "cut/voxel_cut.hpp"
+#include "io/mesh.hpp"
+#include "io/tool_script.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace vox::app {
+namespace {
+
+contact::ToolShape make_shape(const io::ToolSpec& t)
+{
+    switch (t.shape) {
+    case io::ToolShape::blade:
+        return contact::ToolShape::box(t.size_mm);
+    case io::ToolShape::scalpel:
+        return contact::ToolShape::scalpel(t.size_mm.isZero() ? Eigen::Vector3d(30, 0.5, 8) : t.size_mm);
+    case io::ToolShape::sphere:
+        return contact::ToolShape::sphere(t.radius_mm);
+    case io::ToolShape::mesh: {
+        const io::TriangleMesh m = io::read_mesh(t.mesh.string());
+        return contact::ToolShape::from_mesh({m.vertices, m.triangles});
+    }
+    }
+    return contact::ToolShape::sphere(t.radius_mm);
+}
+
+class Stopwatch {
+public:
+    double lap()
+    {
+        const auto now = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - m_start).count();
+        m_start = now;
+        return ms;
+    }
+
+private:
+    std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now();
+};
+
+} // namespace
+
+ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_cut_from(scene.tools.size()), m_was_placed(scene.tools.size(), false)
+{
+    for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
+    for (std::size_t k = 0; k < m_shapes.size(); ++k) m_cut_from[k].shape = &m_shapes[k];
+}
+
+ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s)
+{
+    ToolFrameStats stats;
+    stats.tools.resize(m_scene.tools.size());
+    std::vector<contact::PlacedShape> placed(m_scene.tools.size());
+    std::vector<cut::SurfaceContact> touch(m_scene.tools.size());
+    std::vector<bool> fresh(m_scene.tools.size(), false); // touch[k] is up to date with the model
+    Stopwatch clock;
+    for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
+        const io::ToolSpec& spec = m_scene.tools[k];
+        const io::ToolPose pose = io::tool_pose(m_scene, k, t_s);
+        ToolFrame& out = stats.tools[k];
+        out.placed = pose.placed;
+        if (!pose.placed) continue;
+        out.position_mm = pose.position_mm;
+        placed[k] = {&m_shapes[k], pose.position_mm, pose.orientation};
+        if (!m_was_placed[k]) m_cut_from[k] = placed[k];
+        const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
+        touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k], parameters);
+        fresh[k] = true;
+        stats.collision_ms += clock.lap();
+        const contact::ContactResult& c = touch[k].contact;
+        if (c.points.empty()) m_cut_from[k] = placed[k]; // a stroke starts where the tool first touches
+        if (spec.action == io::ToolAction::cut && !c.points.empty() && c.pressure_pa >= spec.cut_pressure_pa) {
+            std::vector<grid::Coord> removed;
+            std::vector<std::pair<grid::Coord, int>> faces;
+            if (spec.cut_mode == io::CutMode::remove) {
+                for (std::uint32_t v : cut::voxels_inside(sim.surface(), sim.solver().positions(), placed[k], touch[k].vertices))
+                    removed.push_back(grid.voxels().coord(v));
+            } else {
+                // Everything the section swept since the stroke began or last cut: material the
+                // blade entered while the pressure was still too low is cut now.
+                faces = cut::faces_crossed(sim.surface(), sim.solver().positions(),
+                                           cut::sweep_section(m_shapes[k], spec.push_margin_mm, m_cut_from[k], placed[k]));
+            }
+            stats.propagation_ms += clock.lap();
+            if (!removed.empty() || !faces.empty()) {
+                const CutTimings t = sim.apply_cut(grid, removed, faces);
+                stats.grid_update_ms += t.grid_update_ms;
+                stats.remesh_ms += t.remesh_ms;
+                stats.fem_update_ms += t.fem_update_ms;
+                stats.removed_voxels += removed.size();
+                stats.separated_faces += faces.size();
+                out.cut = true;
+                m_cut_from[k] = placed[k];
+                std::fill(fresh.begin(), fresh.end(), false); // node numbers changed
+                clock.lap();
+            }
+        }
+        if (spec.action == io::ToolAction::wet && fresh[k])
+            for (std::uint32_t e : touch[k].elements)
+                sim.solver().set_water(e, sim.solver().water(e) + spec.wet_rate_per_s * dt_s);
+    }
+    // The forces for the next step, on the model as it now is.
+    std::vector<fem::NodeContact> nodes;
+    for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
+        if (!stats.tools[k].placed) continue;
+        if (!fresh[k]) {
+            const io::ToolSpec& spec = m_scene.tools[k];
+            touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k],
+                                          {spec.push_margin_mm, spec.contact_stiffness_n_per_mm});
+        }
+        cut::merge_node_contacts(nodes, touch[k].nodes);
+        ToolFrame& out = stats.tools[k];
+        out.force_n = touch[k].contact.force_on_tool_n;
+        out.pressure_pa = touch[k].contact.pressure_pa;
+        out.contact_area_mm2 = touch[k].contact.area_mm2;
+        m_was_placed[k] = true;
+    }
+    sim.solver().set_contact(std::move(nodes));
+    stats.collision_ms += clock.lap();
+    return stats;
+}
+
+} // namespace vox::app

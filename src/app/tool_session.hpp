@@ -1,0 +1,58 @@
+#pragma once
+// The scene's tools acting on a simulation, frame by frame: each placed tool touches the surface
+// (penalty contact), cuts where its inner shape reaches material and the contact pressure exceeds
+// its threshold (removing voxels or separating faces), wets what it touches, and leaves its
+// contact forces with the solver for the next step. What decides a cut is the contact the user
+// would feel.
+
+#include "app/scene_simulation.hpp"
+#include "contact/tool_shape.hpp"
+
+#include <vector>
+
+namespace vox::app {
+
+/// One tool during one frame.
+struct ToolFrame {
+    bool placed = false;
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero(); ///< on the tool (the object's reaction)
+    double pressure_pa = 0.0;
+    double contact_area_mm2 = 0.0;
+    bool cut = false; ///< it cut this frame
+};
+
+/// What the tools did in one frame, and how long each phase took.
+struct ToolFrameStats {
+    double collision_ms = 0.0;   ///< contact between tools and surface
+    double propagation_ms = 0.0; ///< finding the voxels to remove or the faces to open
+    double grid_update_ms = 0.0;
+    double remesh_ms = 0.0;
+    double fem_update_ms = 0.0;  ///< model rebuilt and state carried over
+    std::size_t removed_voxels = 0;
+    std::size_t separated_faces = 0;
+    std::vector<ToolFrame> tools; ///< one per scene tool
+    [[nodiscard]] double cutting_ms() const { return collision_ms + propagation_ms + grid_update_ms + remesh_ms; }
+};
+
+class ToolSession {
+public:
+    /// Throws InputError when a mesh tool's file cannot be read.
+    explicit ToolSession(const io::Scene& scene);
+
+    /// Places the tools at simulated time `t_s`, lets them touch, cut and wet `sim` (built on
+    /// `grid`), and sets the solver's contact forces for the next step of `dt_s`.
+    ToolFrameStats frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s);
+
+    [[nodiscard]] const contact::ToolShape& shape(std::size_t tool) const { return m_shapes[tool]; }
+
+private:
+    const io::Scene& m_scene;
+    std::vector<contact::ToolShape> m_shapes;
+    /// Per tool: where its current stroke began (first contact) or it last cut; a separating cut
+    /// opens what the section swept since.
+    std::vector<contact::PlacedShape> m_cut_from;
+    std::vector<bool> m_was_placed;
+};
+
+} // namespace vox::app

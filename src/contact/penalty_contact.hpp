@@ -1,0 +1,61 @@
+#pragma once
+// Discrete penalty contact between a tool and points of the object's surface: the one contact
+// model behind pushing, the cut decision and (later) the forces the user feels.
+//
+// The pushing shape is the tool's inner (cutting) shape grown by `margin_mm`. A surface point at
+// depth d inside it, carrying surface area a, is pushed into the object, along minus its outward
+// surface normal n, by
+//     f = -k d a n / (1 cm^2),
+// k the scene's contact_stiffness_n_per_mm: a flat face pressed 1 mm into the object over 1 cm^2
+// pushes with k newtons, whatever the mesh resolution. The contact pressure is the mean over the
+// contact, sum |f| / sum a, which is what decides a cut: a broad tool spreads its force over a
+// large area, a sharp one concentrates it. The force follows the object's normal, not the tool's:
+// once a thin blade is inside the material the nearest tool face says nothing about which side a
+// point is on, while the two walls of a slit face opposite ways and are pushed apart.
+
+#include "contact/tool_shape.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace vox::contact {
+
+struct ContactParameters {
+    double margin_mm = 1.0;                 ///< outer shape = inner grown by this, mm (>= 0)
+    double stiffness_n_per_mm = 5.0;        ///< per cm^2 of contact (> 0)
+};
+
+struct PointContact {
+    std::uint32_t point = 0;                ///< index into the points given
+    double depth_mm = 0.0;                  ///< inside the outer shape, > 0
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< direction the point is pushed (unit), world
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero(); ///< on the surface point
+    double stiffness_n_per_mm = 0.0;        ///< d |force| / d depth
+    bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
+};
+
+struct ContactResult {
+    std::vector<PointContact> points;
+    Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();       ///< the reaction: minus the sum of the point forces
+    Eigen::Vector3d torque_on_tool_n_mm = Eigen::Vector3d::Zero();   ///< about the tool's origin
+    double area_mm2 = 0.0;                   ///< surface area in contact
+    double pressure_pa = 0.0;                ///< sum |f| / area (0 without contact)
+    [[nodiscard]] bool inner_reaches_surface() const
+    {
+        for (const PointContact& p : points)
+            if (p.inside_inner) return true;
+        return false;
+    }
+};
+
+/// Contact of `tool` (its inner shape, placed in the world) with surface points (world mm), each
+/// carrying `areas[i]` mm^2 of surface with outward unit normal `normals[i]` (a zero normal: the
+/// point is pushed along the tool's outward normal instead). Points outside the outer shape are skipped.
+[[nodiscard]] ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
+                                            std::span<const Eigen::Vector3d> points, std::span<const double> areas,
+                                            std::span<const Eigen::Vector3d> normals);
+
+} // namespace vox::contact

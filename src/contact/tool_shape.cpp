@@ -1,0 +1,306 @@
+#include "contact/tool_shape.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
+
+namespace vox::contact {
+namespace {
+
+/// Exact signed distance from q to a convex counter-clockwise polygon; `g` the unit gradient.
+double polygon_distance(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& q, Eigen::Vector2d& g)
+{
+    const std::size_t n = poly.size();
+    double inside = -std::numeric_limits<double>::infinity();
+    Eigen::Vector2d inside_normal(1, 0);
+    double outside = std::numeric_limits<double>::infinity();
+    Eigen::Vector2d nearest = poly[0];
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d a = poly[i], b = poly[(i + 1) % n];
+        const Eigen::Vector2d e = b - a;
+        const Eigen::Vector2d normal = Eigen::Vector2d(e.y(), -e.x()).normalized(); // outward for CCW
+        const double plane = normal.dot(q - a);
+        if (plane > inside) {
+            inside = plane;
+            inside_normal = normal;
+        }
+        const double t = std::clamp((q - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+        const Eigen::Vector2d c = a + t * e;
+        const double d = (q - c).norm();
+        if (d < outside) {
+            outside = d;
+            nearest = c;
+        }
+    }
+    if (inside <= 0.0) { // inside a convex polygon the nearest edge is the nearest plane
+        g = inside_normal;
+        return inside;
+    }
+    g = outside > 0.0 ? Eigen::Vector2d((q - nearest) / outside) : inside_normal;
+    return outside;
+}
+
+/// The convex polygon moved out by `margin` (each edge along its outward normal).
+std::vector<Eigen::Vector2d> offset_polygon(const std::vector<Eigen::Vector2d>& poly, double margin)
+{
+    const std::size_t n = poly.size();
+    std::vector<Eigen::Vector2d> out(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d prev = poly[(i + n - 1) % n], here = poly[i], next = poly[(i + 1) % n];
+        const Eigen::Vector2d e0 = (here - prev).normalized(), e1 = (next - here).normalized();
+        const Eigen::Vector2d n0(e0.y(), -e0.x()), n1(e1.y(), -e1.x());
+        // The corner of the two moved edges: here + m (n0 + n1) / (1 + n0.n1).
+        out[i] = here + margin * (n0 + n1) / (1.0 + n0.dot(n1));
+    }
+    return out;
+}
+
+/// Closest point to p on triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c)
+{
+    const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    const Eigen::Vector3d bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+    const Eigen::Vector3d cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    const double denom = 1.0 / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+/// Solid angle of triangle abc seen from the origin (Van Oosterom and Strackee 1983).
+double solid_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+{
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double numerator = a.dot(b.cross(c));
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    return 2.0 * std::atan2(numerator, denominator);
+}
+
+/// Outward orientation for a convex mesh around its centre.
+void orient_outward(TriangleMesh& m, const Eigen::Vector3d& centre)
+{
+    for (Eigen::Vector3i& t : m.triangles) {
+        const Eigen::Vector3d &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
+        if ((b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) < 0.0) std::swap(t[1], t[2]);
+    }
+}
+
+TriangleMesh icosphere(double radius, int detail)
+{
+    const double p = (1.0 + std::sqrt(5.0)) / 2.0;
+    TriangleMesh m;
+    for (const auto& v : {Eigen::Vector3d(-1, p, 0), Eigen::Vector3d(1, p, 0), Eigen::Vector3d(-1, -p, 0),
+                          Eigen::Vector3d(1, -p, 0), Eigen::Vector3d(0, -1, p), Eigen::Vector3d(0, 1, p),
+                          Eigen::Vector3d(0, -1, -p), Eigen::Vector3d(0, 1, -p), Eigen::Vector3d(p, 0, -1),
+                          Eigen::Vector3d(p, 0, 1), Eigen::Vector3d(-p, 0, -1), Eigen::Vector3d(-p, 0, 1)})
+        m.positions.push_back(v.normalized());
+    m.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                   {3, 8, 9},   {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    for (int d = 0; d < detail; ++d) {
+        std::map<std::pair<int, int>, int> middle;
+        auto mid = [&](int a, int b) {
+            const auto key = std::minmax(a, b);
+            const auto found = middle.find(key);
+            if (found != middle.end()) return found->second;
+            m.positions.push_back((m.positions[a] + m.positions[b]).normalized());
+            const int id = static_cast<int>(m.positions.size()) - 1;
+            middle.emplace(key, id);
+            return id;
+        };
+        std::vector<Eigen::Vector3i> next;
+        for (const Eigen::Vector3i& t : m.triangles) {
+            const int ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
+            next.insert(next.end(), {{t[0], ab, ca}, {t[1], bc, ab}, {t[2], ca, bc}, {ab, bc, ca}});
+        }
+        m.triangles = std::move(next);
+    }
+    for (Eigen::Vector3d& v : m.positions) v *= radius;
+    orient_outward(m, Eigen::Vector3d::Zero());
+    return m;
+}
+
+} // namespace
+
+ToolShape ToolShape::box(const Eigen::Vector3d& size)
+{
+    ToolShape s;
+    s.m_kind = Kind::box;
+    s.m_size = size;
+    const double hx = size.x() / 2, hz = size.z() / 2;
+    s.m_profile = {{-hx, -hz}, {hx, -hz}, {hx, hz}, {-hx, hz}};
+    s.m_bounds = Eigen::AlignedBox3d(-size / 2, size / 2);
+    return s;
+}
+
+ToolShape ToolShape::scalpel(const Eigen::Vector3d& size)
+{
+    ToolShape s = box(size);
+    s.m_kind = Kind::scalpel;
+    const double hx = size.x() / 2, hz = size.z() / 2;
+    // The front rises at 45 degrees from the point; a blade shorter than it is tall becomes a triangle.
+    const double top_front = std::max(-hx, hx - size.z());
+    s.m_profile = {{-hx, -hz}, {hx, -hz}, {top_front, hz}, {-hx, hz}};
+    if (top_front <= -hx) s.m_profile = {{-hx, -hz}, {hx, -hz}, {-hx, hz}};
+    return s;
+}
+
+ToolShape ToolShape::sphere(double radius)
+{
+    ToolShape s;
+    s.m_kind = Kind::sphere;
+    s.m_radius = radius;
+    s.m_bounds = Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-radius), Eigen::Vector3d::Constant(radius));
+    return s;
+}
+
+ToolShape ToolShape::from_mesh(TriangleMesh mesh)
+{
+    if (mesh.triangles.empty()) throw InputError("tool mesh: it has no triangle");
+    ToolShape s;
+    s.m_kind = Kind::mesh;
+    s.m_bounds.setEmpty();
+    for (const Eigen::Vector3d& p : mesh.positions) s.m_bounds.extend(p);
+    s.m_mesh = std::move(mesh);
+    return s;
+}
+
+double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+{
+    Eigen::Vector2d g2;
+    const double d2 = polygon_distance(m_profile, Eigen::Vector2d(p.x(), p.z()), g2);
+    const double sy = p.y() >= 0.0 ? 1.0 : -1.0;
+    const double dy = std::abs(p.y()) - m_size.y() / 2;
+    double d;
+    Eigen::Vector3d g;
+    if (d2 <= 0.0 && dy <= 0.0) {
+        d = std::max(d2, dy);
+        g = d2 >= dy ? Eigen::Vector3d(g2.x(), 0, g2.y()) : Eigen::Vector3d(0, sy, 0);
+    } else {
+        const double a = std::max(d2, 0.0), b = std::max(dy, 0.0);
+        d = std::hypot(a, b);
+        g = (Eigen::Vector3d(a * g2.x(), b * sy, a * g2.y()) / d);
+    }
+    if (gradient) *gradient = g;
+    return d;
+}
+
+double ToolShape::mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+{
+    double best = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d nearest = p, face_normal(0, 0, 1);
+    double winding = 0.0;
+    for (const Eigen::Vector3i& t : m_mesh.triangles) {
+        const Eigen::Vector3d &a = m_mesh.positions[t[0]], &b = m_mesh.positions[t[1]], &c = m_mesh.positions[t[2]];
+        const Eigen::Vector3d q = closest_on_triangle(p, a, b, c);
+        const double d = (p - q).squaredNorm();
+        if (d < best) {
+            best = d;
+            nearest = q;
+            face_normal = (b - a).cross(c - a).normalized();
+        }
+        winding += solid_angle(a - p, b - p, c - p);
+    }
+    const bool inside = winding / (4.0 * M_PI) > 0.5;
+    const double distance = std::sqrt(best);
+    if (gradient) *gradient = distance > 1e-12 ? Eigen::Vector3d((p - nearest) / distance * (inside ? -1.0 : 1.0)) : face_normal;
+    return inside ? -distance : distance;
+}
+
+double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+{
+    switch (m_kind) {
+    case Kind::box:
+    case Kind::scalpel:
+        return prism_distance(p, gradient);
+    case Kind::sphere: {
+        const double r = p.norm();
+        if (gradient) *gradient = r > 0.0 ? Eigen::Vector3d(p / r) : Eigen::Vector3d(0, 0, 1);
+        return r - m_radius;
+    }
+    case Kind::mesh:
+        return mesh_distance(p, gradient);
+    }
+    return 0.0;
+}
+
+Eigen::AlignedBox3d ToolShape::bounds(double margin) const
+{
+    const Eigen::Vector3d m = Eigen::Vector3d::Constant(margin);
+    return Eigen::AlignedBox3d(m_bounds.min() - m, m_bounds.max() + m);
+}
+
+TriangleMesh ToolShape::mesh(double margin, int detail) const
+{
+    TriangleMesh m;
+    switch (m_kind) {
+    case Kind::box:
+    case Kind::scalpel: {
+        const std::vector<Eigen::Vector2d> poly = offset_polygon(m_profile, margin);
+        const int n = static_cast<int>(poly.size());
+        const double hy = m_size.y() / 2 + margin;
+        for (double y : {-hy, hy})
+            for (const Eigen::Vector2d& q : poly) m.positions.emplace_back(q.x(), y, q.y());
+        for (int i = 1; i + 1 < n; ++i) {
+            m.triangles.emplace_back(0, i, i + 1);
+            m.triangles.emplace_back(n, n + i, n + i + 1);
+        }
+        for (int i = 0; i < n; ++i) {
+            const int j = (i + 1) % n;
+            m.triangles.emplace_back(i, j, n + j);
+            m.triangles.emplace_back(i, n + j, n + i);
+        }
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& p : m.positions) centre += p;
+        orient_outward(m, centre / static_cast<double>(m.positions.size()));
+        return m;
+    }
+    case Kind::sphere:
+        return icosphere(m_radius + margin, detail);
+    case Kind::mesh: {
+        m = m_mesh;
+        std::vector<Eigen::Vector3d> normal(m.positions.size(), Eigen::Vector3d::Zero());
+        for (const Eigen::Vector3i& t : m.triangles) {
+            const Eigen::Vector3d n = (m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]);
+            for (int k = 0; k < 3; ++k) normal[t[k]] += n;
+        }
+        for (std::size_t i = 0; i < m.positions.size(); ++i)
+            if (normal[i].norm() > 0.0) m.positions[i] += margin * normal[i].normalized();
+        return m;
+    }
+    }
+    return m;
+}
+
+double PlacedShape::signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient) const
+{
+    const double d = shape->signed_distance(orientation.conjugate() * (world - position), gradient);
+    if (gradient) *gradient = orientation * *gradient;
+    return d;
+}
+
+Eigen::AlignedBox3d PlacedShape::world_bounds(double margin) const
+{
+    const Eigen::AlignedBox3d local = shape->bounds(margin);
+    Eigen::AlignedBox3d out;
+    out.setEmpty();
+    for (int c = 0; c < 8; ++c) out.extend(position + orientation * local.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)));
+    return out;
+}
+
+} // namespace vox::contact

@@ -1,0 +1,84 @@
+#pragma once
+// The geometry of a tool in its own frame (millimetres): an exact signed distance (negative
+// inside) and a triangle mesh. A tool is two nested shapes (Jerabkova et al. 2010, Figure 11):
+// the inner one cuts, the outer one, the inner grown by a margin, pushes. Growing is exact on the
+// distance: the outer shape is {p : distance(p) < margin} (a Minkowski sum with a ball), so both
+// shapes come from one function.
+//
+// Shapes, each centred on the tool's origin:
+//  - box: full extents `size` along the tool's x, y, z (a blade: length, thickness, height);
+//  - scalpel: the box's profile in the x-z plane with its front (+x) end cut at 45 degrees from
+//    the bottom front corner (the point) upward and back, extruded over the thickness (y); the
+//    cutting edge is the bottom (-z) edge;
+//  - sphere: a ball of a radius;
+//  - mesh: any closed, consistently oriented triangle mesh (distance to the nearest triangle,
+//    sign by the generalised winding number).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <vector>
+
+namespace vox::contact {
+
+struct TriangleMesh {
+    std::vector<Eigen::Vector3d> positions;  ///< mm
+    std::vector<Eigen::Vector3i> triangles; ///< counter-clockwise seen from outside
+};
+
+class ToolShape {
+public:
+    enum class Kind { box, scalpel, sphere, mesh };
+
+    /// `size`: full extents along x, y, z, mm (each > 0).
+    static ToolShape box(const Eigen::Vector3d& size);
+    /// `size`: length (x), thickness (y), height (z), mm (each > 0).
+    static ToolShape scalpel(const Eigen::Vector3d& size);
+    static ToolShape sphere(double radius);
+    /// A closed triangle mesh in the tool's frame, mm. Throws InputError when it has no triangle.
+    static ToolShape from_mesh(TriangleMesh mesh);
+
+    [[nodiscard]] Kind kind() const { return m_kind; }
+
+    /// Signed distance from p (tool frame, mm) to the surface: negative inside. `gradient`, when
+    /// given, receives the unit direction in which the distance grows fastest (the outward normal
+    /// of the nearest surface point).
+    [[nodiscard]] double signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const;
+
+    /// Bounds of the shape grown by `margin` (mm), tool frame.
+    [[nodiscard]] Eigen::AlignedBox3d bounds(double margin = 0.0) const;
+
+    /// A triangle mesh of the shape grown by `margin`, for pictures and continuous collision:
+    /// boxes and scalpels keep their flat faces (each face moved out by the margin, corners not
+    /// rounded), spheres are subdivided icosahedra (`detail` subdivisions) of radius + margin,
+    /// meshes move each vertex out by the margin along its normal.
+    [[nodiscard]] TriangleMesh mesh(double margin = 0.0, int detail = 2) const;
+
+private:
+    ToolShape() = default;
+    [[nodiscard]] double prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const;
+    [[nodiscard]] double mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const;
+
+    Kind m_kind = Kind::box;
+    Eigen::Vector3d m_size = Eigen::Vector3d::Zero();
+    double m_radius = 0.0;
+    /// box, scalpel: the convex profile in the x-z plane, counter-clockwise (x right, z up).
+    std::vector<Eigen::Vector2d> m_profile;
+    TriangleMesh m_mesh; ///< mesh tools
+    Eigen::AlignedBox3d m_bounds;
+};
+
+/// A tool shape placed in the world: world = position + orientation * tool frame (mm).
+struct PlacedShape {
+    const ToolShape* shape = nullptr;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+
+    /// Signed distance of a world point (mm); `gradient` in world frame.
+    [[nodiscard]] double signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient = nullptr) const;
+    /// World-axis box holding the shape grown by `margin`.
+    [[nodiscard]] Eigen::AlignedBox3d world_bounds(double margin = 0.0) const;
+};
+
+} // namespace vox::contact

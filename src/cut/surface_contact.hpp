@@ -1,0 +1,32 @@
+#pragma once
+// A tool pressed against the deformed surface: the contact module's penalty model evaluated on
+// the surface vertices near the tool, and its forces gathered on the model's nodes (each vertex's
+// force shared by the corners of its element with the trilinear weights; the penalty stiffness
+// lumped the same way), ready for the solver's implicit contact.
+
+#include "contact/penalty_contact.hpp"
+#include "cut/model_surface.hpp"
+#include "fem/implicit_solver.hpp"
+
+#include <vector>
+
+namespace vox::cut {
+
+struct SurfaceContact {
+    contact::ContactResult contact;         ///< its points index `vertices`
+    std::vector<std::uint32_t> vertices;    ///< surface vertex slot of each contact point
+    std::vector<Eigen::Vector3d> positions_mm; ///< deformed position of each contact point, world mm
+    std::vector<fem::NodeContact> nodes;    ///< the forces on the model's nodes (N, N/m)
+    std::vector<std::uint32_t> elements;    ///< model elements holding contact points (sorted, unique)
+};
+
+/// Contact of `tool` (its inner shape; the outer is grown by parameters.margin_mm) with the
+/// surface deformed by `node_positions` (m). Only elements whose deformed corner box meets the
+/// tool's reach are visited.
+[[nodiscard]] SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                                           const contact::PlacedShape& tool, const contact::ContactParameters& parameters);
+
+/// Adds `b`'s node contacts to `a` (several tools on one object).
+void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b);
+
+} // namespace vox::cut
