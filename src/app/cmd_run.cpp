@@ -11,6 +11,7 @@
 #include "app/level_choice.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/tool_session.hpp"
+#include "cut/pieces.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -63,9 +64,13 @@ void add_run_command(CLI::App& app)
         if (scene.solver.type != io::SolverType::dbg)
             throw scene.error("solver.type", "\"isxfem\" runs are not available yet; use \"dbg\"");
         const grid::LabelGrid labels = io::load_scene_object(scene);
-        // Coarser levels than the simulated one serve the multigrid preconditioner; "auto" tries them all.
-        const int max_level = scene.object.auto_levels ? 6 : std::min(6, std::max(scene.object.levels, 1) + 3);
-        grid::BranchedGrid g = build_scene_grid(scene, labels, max_level);
+        // Coarser levels than the simulated one serve only the multigrid preconditioner (built
+        // when the solver will use it: every level costs memory and time at each cut); "auto"
+        // tries them all.
+        const int simulated = std::max(scene.object.levels, 1);
+        grid::BranchedGrid g = build_scene_grid(scene, labels, scene.object.auto_levels ? 6 : simulated);
+        if (!scene.object.auto_levels && simulated < 6 && wants_multigrid(scene, g, scene.object.levels))
+            g = build_scene_grid(scene, labels, std::min(6, simulated + 3));
         LevelChoice choice;
         choice.level = scene.object.levels;
         if (scene.object.auto_levels) {
@@ -174,6 +179,8 @@ void add_run_command(CLI::App& app)
                             {"cutting_frames", cutting_ms.size()},
                             {"cutting_ms_p95", percentile(cutting_ms, 0.95)},
                             {"final_elements", sim.model().elements().size()},
+                            {"pieces", cut::piece_count(sim.model())},
+                            {"mass_kg", g.total_mass_kg()},
                             {"final_max_displacement_mm", last.max_displacement_m * 1e3},
                             {"final_elastic_energy_j", last.elastic_energy_j},
                             {"final_kinetic_energy_j", last.kinetic_energy_j}};

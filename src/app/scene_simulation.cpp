@@ -54,6 +54,13 @@ std::string energy_guard_message(const io::Scene& scene, int frame)
            "the forces are too large for this object (or solver.dt_s too long): reduce the loads or dt_s";
 }
 
+bool wants_multigrid(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
+{
+    // The DOF count of a level is three per node; level 0 has about one node per voxel.
+    const std::size_t dofs = 3 * (level >= 1 ? grid.level(level).stats.nodes : grid.voxels().alive_count());
+    return resolve(scene.solver.preconditioner, dofs, true) == io::PreconditionerChoice::multigrid;
+}
+
 grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGrid& labels, int max_level)
 {
     const io::MaterialTable table = io::material_table(scene);

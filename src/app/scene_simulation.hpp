@@ -21,6 +21,11 @@ namespace vox::app {
 /// one serve the multigrid preconditioner).
 [[nodiscard]] grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGrid& labels, int max_level);
 
+/// Whether simulating `scene` at `level` of `grid` would pick the multigrid preconditioner, which
+/// needs the grid's coarser levels; without it a grid up to `level` is enough (and cuts update
+/// fewer levels).
+[[nodiscard]] bool wants_multigrid(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+
 /// The message of a step that still created energy at 1/32 of dt (fem::StepStats::energy_guarded):
 /// the loads or the time step are beyond what this object and level can follow.
 [[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);

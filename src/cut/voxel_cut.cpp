@@ -1,5 +1,6 @@
 #include "cut/voxel_cut.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <unordered_map>
@@ -127,38 +128,74 @@ std::vector<std::pair<grid::Coord, int>> faces_crossed(const ModelSurface& surfa
     std::vector<std::pair<grid::Coord, int>> out;
     if (swept.triangles.empty()) return out;
     const fem::HexModel& model = surface.model();
-    const grid::FineVoxels& voxels = surface.grid().voxels();
+    const grid::BranchedGrid& grid = surface.grid();
+    const grid::FineVoxels& voxels = grid.voxels();
+    const int level = model.level();
+    // Pairs are tested from their lower voxel, which may lie a whole (stretched) segment away
+    // from the surface: two voxels of margin.
     Eigen::AlignedBox3d reach = swept.bounds();
     const double voxel_mm = 1e3 * voxels.voxel_size_m().maxCoeff();
-    reach.extend(reach.min() - Eigen::Vector3d::Constant(voxel_mm));
-    reach.extend(reach.max() + Eigen::Vector3d::Constant(voxel_mm));
+    reach.extend(reach.min() - Eigen::Vector3d::Constant(2.0 * voxel_mm));
+    reach.extend(reach.max() + Eigen::Vector3d::Constant(2.0 * voxel_mm));
+    const Eigen::Matrix4d& to_world = voxels.index_to_world();
+    const Eigen::Matrix3d to_index = to_world.topLeftCorner<3, 3>().inverse();
     std::unordered_map<std::uint32_t, Eigen::Vector3d, CoordHash> centre;
     auto centre_of = [&](std::uint32_t v) -> const Eigen::Vector3d& {
         auto found = centre.find(v);
         if (found == centre.end()) found = centre.emplace(v, surface.voxel_centre_mm(v, node_positions)).first;
         return found->second;
     };
+    std::vector<std::uint32_t> candidates;
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        const fem::HexElement& el = model.elements()[e];
         Eigen::AlignedBox3d box;
         box.setEmpty();
-        for (std::uint32_t n : model.elements()[e].dof_node) box.extend(1e3 * node_positions[n]);
+        for (std::uint32_t n : el.dof_node) box.extend(1e3 * node_positions[n]);
         if (!box.intersects(reach)) continue;
-        for (std::uint32_t v : surface.element_voxels(e)) {
-            const Eigen::Vector3d p = centre_of(v);
-            if (!reach.contains(p)) continue;
-            for (int axis = 0; axis < 3; ++axis) {
-                const std::uint32_t u = voxels.connected_neighbour(v, axis);
-                if (u == grid::FineVoxels::missing) continue;
-                // The rest segment, carried to where the pair now is: judged by its rest geometry,
-                // not by how far the blade has squeezed the two centres apart or together.
-                const Eigen::Vector3d mid = 0.5 * (p + centre_of(u));
-                const Eigen::Vector3d half = 0.5 * (surface.voxel_rest_mm(v) - surface.voxel_rest_mm(u));
-                for (const auto& t : swept.triangles)
-                    if (segment_crosses(mid + half, mid - half, t, swept.normal)) {
-                        out.emplace_back(voxels.coord(v), axis);
-                        break;
-                    }
-            }
+        // Only voxels whose rest centre, moved by the element's mean displacement, can reach:
+        // a trilinear displacement differs from the mean by at most the corners' spread.
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (std::uint32_t n : el.dof_node) mean += 1e3 * (node_positions[n] - model.rest_positions()[n]) / 8.0;
+        double spread = 0.0;
+        for (std::uint32_t n : el.dof_node) spread = std::max(spread, (1e3 * (node_positions[n] - model.rest_positions()[n]) - mean).norm());
+        const Eigen::Vector3d lo = reach.min() - mean - Eigen::Vector3d::Constant(spread);
+        const Eigen::Vector3d hi = reach.max() - mean + Eigen::Vector3d::Constant(spread);
+        Eigen::AlignedBox3d index_box;
+        index_box.setEmpty();
+        for (int c = 0; c < 8; ++c) {
+            const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+            index_box.extend(to_index * (corner - to_world.topRightCorner<3, 1>()));
+        }
+        const grid::Coord cell = level == 0 ? voxels.coord(el.grid_element) : grid.level(level).elements[el.grid_element].cell;
+        const int size = 1 << level;
+        grid::Coord first, last;
+        for (int a = 0; a < 3; ++a) {
+            first[a] = std::max(cell[a] * size, static_cast<int>(std::ceil(index_box.min()[a] - 0.5)));
+            last[a] = std::min(cell[a] * size + size - 1, static_cast<int>(std::floor(index_box.max()[a] + 0.5)));
+        }
+        for (int k = first.z(); k <= last.z(); ++k)
+            for (int j = first.y(); j <= last.y(); ++j)
+                for (int i = first.x(); i <= last.x(); ++i) {
+                    const std::uint32_t v = voxels.find(grid::Coord(i, j, k));
+                    if (v == grid::FineVoxels::missing) continue;
+                    Eigen::Vector3d local;
+                    if (surface.voxel_element(v, local) == e) candidates.push_back(v); // superimposed: its own element
+                }
+    }
+    // Deformed centres: each voxel is on one side of the swept surface whatever pair it is tested
+    // in (so the cut surface closes), and the cut meets the material where the user sees it.
+    for (std::uint32_t v : candidates) {
+        const Eigen::Vector3d p = centre_of(v);
+        if (!reach.contains(p)) continue;
+        for (int axis = 0; axis < 3; ++axis) {
+            const std::uint32_t u = voxels.connected_neighbour(v, axis);
+            if (u == grid::FineVoxels::missing) continue;
+            const Eigen::Vector3d q = centre_of(u);
+            for (const auto& t : swept.triangles)
+                if (segment_crosses(p, q, t, swept.normal)) {
+                    out.emplace_back(voxels.coord(v), axis);
+                    break;
+                }
         }
     }
     return out;

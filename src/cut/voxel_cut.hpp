@@ -7,10 +7,11 @@
 //    stays; the cutting surface swept over the stroke opens the face between two neighbours when
 //    the segment joining their centres crosses it (a centre exactly on the surface counts as lying
 //    on the side its normal points to), so a thin blade splits the object, never cuts out a slab.
-//    The segment is the rest one carried to where the pair now is (centred on the midpoint of
-//    the deformed centres): the cut follows the object the user sees, and a pair is judged by its
-//    rest geometry, not by how the blade squeezed it. On an object at rest these are the rest
-//    centres exactly.
+//    The centres are the deformed ones: each voxel is on one side whatever pair it is tested in
+//    (testing each pair by its rest segment moved to where the pair is cuts neighbouring rows at
+//    different faces, and the pieces stay joined through the faces between those rows), and the
+//    cut meets the material where the user sees it. On an object at rest they are the rest
+//    centres, and the side rule is exact.
 // Removal tests deformed centres: what is inside the blade now goes.
 
 #include "contact/tool_shape.hpp"
