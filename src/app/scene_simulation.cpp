@@ -159,23 +159,54 @@ void SceneSimulation::build(bool first)
     }
 
     solver.set_gravity(scene.gravity_m_s2);
+    // Superimposed elements share their cell's corner positions: a box catches a node of one
+    // only when that element's own material reaches into the box, so holding one arm of a U-tube
+    // does not hold the other arm's element in the same cell.
+    std::vector<unsigned char> superimposed(model.elements().size(), 0); // cells holding several elements
+    if (level >= 1) {
+        const grid::Level& lv = grid.level(level);
+        for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+            const grid::Element& ge = lv.elements[model.elements()[e].grid_element];
+            superimposed[e] = lv.cell_elements(ge.code).size() > 1;
+        }
+    }
+    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+        std::vector<unsigned char> kept(model.node_count(), 0);
+        const Eigen::Matrix4d& t = grid.voxels().index_to_world();
+        const Eigen::Vector3d half = 0.5e3 * grid.voxels().voxel_size_m();
+        for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+            bool touches = !superimposed[e];
+            if (!touches)
+                for (std::uint32_t v : grid.level(level).elements[model.elements()[e].grid_element].voxels) {
+                    const grid::Coord c = grid.voxels().coord(v);
+                    const Eigen::Vector3d p = t.topLeftCorner<3, 3>() * Eigen::Vector3d(c.x(), c.y(), c.z()) + t.topRightCorner<3, 1>();
+                    if (in_box(p, lo - half, hi + half)) {
+                        touches = true;
+                        break;
+                    }
+                }
+            if (touches)
+                for (std::uint32_t n : model.elements()[e].dof_node) kept[n] = 1;
+        }
+        std::vector<std::uint32_t> out;
+        for (std::uint32_t n = 0; n < model.node_count(); ++n)
+            if (kept[n] && in_box(model.rest_positions()[n] * 1e3, lo, hi)) out.push_back(n);
+        return out;
+    };
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
         bool caught = false;
-        for (std::uint32_t n = 0; n < model.node_count(); ++n)
-            if (in_box(model.rest_positions()[n] * 1e3, c.box_min_mm, c.box_max_mm)) {
-                solver.fix(n, axes);
-                caught = true;
-            }
+        for (std::uint32_t n : box_nodes(c.box_min_mm, c.box_max_mm)) {
+            solver.fix(n, axes);
+            caught = true;
+        }
         if (!caught && first)
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
         const io::Load& load = scene.loads[k];
-        std::vector<std::uint32_t> caught;
-        for (std::uint32_t n = 0; n < model.node_count(); ++n)
-            if (in_box(model.rest_positions()[n] * 1e3, load.box_min_mm, load.box_max_mm)) caught.push_back(n);
+        const std::vector<std::uint32_t> caught = box_nodes(load.box_min_mm, load.box_max_mm);
         if (caught.empty() && !first) continue; // the cut took the loaded material
         if (caught.empty())
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
