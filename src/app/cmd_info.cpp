@@ -121,6 +121,7 @@ json mesh_info_json(const std::string& path, double mm_per_unit)
             {"boundary_edges", m.boundary_edges},
             {"non_manifold_edges", m.non_manifold_edges},
             {"closed", m.closed},
+            {"components", m.components},
             {"consistently_oriented", m.consistently_oriented},
             {"area_mm2", m.area_mm2},
             // An open mesh encloses no well-defined volume.

@@ -153,10 +153,15 @@ ToolShape ToolShape::scalpel(const Eigen::Vector3d& size)
     ToolShape s = box(size);
     s.m_kind = Kind::scalpel;
     const double hx = size.x() / 2, hz = size.z() / 2;
-    // The front rises at 45 degrees from the point; a blade shorter than it is tall becomes a triangle.
-    const double top_front = std::max(-hx, hx - size.z());
+    // The front rises at 45 degrees from the point; a blade shorter than it is tall becomes the
+    // 45-degree triangle whose slanted side meets the back at height size.x() above the bottom.
+    const double top_front = hx - size.z();
     s.m_profile = {{-hx, -hz}, {hx, -hz}, {top_front, hz}, {-hx, hz}};
-    if (top_front <= -hx) s.m_profile = {{-hx, -hz}, {hx, -hz}, {-hx, hz}};
+    if (top_front <= -hx) {
+        const double top = std::min(hz, -hz + size.x());
+        s.m_profile = {{-hx, -hz}, {hx, -hz}, {-hx, top}};
+        s.m_bounds.max().z() = top;
+    }
     return s;
 }
 

@@ -110,15 +110,20 @@ SweptSurface sweep_section(const contact::ToolShape& shape, double margin, const
 bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const std::array<Eigen::Vector3d, 3>& t,
                      const Eigen::Vector3d& normal)
 {
-    Eigen::Vector3d n = (t[1] - t[0]).cross(t[2] - t[0]);
-    if (n.squaredNorm() == 0.0) return false; // a degenerate band (an edge moving along itself)
-    if (n.dot(normal) < 0.0) n = -n;
+    const Eigen::Vector3d winding = (t[1] - t[0]).cross(t[2] - t[0]);
+    if (winding.squaredNorm() == 0.0) return false; // a degenerate band (an edge moving along itself)
+    const Eigen::Vector3d n = winding.dot(normal) < 0.0 ? Eigen::Vector3d(-winding) : winding; // the side rule's orientation
     const double sp = n.dot(p - t[0]), sq = n.dot(q - t[0]);
-    if ((sp >= 0.0) == (sq >= 0.0)) return false; // both on one side (on the surface counts as +)
+    // On the surface counts as +, to within 1e-9 of the segment's length: the triangles of one flat
+    // section are coplanar only up to rounding, and a centre on it must fall on the same side of
+    // all of them, or both pairs around it are cut (a one-voxel slab).
+    const double on = 1e-9 * (q - p).norm() * n.norm();
+    if ((sp >= -on) == (sq >= -on)) return false; // both on one side
     const Eigen::Vector3d x = p + (sp / (sp - sq)) * (q - p);
-    // Inside the triangle, edges included: the same side of each edge as the normal says.
+    // Inside the triangle, edges included: x on the inner side of each edge, as the triangle's own
+    // winding (not the side rule's normal, which may be its opposite) orders them.
     for (int k = 0; k < 3; ++k)
-        if ((t[(k + 1) % 3] - t[k]).cross(x - t[k]).dot(n) < -1e-12 * n.squaredNorm()) return false;
+        if ((t[(k + 1) % 3] - t[k]).cross(x - t[k]).dot(winding) < -1e-12 * winding.squaredNorm()) return false;
     return true;
 }
 

@@ -44,7 +44,8 @@ struct SweptSurface {
                                          const contact::PlacedShape& to);
 
 /// Whether the segment p-q crosses the triangle, with the side rule above (`normal` orients the
-/// triangle's plane).
+/// triangle's plane; an end within 1e-9 of |q - p| of the plane counts as on it, so rounding cannot
+/// put one centre on different sides of the coplanar triangles of a section).
 [[nodiscard]] bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const std::array<Eigen::Vector3d, 3>& triangle,
                                    const Eigen::Vector3d& normal);
 

@@ -75,6 +75,15 @@ void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, Me
     }
     info.boundary_loops = loop_area.size();
     for (const auto& [root, area] : loop_area) info.boundary_cap_area_mm2 += area.norm();
+
+    grid::UnionFind pieces(mesh.vertices.size());
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+        pieces.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]));
+        pieces.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[2]));
+    }
+    std::unordered_map<std::uint32_t, bool> roots;
+    for (const Eigen::Vector3i& t : mesh.triangles) roots.emplace(pieces.find(static_cast<std::uint32_t>(t[0])), true);
+    info.components = roots.size();
 }
 
 } // namespace

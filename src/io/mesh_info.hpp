@@ -19,6 +19,7 @@ struct MeshInfo {
     std::size_t boundary_edges = 0;     ///< edges in exactly one triangle
     std::size_t non_manifold_edges = 0; ///< edges in more than two triangles
     std::size_t boundary_loops = 0;     ///< connected components of the boundary edges (holes)
+    std::size_t components = 0;         ///< connected pieces: triangles joined through shared vertices
     bool closed = false;                ///< every edge in exactly two triangles
     /// Every edge shared by several triangles is traversed as often in one direction as in the
     /// other, i.e. neighbouring triangles agree on which side is outside.

@@ -1,0 +1,165 @@
+// Cutting end to end: the bundled cutting scenes run headless, checked on what they must show.
+
+#include "app/run_command.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using vox::test::fresh_dir;
+using vox::test::quote;
+using vox::test::run_voxsculpt;
+
+namespace {
+
+nlohmann::json info_json(const fs::path& file)
+{
+    const auto r = run_voxsculpt("info --json " + quote(file.string()));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+}
+
+/// Runs a bundled scene (data/scenes/NAME.json) into `out` with extra options; returns stats.json.
+nlohmann::json run_bundled(const std::string& name, const fs::path& out, const std::string& options = "")
+{
+    const auto r = run_voxsculpt("run " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/" + name + ".json") + " --out " +
+                                 quote(out.string()) + " " + options);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(out / "stats.json");
+    return nlohmann::json::parse(in);
+}
+
+/// Every frame mesh written into `dir` is a closed surface.
+void expect_all_frames_closed(const fs::path& dir)
+{
+    int checked = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().extension() != ".obj") continue;
+        const nlohmann::json j = info_json(entry.path());
+        EXPECT_EQ(j["closed"], true) << entry.path();
+        EXPECT_EQ(j["consistently_oriented"], true) << entry.path();
+        ++checked;
+    }
+    EXPECT_GT(checked, 0);
+}
+
+/// Lowest z of the surface vertices within 1.5 mm (x, y) of a point, from an OBJ file.
+double lowest_top(const fs::path& obj, double x, double y)
+{
+    std::ifstream in(obj);
+    std::string line;
+    double lowest = 1e9;
+    while (std::getline(in, line)) {
+        if (line.rfind("v ", 0) != 0) continue;
+        std::istringstream s(line.substr(2));
+        double px = 0, py = 0, pz = 0;
+        s >> px >> py >> pz;
+        if (std::abs(px - x) < 1.5 && std::abs(py - y) < 1.5 && pz > 5.0) lowest = std::min(lowest, pz);
+    }
+    return lowest;
+}
+
+} // namespace
+
+TEST(Cutting, ThroughCutSeparatesTheCylinderIntoTwoClosedPiecesAndKeepsEveryVoxel)
+{
+    // The scene's blade sweeps through the hanging cylinder in separate mode; a mesh every frame.
+    const fs::path out = fresh_dir("cut_cylinder");
+    const nlohmann::json stats = run_bundled("cylinder_cut", out, "--frames 60");
+    const nlohmann::json& s = stats["summary"];
+    EXPECT_EQ(s["pieces"], 2);
+    EXPECT_GT(s["separated_faces"].get<int>(), 0);
+    EXPECT_EQ(s["removed_voxels"], 0);
+    // Separate mode keeps every voxel and so every gram: 4,800 voxels of 1 mm^3 at 1100 kg/m^3.
+    EXPECT_EQ(s["voxels"], 4800);
+    EXPECT_NEAR(s["mass_kg"].get<double>(), 4800 * 1e-9 * 1100, 1e-12);
+    const nlohmann::json final_surface = info_json(out / "final.obj");
+    EXPECT_EQ(final_surface["closed"], true);
+    EXPECT_EQ(final_surface["components"], 2);
+    // The lower piece falls away: after the cut its displacement grows like g t^2 / 2.
+    EXPECT_GT(s["final_max_displacement_mm"].get<double>(), 100.0);
+    // Per-frame phases are reported.
+    for (const char* key : {"collision_ms", "propagation_ms", "grid_update_ms", "remesh_ms", "fem_update_ms", "removed_voxels",
+                            "separated_faces"})
+        EXPECT_TRUE(stats["frames"][0].contains(key)) << key;
+}
+
+TEST(Cutting, SurfaceStaysClosedAfterEveryCutStep)
+{
+    // Every frame's surface, in both modes: the cylinder (separate) and the knife of the broad /
+    // sharp scene (remove).
+    const fs::path separate = fresh_dir("cut_every_frame_separate");
+    {
+        std::ifstream in(std::string(VOX_SOURCE_DIR) + "/data/scenes/cylinder_cut.json");
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string scene = text.str();
+        const std::string every = "\"mesh_every_n_frames\": 10";
+        scene.replace(scene.find(every), every.size(), "\"mesh_every_n_frames\": 1");
+        std::ofstream(separate / "scene.json") << scene;
+    }
+    ASSERT_EQ(run_voxsculpt("run " + quote((separate / "scene.json").string()) + " --frames 16 --out " + quote((separate / "out").string()))
+                  .exit_code,
+              0);
+    expect_all_frames_closed(separate / "out");
+
+    const fs::path removal = fresh_dir("cut_every_frame_remove");
+    const nlohmann::json stats = run_bundled("push_broad_vs_sharp", removal, "--frames 40");
+    EXPECT_GT(stats["summary"]["removed_voxels"].get<int>(), 0);
+    expect_all_frames_closed(removal);
+}
+
+TEST(Cutting, ABroadPushCutsNothingWhereASharpOneCuts)
+{
+    const fs::path out = fresh_dir("cut_broad_sharp");
+    const nlohmann::json stats = run_bundled("push_broad_vs_sharp", out);
+    bool paddle_cut = false, knife_cut = false;
+    double paddle_force = 0.0, knife_force = 0.0;
+    for (const nlohmann::json& f : stats["frames"]) {
+        paddle_cut = paddle_cut || f["tools"][0]["cut"].get<bool>();
+        knife_cut = knife_cut || f["tools"][1]["cut"].get<bool>();
+        paddle_force = std::max(paddle_force, f["tools"][0]["force_n"][2].get<double>());
+        knife_force = std::max(knife_force, f["tools"][1]["force_n"][2].get<double>());
+    }
+    EXPECT_FALSE(paddle_cut);
+    EXPECT_TRUE(knife_cut);
+    // The paddle pushes with more force than the knife, spread over more area.
+    EXPECT_GT(paddle_force, knife_force);
+    EXPECT_EQ(stats["summary"]["pieces"], 1);
+}
+
+TEST(Cutting, TheUTubesArmsComeApart)
+{
+    // One coarse cell holds the base and both arms' feet: cutting the base splits it into two
+    // superimposed elements, and the free arm falls.
+    const fs::path out = fresh_dir("cut_utube");
+    const nlohmann::json stats = run_bundled("utube_cut", out);
+    EXPECT_EQ(stats["elements"], 7);
+    EXPECT_EQ(stats["summary"]["final_elements"], 8);
+    EXPECT_EQ(stats["summary"]["pieces"], 2);
+    EXPECT_EQ(info_json(out / "final.obj")["components"], 2);
+    EXPECT_GT(stats["summary"]["final_max_displacement_mm"].get<double>(), 50.0);
+}
+
+TEST(Cutting, AWettedRegionIsPushedFurtherThanADryOne)
+{
+    // Identical spheres press the same 3 mm into dry and soaked clay and lift off: the soaked side
+    // resists with less force and keeps a deeper dent.
+    const fs::path out = fresh_dir("cut_wet_push");
+    const nlohmann::json stats = run_bundled("wet_push", out);
+    double dry_force = 0.0, wet_force = 0.0;
+    for (const nlohmann::json& f : stats["frames"]) {
+        dry_force = std::max(dry_force, f["tools"][0]["force_n"][2].get<double>());
+        wet_force = std::max(wet_force, f["tools"][1]["force_n"][2].get<double>());
+    }
+    EXPECT_LT(wet_force, 0.6 * dry_force);
+    const double dry_top = lowest_top(out / "final.obj", 9.5, 9.5);
+    const double wet_top = lowest_top(out / "final.obj", 29.5, 9.5);
+    EXPECT_LT(dry_top, 9.5);            // a lasting dent in the dry clay too
+    EXPECT_LT(wet_top, dry_top - 0.1);  // deeper in the wet
+}

@@ -1,0 +1,248 @@
+// Penalty contact: a flat patch under a flat tool gives f = k d A / 1 cm^2 and the pressure k d,
+// the reaction and torque on the tool balance the point forces, and the per-point stiffness is
+// the derivative of the force with respect to the depth.
+
+#include "contact/penalty_contact.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+using namespace vox::contact;
+using Eigen::Vector3d;
+
+namespace {
+
+/// A 20 x 20 x 4 mm plate tool; its bottom face is at z = position.z - 2.
+const ToolShape plate = ToolShape::box({20, 20, 4});
+
+/// A 10 x 10 grid of surface points on z = 0, 1 mm apart, centred on (cx, cy), 1 mm^2 each,
+/// outward normal +z (the object lies below).
+struct Patch {
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    Patch(double cx = 0.0, double cy = 0.0)
+    {
+        for (int i = 0; i < 10; ++i)
+            for (int j = 0; j < 10; ++j) {
+                points.emplace_back(cx - 4.5 + i, cy - 4.5 + j, 0.0);
+                normals.emplace_back(0, 0, 1);
+                areas.push_back(1.0);
+            }
+    }
+    void add(const Vector3d& p, const Vector3d& n, double a)
+    {
+        points.push_back(p);
+        normals.push_back(n);
+        areas.push_back(a);
+    }
+    [[nodiscard]] ContactResult contact(const PlacedShape& tool, const ContactParameters& c) const
+    {
+        return penalty_contact(tool, c, points, areas, normals);
+    }
+};
+
+/// The plate placed so that the patch (z = 0) is `depth` inside its outer shape.
+PlacedShape plate_pressing(double depth, const ContactParameters& c, double x = 0.0, double y = 0.0)
+{
+    return PlacedShape{&plate, Vector3d(x, y, c.margin_mm - depth + 2.0), Eigen::Quaterniond::Identity()};
+}
+
+} // namespace
+
+TEST(PenaltyContact, FlatPatchUnderAFlatToolPushesWithKDAPerSquareCentimetre)
+{
+    ContactParameters c;
+    c.margin_mm = 1.0;
+    c.stiffness_n_per_mm = 7.0;
+    const double depth = 0.25, area = 100.0; // mm, mm^2
+    const Patch patch;
+    const ContactResult r = patch.contact(plate_pressing(depth, c), c);
+    ASSERT_EQ(r.points.size(), 100u);
+    const double total = c.stiffness_n_per_mm * depth * area / 100.0; // N
+    Vector3d on_points = Vector3d::Zero();
+    for (const PointContact& p : r.points) {
+        EXPECT_DOUBLE_EQ(p.depth_mm, depth);
+        EXPECT_EQ(p.normal, Vector3d(0, 0, -1));
+        EXPECT_DOUBLE_EQ(p.stiffness_n_per_mm, c.stiffness_n_per_mm / 100.0);
+        EXPECT_LT((p.force_n - Vector3d(0, 0, -c.stiffness_n_per_mm * depth / 100.0)).norm(), 1e-16);
+        EXPECT_FALSE(p.inside_inner);
+        on_points += p.force_n;
+    }
+    EXPECT_LT((on_points - Vector3d(0, 0, -total)).norm(), 1e-14 * total);
+    EXPECT_LT((r.force_on_tool_n - Vector3d(0, 0, total)).norm(), 1e-14 * total);
+    EXPECT_DOUBLE_EQ(r.area_mm2, area);
+    // k d over 1 cm^2: N / mm^2 = 1e6 Pa.
+    EXPECT_NEAR(r.pressure_pa, 1e6 * c.stiffness_n_per_mm * depth / 100.0, 1e-9);
+    EXPECT_FALSE(r.inner_reaches_surface());
+    // Linear in the depth and independent of the resolution: twice as deep, twice the force.
+    const ContactResult deeper = patch.contact(plate_pressing(2 * depth, c), c);
+    EXPECT_NEAR(deeper.force_on_tool_n.z(), 2 * total, 1e-14 * total);
+    EXPECT_NEAR(deeper.pressure_pa, 2 * r.pressure_pa, 1e-9);
+}
+
+TEST(PenaltyContact, PressureDoesNotDependOnTheSampling)
+{
+    // The same 100 mm^2 as 400 points of 0.25 mm^2: the same force and pressure.
+    ContactParameters c;
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) {
+            points.emplace_back(-4.75 + 0.5 * i, -4.75 + 0.5 * j, 0.0);
+            normals.emplace_back(0, 0, 1);
+            areas.push_back(0.25);
+        }
+    const PlacedShape tool = plate_pressing(0.4, c);
+    const ContactResult fine = penalty_contact(tool, c, points, areas, normals);
+    const ContactResult coarse = Patch().contact(tool, c);
+    EXPECT_NEAR(fine.force_on_tool_n.z(), coarse.force_on_tool_n.z(), 1e-13 * coarse.force_on_tool_n.z());
+    EXPECT_NEAR(fine.pressure_pa, coarse.pressure_pa, 1e-8);
+    EXPECT_DOUBLE_EQ(fine.area_mm2, coarse.area_mm2);
+}
+
+TEST(PenaltyContact, PointsOutsideTheMarginAreIgnored)
+{
+    ContactParameters c;
+    c.margin_mm = 1.0;
+    Patch patch;
+    const PlacedShape tool = plate_pressing(0.25, c); // bottom face at z = 0.75
+    patch.add({0, 0, -0.25}, {0, 0, 1}, 5.0);       // exactly at the margin: depth 0
+    patch.add({1, 1, -0.5}, {0, 0, 1}, 5.0);        // beyond the margin
+    patch.add({50, 0, 0.75}, {0, 0, 1}, 5.0);       // far beside the tool
+    patch.add({10.9, 10.9, 0.75}, {0, 0, 1}, 5.0);  // inside the grown bounds, outside the rounded edge (0.9 sqrt2 > 1)
+    patch.add({10.5, 10.5, 0.75}, {0, 0, 1}, 5.0);  // inside the rounded edge (0.5 sqrt2 < 1): counts
+    ASSERT_NEAR(tool.signed_distance(patch.points[100]), 1.0, 1e-15);
+    const ContactResult r = patch.contact(tool, c);
+    ASSERT_EQ(r.points.size(), 101u);
+    EXPECT_EQ(r.points.back().point, 104u);
+    EXPECT_NEAR(r.points.back().depth_mm, 1.0 - 0.5 * std::sqrt(2.0), 1e-15);
+    EXPECT_DOUBLE_EQ(r.area_mm2, 105.0);
+    for (const PointContact& p : r.points) EXPECT_GT(p.depth_mm, 0.0);
+    // Nothing within reach: no force, no pressure.
+    const ContactResult none = patch.contact(plate_pressing(-0.5, c), c);
+    EXPECT_TRUE(none.points.empty());
+    EXPECT_EQ(none.force_on_tool_n, Vector3d::Zero());
+    EXPECT_EQ(none.pressure_pa, 0.0);
+    EXPECT_EQ(none.area_mm2, 0.0);
+}
+
+TEST(PenaltyContact, TorqueIsZeroForACentredPatchAndRCrossFOffCentre)
+{
+    ContactParameters c;
+    c.stiffness_n_per_mm = 5.0;
+    const double depth = 0.3;
+    const Patch patch; // centred on the origin
+    const ContactResult centred = patch.contact(plate_pressing(depth, c), c);
+    const double f = c.stiffness_n_per_mm * depth; // over 100 mm^2
+    EXPECT_LT(centred.torque_on_tool_n_mm.norm(), 1e-12 * f);
+    // The tool moved by (3, -2) in its plane: the patch's centroid is at r = (-3, 2, -h) from the
+    // tool's origin and the uniform load acts there: torque = r x F.
+    const PlacedShape off = plate_pressing(depth, c, 3.0, -2.0);
+    const ContactResult r = patch.contact(off, c);
+    ASSERT_EQ(r.points.size(), 100u);
+    const Vector3d arm = Vector3d::Zero() - off.position;
+    const Vector3d expected = arm.cross(r.force_on_tool_n);
+    EXPECT_LT((r.force_on_tool_n - Vector3d(0, 0, f)).norm(), 1e-13 * f);
+    EXPECT_LT((r.torque_on_tool_n_mm - expected).norm(), 1e-12 * expected.norm());
+    EXPECT_NEAR(r.torque_on_tool_n_mm.x(), 2 * f, 1e-12 * f);
+    EXPECT_NEAR(r.torque_on_tool_n_mm.y(), 3 * f, 1e-12 * f);
+    // And the moment balance point by point: the tool's torque is minus the points' moments.
+    Vector3d moments = Vector3d::Zero();
+    for (const PointContact& p : r.points) moments += (patch.points[p.point] - off.position).cross(p.force_n);
+    EXPECT_LT((r.torque_on_tool_n_mm + moments).norm(), 1e-12 * expected.norm());
+}
+
+TEST(PenaltyContact, ZeroNormalFallsBackToTheToolNormal)
+{
+    ContactParameters c;
+    c.margin_mm = 1.0;
+    c.stiffness_n_per_mm = 4.0;
+    const PlacedShape tool{&plate, Vector3d(0, 0, 10), Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Vector3d::UnitZ()))};
+    // Beside the plate's side face (its local x = 10, turned to world y = 10), 0.3 mm off it.
+    const std::vector<Vector3d> points{{0, 10.3, 10}, {0, 10.3, 10}};
+    const std::vector<Vector3d> normals{Vector3d::Zero(), Vector3d(0, 0, 1)};
+    const std::vector<double> areas{2.0, 2.0};
+    const ContactResult r = penalty_contact(tool, c, points, areas, normals);
+    ASSERT_EQ(r.points.size(), 2u);
+    const double magnitude = c.stiffness_n_per_mm / 100.0 * 2.0 * 0.7;
+    // Without a normal: pushed away from the tool, along its face normal (world +y).
+    EXPECT_LT((r.points[0].normal - Vector3d(0, 1, 0)).norm(), 1e-15);
+    EXPECT_LT((r.points[0].force_n - magnitude * Vector3d(0, 1, 0)).norm(), 1e-15);
+    // With one: along minus the object's normal, whatever the tool's face says.
+    EXPECT_EQ(r.points[1].normal, Vector3d(0, 0, -1));
+    EXPECT_LT((r.points[1].force_n - magnitude * Vector3d(0, 0, -1)).norm(), 1e-15);
+    EXPECT_NEAR(r.points[1].depth_mm, 0.7, 1e-14);
+}
+
+TEST(PenaltyContact, InsideInnerExactlyWhenTheDistanceIsNegative)
+{
+    // Points on the plate's axis across its bottom face (z = 0.75) at offsets -1e-12, 0, 1e-12.
+    ContactParameters c;
+    c.margin_mm = 1.0;
+    const PlacedShape tool = plate_pressing(0.25, c);
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    for (double offset : {-0.5, -1e-12, 0.0, 1e-12, 0.5, 1.9}) {
+        points.emplace_back(0.3, -0.2, 0.75 + offset);
+        normals.emplace_back(0, 0, 1);
+        areas.push_back(1.0);
+    }
+    const ContactResult r = penalty_contact(tool, c, points, areas, normals);
+    ASSERT_EQ(r.points.size(), points.size());
+    const bool expected[] = {false, false, false, true, true, true};
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        SCOPED_TRACE(testing::Message() << "point " << i);
+        const double distance = tool.signed_distance(points[i]);
+        EXPECT_EQ(r.points[i].inside_inner, distance < 0.0);
+        EXPECT_EQ(r.points[i].inside_inner, expected[i]);
+        EXPECT_DOUBLE_EQ(r.points[i].depth_mm, c.margin_mm - distance);
+    }
+    EXPECT_DOUBLE_EQ(tool.signed_distance(points[2]), 0.0); // on the face: not inside
+    EXPECT_TRUE(r.inner_reaches_surface());
+}
+
+TEST(PenaltyContact, StiffnessIsTheDerivativeOfTheForceWithDepth)
+{
+    // Press a sphere into a random curved cloud of points: moving the tool by h along a direction
+    // changes each point's force by the finite difference stiffness * d(depth).
+    ContactParameters c;
+    c.margin_mm = 0.5;
+    c.stiffness_n_per_mm = 3.0;
+    const ToolShape ball = ToolShape::sphere(4.0);
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) {
+            const double x = -3.3 + 0.6 * i, y = -3.3 + 0.6 * j;
+            points.emplace_back(x, y, 0.02 * x * x - 0.01 * y * y);
+            normals.push_back(Vector3d(-0.04 * x, 0.02 * y, 1).normalized());
+            areas.push_back(0.36);
+        }
+    const PlacedShape tool{&ball, Vector3d(0.2, -0.1, 4.1), Eigen::Quaterniond::Identity()};
+    const ContactResult r = penalty_contact(tool, c, points, areas, normals);
+    ASSERT_GT(r.points.size(), 20u);
+    const double h = 1e-6;
+    PlacedShape up = tool, down = tool;
+    up.position.z() += h;
+    down.position.z() -= h;
+    for (const PointContact& p : r.points) {
+        const double ddepth = -(tool.signed_distance(points[p.point] - Vector3d(0, 0, h)) -
+                                tool.signed_distance(points[p.point] + Vector3d(0, 0, h))) / (2 * h);
+        const ContactResult a = penalty_contact(up, c, std::span(&points[p.point], 1), std::span(&areas[p.point], 1),
+                                                std::span(&normals[p.point], 1));
+        const ContactResult b = penalty_contact(down, c, std::span(&points[p.point], 1), std::span(&areas[p.point], 1),
+                                                std::span(&normals[p.point], 1));
+        ASSERT_EQ(a.points.size(), 1u);
+        ASSERT_EQ(b.points.size(), 1u);
+        const Vector3d dforce = (a.points[0].force_n - b.points[0].force_n) / (2 * h);
+        EXPECT_LT((dforce - p.stiffness_n_per_mm * ddepth * p.normal).norm(), 1e-6 * p.stiffness_n_per_mm);
+        // Raising the tool makes every point shallower.
+        EXPECT_LT(ddepth, 0.0);
+        EXPECT_LT((p.force_n - p.stiffness_n_per_mm * p.depth_mm * p.normal).norm(), 1e-15);
+        EXPECT_NEAR(p.normal.norm(), 1.0, 1e-15);
+    }
+}

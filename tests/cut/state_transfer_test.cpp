@@ -1,0 +1,77 @@
+// A cut rebuilds the model without restarting the simulation: every new node takes the position
+// and velocity of the material point it sits on, every new element its source's water and
+// plastic strain. Checked against fields given as functions of the rest position, across a cut
+// that splits coarse cells into superimposed elements.
+
+#include "cut/state_transfer.hpp"
+
+#include "fem/block_grid.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace vox;
+
+namespace {
+
+Eigen::Vector3d position_field(const Eigen::Vector3d& X)
+{
+    return X + Eigen::Vector3d(0.01 * X.z(), -0.02 * X.x(), 0.03 * X.y() + 1e-4);
+}
+Eigen::Vector3d velocity_field(const Eigen::Vector3d& X) { return Eigen::Vector3d(1, 2, 3) + 50.0 * X; }
+/// A per-cell value: the cell centre's x in mm, so split halves inherit the same value.
+double cell_value(const fem::HexModel& m, const fem::HexElement& el)
+{
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::uint32_t n : el.dof_node) centre += m.rest_positions()[n] / 8.0;
+    return 1e3 * centre.x();
+}
+
+class StateTransfer : public ::testing::TestWithParam<int> {};
+
+} // namespace
+
+TEST_P(StateTransfer, NodesAndElementsInheritWhatTheCutDidNotChange)
+{
+    const int level = GetParam();
+    grid::BranchedGrid grid = test::block_grid({8, 4, 4}, level);
+    const auto old_model = std::make_unique<fem::HexModel>(grid, level);
+    fem::SolverOptions o;
+    auto old_solver = std::make_unique<fem::ImplicitSolver>(*old_model, o);
+    fem::MaterialBehaviour plastic;
+    plastic.yield_strain = 0.01;
+    plastic.creep_per_s = 1.0;
+    plastic.max_strain = 1.0;
+    old_solver->set_materials({plastic});
+    for (std::uint32_t n = 0; n < old_model->node_count(); ++n) {
+        old_solver->positions()[n] = position_field(old_model->rest_positions()[n]);
+        old_solver->velocities()[n] = velocity_field(old_model->rest_positions()[n]);
+    }
+    for (std::uint32_t e = 0; e < old_model->elements().size(); ++e) {
+        const double value = cell_value(*old_model, old_model->elements()[e]);
+        old_solver->set_water(e, value / 10.0);
+        old_solver->set_plastic_strain(e, value * Eigen::Matrix3d::Identity());
+    }
+    // Open every face between voxel columns x = 4 and x = 5: inside a level-1 cell (it splits into
+    // two superimposed elements) and inside the level-2 cells.
+    std::vector<std::pair<grid::Coord, int>> faces;
+    for (int y = 0; y < 4; ++y)
+        for (int z = 0; z < 4; ++z) faces.emplace_back(grid::Coord(4, y, z), 0);
+    const grid::UpdateReport report = grid.update({}, faces);
+    const fem::HexModel new_model(grid, level);
+    ASSERT_GT(new_model.node_count(), old_model->node_count()); // the split nodes doubled
+    fem::ImplicitSolver new_solver(new_model, o);
+    new_solver.set_materials({plastic});
+    cut::transfer_state(report, *old_model, *old_solver, new_model, new_solver);
+    for (std::uint32_t n = 0; n < new_model.node_count(); ++n) {
+        const Eigen::Vector3d X = new_model.rest_positions()[n];
+        EXPECT_LT((new_solver.positions()[n] - position_field(X)).norm(), 1e-15) << n;
+        EXPECT_LT((new_solver.velocities()[n] - velocity_field(X)).norm(), 1e-12) << n;
+    }
+    for (std::uint32_t e = 0; e < new_model.elements().size(); ++e) {
+        const double value = cell_value(new_model, new_model.elements()[e]);
+        EXPECT_NEAR(new_solver.water(e), std::min(1.0, value / 10.0), 1e-12) << e;
+        EXPECT_NEAR(new_solver.plastic_strain(e)(0, 0), value, 1e-12) << e;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Levels, StateTransfer, ::testing::Values(1, 2));
