@@ -2,11 +2,11 @@
 // Repeated timings summarised as median and spread, and the machine they ran on, for the
 // benchmark programs (figures go to the README).
 
+#include "core/sample_stats.hpp"
+
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace vox::bench {
@@ -37,17 +37,7 @@ template <class F> double time_ms(F&& f)
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// "model name" of the CPU and the number of hardware threads.
-inline std::string machine()
-{
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string line, model = "unknown CPU";
-    while (std::getline(cpuinfo, line))
-        if (line.rfind("model name", 0) == 0) {
-            model = line.substr(line.find(':') + 2);
-            break;
-        }
-    return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
-}
+/// The CPU and its hardware threads.
+inline std::string machine() { return machine_description(); }
 
 } // namespace vox::bench

@@ -7,6 +7,7 @@
 #include "app/bench_haptics.hpp"
 #include "app/scene_simulation.hpp"
 #include "core/log.hpp"
+#include "core/sample_stats.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/virtual_device.hpp"
 #include "io/scene_object.hpp"
@@ -24,12 +25,9 @@ struct Percentiles {
     double p50 = 0, p99 = 0, max = 0;
 };
 
-Percentiles percentiles(std::vector<double> v)
+Percentiles percentiles(const std::vector<double>& v)
 {
-    if (v.empty()) return {};
-    std::sort(v.begin(), v.end());
-    auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())))]; };
-    return {at(0.5), at(0.99), v.back()};
+    return {quantile(v, 0.5), quantile(v, 0.99), quantile(v, 1.0)};
 }
 
 } // namespace

@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "app/bench_cutting.hpp"
 #include "app/bench_haptics.hpp"
 #include "app/bench_stability.hpp"
 #include "app/scene_simulation.hpp"
@@ -241,6 +242,11 @@ void add_bench_command(CLI::App& app)
     CLI::App* haptics = bench->add_subcommand("haptics", "Period error and force time of the 1 kHz loop beside a running simulation");
     haptics->add_option("--seconds", *seconds, "How long to run (default 10)")->check(CLI::Range(0.5, 3600.0));
     haptics->callback([seconds] { run_haptics_bench(*seconds); });
+
+    auto cutting_runs = std::make_shared<int>(5);
+    CLI::App* cutting = bench->add_subcommand("cutting", "Cutting-frame time on the liver at level 4 during a 5 cm incision");
+    cutting->add_option("--runs", *cutting_runs, "How many times to replay the incision (default 5)")->check(CLI::Range(1, 100));
+    cutting->callback([cutting_runs] { run_cutting_bench(*cutting_runs); });
 
     auto stability_out = std::make_shared<std::string>("docs");
     auto quick = std::make_shared<bool>(false);

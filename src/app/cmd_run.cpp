@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "core/sample_stats.hpp"
 #include "app/level_choice.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/tool_session.hpp"
@@ -28,15 +29,6 @@
 
 namespace vox::app {
 namespace {
-
-/// The q-quantile of `values` (nearest rank), 0 when empty.
-double percentile(std::vector<double> values, double q)
-{
-    if (values.empty()) return 0.0;
-    std::sort(values.begin(), values.end());
-    const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size())));
-    return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
 
 void write_surface(const std::filesystem::path& path, const SceneSimulation& sim)
 {
@@ -177,7 +169,7 @@ void add_run_command(CLI::App& app)
                             {"separated_faces", separated},
                             {"voxels", g.voxels().alive_count()},
                             {"cutting_frames", cutting_ms.size()},
-                            {"cutting_ms_p95", percentile(cutting_ms, 0.95)},
+                            {"cutting_ms_p95", quantile(cutting_ms, 0.95)},
                             {"final_elements", sim.model().elements().size()},
                             {"pieces", cut::piece_count(sim.model())},
                             {"mass_kg", g.total_mass_kg()},

@@ -44,10 +44,9 @@ private:
 
 } // namespace
 
-ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_cut_from(scene.tools.size()), m_was_placed(scene.tools.size(), false)
+ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_stroke_start(scene.tools.size())
 {
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
-    for (std::size_t k = 0; k < m_shapes.size(); ++k) m_cut_from[k].shape = &m_shapes[k];
 }
 
 ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s)
@@ -66,13 +65,26 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
         if (!pose.placed) continue;
         out.position_mm = pose.position_mm;
         placed[k] = {&m_shapes[k], pose.position_mm, pose.orientation};
-        if (!m_was_placed[k]) m_cut_from[k] = placed[k];
         const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
         touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k], parameters);
         fresh[k] = true;
         stats.collision_ms += clock.lap();
         const contact::ContactResult& c = touch[k].contact;
-        if (c.points.empty()) m_cut_from[k] = placed[k]; // a stroke starts where the tool first touches
+        // A separating stroke is followed in rest space from the first touch (cut/voxel_cut.hpp).
+        std::vector<Eigen::Vector3d> rest_section;
+        if (spec.action == io::ToolAction::cut && spec.cut_mode == io::CutMode::separate) {
+            if (c.points.empty()) {
+                m_stroke_start[k].clear();
+            } else {
+                rest_section = cut::section_polygon(m_shapes[k], spec.push_margin_mm, placed[k]);
+                Eigen::AlignedBox3d box;
+                box.setEmpty();
+                for (const Eigen::Vector3d& p : rest_section) box.extend(p);
+                const Eigen::Vector3d moved = cut::mean_displacement_mm(sim.surface(), sim.solver().positions(), box);
+                for (Eigen::Vector3d& p : rest_section) p -= moved;
+                if (m_stroke_start[k].empty()) m_stroke_start[k] = rest_section;
+            }
+        }
         if (spec.action == io::ToolAction::cut && !c.points.empty() && c.pressure_pa >= spec.cut_pressure_pa) {
             std::vector<grid::Coord> removed;
             std::vector<std::pair<grid::Coord, int>> faces;
@@ -82,8 +94,8 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
             } else {
                 // Everything the section swept since the stroke began or last cut: material the
                 // blade entered while the pressure was still too low is cut now.
-                faces = cut::faces_crossed(sim.surface(), sim.solver().positions(),
-                                           cut::sweep_section(m_shapes[k], spec.push_margin_mm, m_cut_from[k], placed[k]));
+                faces = cut::faces_crossed(grid.voxels(), cut::sweep_polygons(m_stroke_start[k], rest_section,
+                                                                               placed[k].orientation * Eigen::Vector3d::UnitY()));
             }
             stats.propagation_ms += clock.lap();
             if (!removed.empty() || !faces.empty()) {
@@ -94,8 +106,8 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
                 stats.removed_voxels += removed.size();
                 stats.separated_faces += faces.size();
                 out.cut = true;
-                m_cut_from[k] = placed[k];
-                std::fill(fresh.begin(), fresh.end(), false); // node numbers changed
+                if (!rest_section.empty()) m_stroke_start[k] = rest_section;
+                std::fill(fresh.begin(), fresh.end(), false); // node numbers changed: contacts are carried over
                 clock.lap();
             }
         }
@@ -107,17 +119,12 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
     std::vector<fem::NodeContact> nodes;
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
         if (!stats.tools[k].placed) continue;
-        if (!fresh[k]) {
-            const io::ToolSpec& spec = m_scene.tools[k];
-            touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k],
-                                          {spec.push_margin_mm, spec.contact_stiffness_n_per_mm});
-        }
+        if (!fresh[k]) touch[k].nodes = cut::node_contacts(sim.surface(), touch[k]); // onto the rebuilt model's nodes
         cut::merge_node_contacts(nodes, touch[k].nodes);
         ToolFrame& out = stats.tools[k];
         out.force_n = touch[k].contact.force_on_tool_n;
         out.pressure_pa = touch[k].contact.pressure_pa;
         out.contact_area_mm2 = touch[k].contact.area_mm2;
-        m_was_placed[k] = true;
     }
     sim.solver().set_contact(std::move(nodes));
     stats.collision_ms += clock.lap();

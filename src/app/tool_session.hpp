@@ -49,10 +49,10 @@ public:
 private:
     const io::Scene& m_scene;
     std::vector<contact::ToolShape> m_shapes;
-    /// Per tool: where its current stroke began (first contact) or it last cut; a separating cut
-    /// opens what the section swept since.
-    std::vector<contact::PlacedShape> m_cut_from;
-    std::vector<bool> m_was_placed;
+    /// Per tool: its cutting section, in rest space, where its current stroke began (first
+    /// contact) or it last cut; a separating cut opens what the section swept since. Empty out of
+    /// contact.
+    std::vector<std::vector<Eigen::Vector3d>> m_stroke_start;
 };
 
 } // namespace vox::app

@@ -32,6 +32,8 @@ public:
 
     /// Deformed position of surface vertex slot `v`, world mm (node positions in m).
     [[nodiscard]] Eigen::Vector3d vertex_mm(std::uint32_t v, const std::vector<Eigen::Vector3d>& node_positions) const;
+    /// Rest position of vertex slot `v`, world mm.
+    [[nodiscard]] const Eigen::Vector3d& vertex_rest_mm(std::uint32_t v) const { return m_rest_mm[v]; }
     /// Model element holding vertex slot `v` (no_index for a free slot), and its trilinear coordinates there.
     [[nodiscard]] std::uint32_t vertex_element(std::uint32_t v) const { return m_element[v]; }
     [[nodiscard]] const Eigen::Vector3d& vertex_local(std::uint32_t v) const { return m_local[v]; }

@@ -19,11 +19,21 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
     std::vector<std::uint32_t> inside;
     std::vector<Eigen::Vector3d> inside_mm;
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        const fem::HexElement& el = model.elements()[e];
         Eigen::AlignedBox3d box;
         box.setEmpty();
-        for (std::uint32_t n : model.elements()[e].dof_node) box.extend(1e3 * node_positions[n]);
+        for (std::uint32_t n : el.dof_node) box.extend(1e3 * node_positions[n]);
         if (!box.intersects(reach)) continue;
+        // A vertex moves by the element's mean displacement give or take the corners' spread:
+        // vertices whose rest position is farther than that from the reach are passed over.
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (std::uint32_t n : el.dof_node) mean += 1e3 * (node_positions[n] - model.rest_positions()[n]) / 8.0;
+        double spread = 0.0;
+        for (std::uint32_t n : el.dof_node) spread = std::max(spread, (1e3 * (node_positions[n] - model.rest_positions()[n]) - mean).norm());
+        const Eigen::AlignedBox3d rest_reach(reach.min() - mean - Eigen::Vector3d::Constant(spread),
+                                             reach.max() - mean + Eigen::Vector3d::Constant(spread));
         for (std::uint32_t v : surface.element_vertices(e)) {
+            if (!rest_reach.contains(surface.vertex_rest_mm(v))) continue;
             const Eigen::Vector3d p = surface.vertex_mm(v, node_positions);
             if (!reach.contains(p) || tool.signed_distance(p) >= parameters.margin_mm) continue;
             inside.push_back(v);
@@ -54,27 +64,41 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         if (normals[i].norm() > 0.0) normals[i] *= surface.outward_sign() / normals[i].norm();
     }
     out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals);
-    std::unordered_map<std::uint32_t, std::size_t> node_index;
     for (contact::PointContact& c : out.contact.points) {
         const std::uint32_t v = inside[c.point];
         c.point = static_cast<std::uint32_t>(out.vertices.size());
         out.vertices.push_back(v);
+        out.keys.push_back(surface.embedded().vertices()[v].key);
         out.positions_mm.push_back(known.at(v));
+        out.elements.push_back(surface.vertex_element(v));
+    }
+    out.nodes = node_contacts(surface, out);
+    std::sort(out.elements.begin(), out.elements.end());
+    out.elements.erase(std::unique(out.elements.begin(), out.elements.end()), out.elements.end());
+    return out;
+}
+
+std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const SurfaceContact& contact)
+{
+    const fem::HexModel& model = surface.model();
+    const auto& vertices = surface.embedded().vertices();
+    std::vector<fem::NodeContact> out;
+    std::unordered_map<std::uint32_t, std::size_t> node_index;
+    for (const contact::PointContact& c : contact.contact.points) {
+        const std::uint32_t v = contact.vertices[c.point];
+        if (v >= vertices.size() || vertices[v].users == 0 || vertices[v].key != contact.keys[c.point]) continue;
         const std::uint32_t e = surface.vertex_element(v);
-        out.elements.push_back(e);
         const Eigen::Matrix3d k = 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose(); // N/m
         for (int corner = 0; corner < 8; ++corner) {
             const double w = grid::hex8_shape(corner, surface.vertex_local(v));
             if (w == 0.0) continue;
             const std::uint32_t node = model.elements()[e].dof_node[corner];
-            auto [it, added] = node_index.emplace(node, out.nodes.size());
-            if (added) out.nodes.push_back({node, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()});
-            out.nodes[it->second].force_n += w * c.force_n;
-            out.nodes[it->second].stiffness_n_per_m += w * k;
+            auto [it, added] = node_index.emplace(node, out.size());
+            if (added) out.push_back({node, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()});
+            out[it->second].force_n += w * c.force_n;
+            out[it->second].stiffness_n_per_m += w * k;
         }
     }
-    std::sort(out.elements.begin(), out.elements.end());
-    out.elements.erase(std::unique(out.elements.begin(), out.elements.end()), out.elements.end());
     return out;
 }
 

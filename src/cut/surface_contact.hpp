@@ -15,6 +15,7 @@ namespace vox::cut {
 struct SurfaceContact {
     contact::ContactResult contact;         ///< its points index `vertices`
     std::vector<std::uint32_t> vertices;    ///< surface vertex slot of each contact point
+    std::vector<std::uint64_t> keys;        ///< and that vertex's identity (SurfaceVertex::key)
     std::vector<Eigen::Vector3d> positions_mm; ///< deformed position of each contact point, world mm
     std::vector<fem::NodeContact> nodes;    ///< the forces on the model's nodes (N, N/m)
     std::vector<std::uint32_t> elements;    ///< model elements holding contact points (sorted, unique)
@@ -25,6 +26,12 @@ struct SurfaceContact {
 /// tool's reach are visited.
 [[nodiscard]] SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
                                            const contact::PlacedShape& tool, const contact::ContactParameters& parameters);
+
+/// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
+/// the corners of its element with the trilinear weights, the penalty stiffness lumped the same
+/// way. After a cut has rebuilt the model, this carries a contact over to the new nodes; points
+/// whose surface vertex the cut replaced are dropped (the next frame finds the new ones).
+[[nodiscard]] std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const SurfaceContact& contact);
 
 /// Adds `b`'s node contacts to `a` (several tools on one object).
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b);

@@ -37,10 +37,6 @@ std::vector<Eigen::Vector3d> section(const contact::ToolShape& shape, double mar
     return out;
 }
 
-struct CoordHash {
-    std::size_t operator()(std::uint32_t v) const { return v * 0x9E3779B1u; }
-};
-
 } // namespace
 
 std::vector<std::uint32_t> voxels_inside(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
@@ -79,32 +75,40 @@ Eigen::AlignedBox3d SweptSurface::bounds() const
     return b;
 }
 
-SweptSurface sweep_section(const contact::ToolShape& shape, double margin, const contact::PlacedShape& from,
-                           const contact::PlacedShape& to)
+std::vector<Eigen::Vector3d> section_polygon(const contact::ToolShape& shape, double margin, const contact::PlacedShape& pose)
 {
-    const std::vector<Eigen::Vector3d> polygon = section(shape, margin);
-    const std::size_t n = polygon.size();
+    std::vector<Eigen::Vector3d> polygon = section(shape, margin);
+    for (Eigen::Vector3d& p : polygon) p = pose.position + pose.orientation * p;
+    return polygon;
+}
+
+SweptSurface sweep_polygons(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, const Eigen::Vector3d& normal)
+{
+    const std::size_t n = a.size();
     SweptSurface s;
-    s.normal = to.orientation * Eigen::Vector3d::UnitY();
-    std::vector<Eigen::Vector3d> a(n), b(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        a[i] = from.position + from.orientation * polygon[i];
-        b[i] = to.position + to.orientation * polygon[i];
-    }
+    s.normal = normal;
+    bool moved = false;
+    for (std::size_t i = 0; i < n; ++i) moved = moved || a[i] != b[i];
     for (std::size_t i = 1; i + 1 < n; ++i) { // the section at both ends (convex: a fan)
         s.triangles.push_back({a[0], a[i], a[i + 1]});
-        if ((to.position - from.position).norm() > 0.0 || !to.orientation.isApprox(from.orientation))
-            s.triangles.push_back({b[0], b[i], b[i + 1]});
+        if (moved) s.triangles.push_back({b[0], b[i], b[i + 1]});
     }
     // Whatever the section covered during the stroke and covers at neither end was crossed by its
     // boundary: the bands the edges sweep.
-    if ((to.position - from.position).norm() > 0.0 || !to.orientation.isApprox(from.orientation))
+    if (moved)
         for (std::size_t i = 0; i < n; ++i) {
             const std::size_t j = (i + 1) % n;
             s.triangles.push_back({a[i], a[j], b[j]});
             s.triangles.push_back({a[i], b[j], b[i]});
         }
     return s;
+}
+
+SweptSurface sweep_section(const contact::ToolShape& shape, double margin, const contact::PlacedShape& from,
+                           const contact::PlacedShape& to)
+{
+    return sweep_polygons(section_polygon(shape, margin, from), section_polygon(shape, margin, to),
+                          to.orientation * Eigen::Vector3d::UnitY());
 }
 
 bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const std::array<Eigen::Vector3d, 3>& t,
@@ -127,82 +131,71 @@ bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const s
     return true;
 }
 
-std::vector<std::pair<grid::Coord, int>> faces_crossed(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                                       const SweptSurface& swept)
+Eigen::Vector3d mean_displacement_mm(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                                     const Eigen::AlignedBox3d& box)
+{
+    const fem::HexModel& model = surface.model();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    for (const fem::HexElement& el : model.elements()) {
+        Eigen::AlignedBox3d deformed;
+        deformed.setEmpty();
+        for (std::uint32_t n : el.dof_node) deformed.extend(1e3 * node_positions[n]);
+        if (!deformed.intersects(box)) continue;
+        for (std::uint32_t n : el.dof_node) sum += 1e3 * (node_positions[n] - model.rest_positions()[n]);
+        count += 8;
+    }
+    return count ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
+}
+
+std::vector<std::pair<grid::Coord, int>> faces_crossed(const grid::FineVoxels& voxels, const SweptSurface& swept)
 {
     std::vector<std::pair<grid::Coord, int>> out;
     if (swept.triangles.empty()) return out;
-    const fem::HexModel& model = surface.model();
-    const grid::BranchedGrid& grid = surface.grid();
-    const grid::FineVoxels& voxels = grid.voxels();
-    const int level = model.level();
-    // Pairs are tested from their lower voxel, which may lie a whole (stretched) segment away
-    // from the surface: two voxels of margin.
-    Eigen::AlignedBox3d reach = swept.bounds();
-    const double voxel_mm = 1e3 * voxels.voxel_size_m().maxCoeff();
-    reach.extend(reach.min() - Eigen::Vector3d::Constant(2.0 * voxel_mm));
-    reach.extend(reach.max() + Eigen::Vector3d::Constant(2.0 * voxel_mm));
+    // Every voxel whose rest centre lies within one voxel edge (along each axis) of the surface's
+    // box: the lower voxel of any crossing pair.
     const Eigen::Matrix4d& to_world = voxels.index_to_world();
     const Eigen::Matrix3d to_index = to_world.topLeftCorner<3, 3>().inverse();
-    std::unordered_map<std::uint32_t, Eigen::Vector3d, CoordHash> centre;
-    auto centre_of = [&](std::uint32_t v) -> const Eigen::Vector3d& {
-        auto found = centre.find(v);
-        if (found == centre.end()) found = centre.emplace(v, surface.voxel_centre_mm(v, node_positions)).first;
-        return found->second;
+    const Eigen::AlignedBox3d box = swept.bounds();
+    Eigen::AlignedBox3d index_box;
+    index_box.setEmpty();
+    for (int c = 0; c < 8; ++c)
+        index_box.extend(to_index * (box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)) - to_world.topRightCorner<3, 1>()));
+    const grid::Coord first = (index_box.min().array() - 1.0).floor().cast<int>();
+    const grid::Coord last = (index_box.max().array() + 1.0).ceil().cast<int>();
+    auto rest = [&](const grid::Coord& c) {
+        return Eigen::Vector3d(to_world.topLeftCorner<3, 3>() * c.cast<double>() + to_world.topRightCorner<3, 1>());
     };
-    std::vector<std::uint32_t> candidates;
-    for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
-        const fem::HexElement& el = model.elements()[e];
-        Eigen::AlignedBox3d box;
-        box.setEmpty();
-        for (std::uint32_t n : el.dof_node) box.extend(1e3 * node_positions[n]);
-        if (!box.intersects(reach)) continue;
-        // Only voxels whose rest centre, moved by the element's mean displacement, can reach:
-        // a trilinear displacement differs from the mean by at most the corners' spread.
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (std::uint32_t n : el.dof_node) mean += 1e3 * (node_positions[n] - model.rest_positions()[n]) / 8.0;
-        double spread = 0.0;
-        for (std::uint32_t n : el.dof_node) spread = std::max(spread, (1e3 * (node_positions[n] - model.rest_positions()[n]) - mean).norm());
-        const Eigen::Vector3d lo = reach.min() - mean - Eigen::Vector3d::Constant(spread);
-        const Eigen::Vector3d hi = reach.max() - mean + Eigen::Vector3d::Constant(spread);
-        Eigen::AlignedBox3d index_box;
-        index_box.setEmpty();
-        for (int c = 0; c < 8; ++c) {
-            const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
-            index_box.extend(to_index * (corner - to_world.topRightCorner<3, 1>()));
-        }
-        const grid::Coord cell = level == 0 ? voxels.coord(el.grid_element) : grid.level(level).elements[el.grid_element].cell;
-        const int size = 1 << level;
-        grid::Coord first, last;
-        for (int a = 0; a < 3; ++a) {
-            first[a] = std::max(cell[a] * size, static_cast<int>(std::ceil(index_box.min()[a] - 0.5)));
-            last[a] = std::min(cell[a] * size + size - 1, static_cast<int>(std::floor(index_box.max()[a] + 0.5)));
-        }
-        for (int k = first.z(); k <= last.z(); ++k)
-            for (int j = first.y(); j <= last.y(); ++j)
-                for (int i = first.x(); i <= last.x(); ++i) {
-                    const std::uint32_t v = voxels.find(grid::Coord(i, j, k));
-                    if (v == grid::FineVoxels::missing) continue;
-                    Eigen::Vector3d local;
-                    if (surface.voxel_element(v, local) == e) candidates.push_back(v); // superimposed: its own element
-                }
+    // Each triangle's oriented plane, computed as segment_crosses does: a pair on one side of it
+    // (most pairs, for most triangles) is passed over without the full test.
+    std::vector<Eigen::Vector3d> plane_normal;
+    for (const auto& t : swept.triangles) {
+        const Eigen::Vector3d winding = (t[1] - t[0]).cross(t[2] - t[0]);
+        plane_normal.push_back(winding.dot(swept.normal) < 0.0 ? Eigen::Vector3d(-winding) : winding);
     }
-    // Deformed centres: each voxel is on one side of the swept surface whatever pair it is tested
-    // in (so the cut surface closes), and the cut meets the material where the user sees it.
-    for (std::uint32_t v : candidates) {
-        const Eigen::Vector3d p = centre_of(v);
-        if (!reach.contains(p)) continue;
-        for (int axis = 0; axis < 3; ++axis) {
-            const std::uint32_t u = voxels.connected_neighbour(v, axis);
-            if (u == grid::FineVoxels::missing) continue;
-            const Eigen::Vector3d q = centre_of(u);
-            for (const auto& t : swept.triangles)
-                if (segment_crosses(p, q, t, swept.normal)) {
-                    out.emplace_back(voxels.coord(v), axis);
-                    break;
+    for (int k = first.z(); k <= last.z(); ++k)
+        for (int j = first.y(); j <= last.y(); ++j)
+            for (int i = first.x(); i <= last.x(); ++i) {
+                const grid::Coord c(i, j, k);
+                const std::uint32_t v = voxels.find(c);
+                if (v == grid::FineVoxels::missing) continue;
+                const Eigen::Vector3d p = rest(c);
+                for (int axis = 0; axis < 3; ++axis) {
+                    const std::uint32_t u = voxels.connected_neighbour(v, axis);
+                    if (u == grid::FineVoxels::missing) continue;
+                    const Eigen::Vector3d q = rest(c + grid::Coord::Unit(axis));
+                    const double on = 1e-9 * (q - p).norm();
+                    for (std::size_t t = 0; t < swept.triangles.size(); ++t) {
+                        const auto& tri = swept.triangles[t];
+                        const double tolerance = on * plane_normal[t].norm();
+                        if ((plane_normal[t].dot(p - tri[0]) >= -tolerance) == (plane_normal[t].dot(q - tri[0]) >= -tolerance)) continue;
+                        if (segment_crosses(p, q, tri, swept.normal)) {
+                            out.emplace_back(c, axis);
+                            break;
+                        }
+                    }
                 }
-        }
-    }
+            }
     return out;
 }
 

@@ -1,18 +1,17 @@
 #pragma once
 // Which fine voxels a cut takes (Jerabkova et al. 2010, section 3), and which faces a separating
 // cut opens.
-//  - remove: from the voxels of the surface vertices in contact with the tool, a flood
-//    through face neighbours whose deformed centres lie inside that shape;
+//  - remove: from the voxels of the surface vertices in contact with the tool, a flood through
+//    face neighbours whose deformed centres lie inside the cutting (inner) shape: what is inside
+//    the blade now goes;
 //  - separate (ours, beyond the paper, which names its volume loss as a limitation): every voxel
 //    stays; the cutting surface swept over the stroke opens the face between two neighbours when
-//    the segment joining their centres crosses it (a centre exactly on the surface counts as lying
-//    on the side its normal points to), so a thin blade splits the object, never cuts out a slab.
-//    The centres are the deformed ones: each voxel is on one side whatever pair it is tested in
-//    (testing each pair by its rest segment moved to where the pair is cuts neighbouring rows at
-//    different faces, and the pieces stay joined through the faces between those rows), and the
-//    cut meets the material where the user sees it. On an object at rest they are the rest
-//    centres, and the side rule is exact.
-// Removal tests deformed centres: what is inside the blade now goes.
+//    the segment joining their rest centres crosses it (a centre exactly on the surface counts as
+//    lying on the side its normal points to), so a thin blade splits the object, never cuts out
+//    a slab. The stroke is followed in rest space: each section the tool cuts with is carried
+//    back by the mean displacement of the material around it, and the next sweep starts where the
+//    last one ended there, so strokes join without gaps or double cuts (which would leave joined
+//    bridges or free slivers) however the material moves meanwhile.
 
 #include "contact/tool_shape.hpp"
 #include "cut/model_surface.hpp"
@@ -28,31 +27,42 @@ namespace vox::cut {
 [[nodiscard]] std::vector<std::uint32_t> voxels_inside(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
                                                        const contact::PlacedShape& inner, const std::vector<std::uint32_t>& seed_vertices);
 
-/// The surface a tool cuts along, swept over one stroke from `from` to `to`, world mm: its
-/// cutting section (blade and scalpel: the profile at mid-thickness, y = 0; sphere: the disc
-/// through its centre normal to its y axis; mesh: the rectangle of its bounds at y = 0), grown in
-/// its plane by `margin` (the pushing shape's margin: the material the edge presses on, at a
-/// pressure above the threshold, is the material that gives way), at both poses, and the band
-/// each edge of the section sweeps between them.
+/// The surface a tool cuts along, swept over one stroke, as triangles: its section at both ends
+/// of the stroke and the band each edge of the section sweeps between them.
 struct SweptSurface {
     std::vector<std::array<Eigen::Vector3d, 3>> triangles;
     /// The tool's y axis at the end of the stroke: which side a centre lying on the surface counts on.
     Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
     [[nodiscard]] Eigen::AlignedBox3d bounds() const;
 };
+
+/// A tool's cutting section at `pose`, world mm, as a convex polygon: blade and scalpel: the
+/// profile at mid-thickness (y = 0); sphere: the disc through its centre normal to its y axis;
+/// mesh: the rectangle of its bounds at y = 0; grown in its plane by `margin` (the pushing
+/// shape's margin: the material the edge presses on, at a pressure above the threshold, is the
+/// material that gives way).
+[[nodiscard]] std::vector<Eigen::Vector3d> section_polygon(const contact::ToolShape& shape, double margin,
+                                                           const contact::PlacedShape& pose);
+/// The surface polygon `from` sweeps moving to `to` (same vertex count, in order).
+[[nodiscard]] SweptSurface sweep_polygons(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
+                                          const Eigen::Vector3d& normal);
+/// The section of `shape` swept from pose `from` to pose `to`.
 [[nodiscard]] SweptSurface sweep_section(const contact::ToolShape& shape, double margin, const contact::PlacedShape& from,
                                          const contact::PlacedShape& to);
 
 /// Whether the segment p-q crosses the triangle, with the side rule above (`normal` orients the
-/// triangle's plane; an end within 1e-9 of |q - p| of the plane counts as on it, so rounding cannot
-/// put one centre on different sides of the coplanar triangles of a section).
+/// triangle's plane).
 [[nodiscard]] bool segment_crosses(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const std::array<Eigen::Vector3d, 3>& triangle,
                                    const Eigen::Vector3d& normal);
 
-/// Connected faces crossed by `swept`: each as (voxel coordinate, axis) of the face between the
-/// voxel and its +axis neighbour, in the form BranchedGrid::update takes.
-[[nodiscard]] std::vector<std::pair<grid::Coord, int>> faces_crossed(const ModelSurface& surface,
-                                                                     const std::vector<Eigen::Vector3d>& node_positions,
-                                                                     const SweptSurface& swept);
+/// Mean displacement (mm) of the nodes of the elements whose deformed corner box meets `box`
+/// (world mm): how far the material around a tool has moved from rest.
+[[nodiscard]] Eigen::Vector3d mean_displacement_mm(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                                                   const Eigen::AlignedBox3d& box);
+
+/// Connected faces whose rest-centre segment crosses `rest_swept` (a swept surface in rest
+/// space, world mm): each as (voxel coordinate, axis) of the face between the voxel and its
+/// +axis neighbour, in the form BranchedGrid::update takes.
+[[nodiscard]] std::vector<std::pair<grid::Coord, int>> faces_crossed(const grid::FineVoxels& voxels, const SweptSurface& rest_swept);
 
 } // namespace vox::cut
