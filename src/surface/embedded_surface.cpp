@@ -39,6 +39,7 @@ EmbeddedSurface::EmbeddedSurface(const grid::BranchedGrid& grid, int level) : m_
     const grid::FineVoxels& voxels = grid.voxels();
     m_origin = voxels.origin() - grid::Coord::Ones();
     m_flip = voxels.index_to_world().topLeftCorner<3, 3>().determinant() < 0.0;
+    m_owned.assign(voxels.slots(), 0);
 
     // Surface cubes: the four cubes around every voxel face that is exposed (no neighbour, or a
     // disconnected one). All other cubes are entirely inside or outside.
@@ -185,6 +186,7 @@ std::uint32_t EmbeddedSurface::vertex_for(const grid::BranchedGrid& grid, const 
     v.rest = cube.cast<double>() + Eigen::Vector3d(p[0], p[1], p[2]);
     v.label = grid.voxels().label(voxel);
     v.users = 1;
+    ++m_owned[voxel];
     embed(grid, v);
     m_vertex_index.insert(key, id);
     if (cv.kind != CubeVertex::Kind::crossing) m_centre_vertices.emplace(voxel, id);
@@ -204,6 +206,7 @@ void EmbeddedSurface::release_vertex(std::uint32_t id)
     SurfaceVertex& v = m_vertices[id];
     if (--v.users > 0) return;
     m_vertex_index.insert(v.key, grid::CoordMap::missing);
+    --m_owned[v.voxel];
     if ((v.key & 3) != 0) {
         auto [first, last] = m_centre_vertices.equal_range(v.voxel);
         for (auto it = first; it != last; ++it)
@@ -242,6 +245,7 @@ void EmbeddedSurface::update(const grid::BranchedGrid& grid, std::span<const gri
     if (report.levels.size() <= static_cast<std::size_t>(m_level)) return;
     for (const auto& [element, from] : report.levels[static_cast<std::size_t>(m_level)].created)
         for (std::uint32_t voxel : grid.level(m_level).elements[element].voxels) {
+            if (m_owned[voxel] == 0) continue; // most voxels of an element hold no surface vertex
             for (std::uint64_t dir = 0; dir < 6; ++dir) {
                 const std::uint32_t id = m_vertex_index.find((std::uint64_t{voxel} * 6 + dir) << 2);
                 if (id != grid::CoordMap::missing) embed(grid, m_vertices[id]);

@@ -86,6 +86,9 @@ private:
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> m_cube_triangles;
     /// Face- and cube-centre vertices by the voxel they belong to (crossings are found by key).
     std::unordered_multimap<std::uint32_t, std::uint32_t> m_centre_vertices;
+    /// Per voxel slot: how many vertices belong to it, so that re-embedding after a cut visits
+    /// only the few voxels of an element that carry surface.
+    std::vector<std::uint16_t> m_owned;
     std::size_t m_vertex_count = 0;
     std::size_t m_triangle_count = 0;
     bool m_flip = false; ///< the index-to-world transform mirrors: flip windings in world space
