@@ -51,6 +51,13 @@ step "Simulation: a soft cantilever swinging under gravity (implicit Euler, 50 f
 step "Simulation: a clay slab under two weights, plastic, its right half wet (100 frames)"
 "$vox" run "$data/scenes/clay.json" --frames 100 --out "$out/run-clay"
 
+step "Cutting: a 5 cm scalpel incision in the liver (level 4, separating faces, 150 frames)"
+"$vox" run "$data/scenes/liver_incision.json" --out "$out/run-liver-incision"
+"$vox" info "$out/run-liver-incision/final.obj"
+
+step "Cutting: a hanging cylinder cut through; the lower piece falls away"
+"$vox" run "$data/scenes/cylinder_cut.json" --out "$out/run-cylinder-cut"
+
 step "Outputs"
 ls -l "$out"
 echo "demo outputs are in $out"
