@@ -30,6 +30,14 @@
 namespace vox::app {
 namespace {
 
+/// Elements holding any water (scene regions or a wetting tool).
+std::size_t wet_elements(const SceneSimulation& sim)
+{
+    std::size_t n = 0;
+    for (std::uint32_t e = 0; e < sim.model().elements().size(); ++e) n += sim.solver().water(e) > 0.0;
+    return n;
+}
+
 void write_surface(const std::filesystem::path& path, const SceneSimulation& sim)
 {
     const surface::SurfaceMesh m = sim.surface().mesh(sim.solver().positions());
@@ -172,6 +180,7 @@ void add_run_command(CLI::App& app)
                             {"cutting_ms_p95", quantile(cutting_ms, 0.95)},
                             {"final_elements", sim.model().elements().size()},
                             {"pieces", cut::piece_count(sim.model())},
+                            {"wet_elements", wet_elements(sim)},
                             {"mass_kg", g.total_mass_kg()},
                             {"final_max_displacement_mm", last.max_displacement_m * 1e3},
                             {"final_elastic_energy_j", last.elastic_energy_j},

@@ -163,3 +163,31 @@ TEST(Cutting, AWettedRegionIsPushedFurtherThanADryOne)
     EXPECT_LT(dry_top, 9.5);            // a lasting dent in the dry clay too
     EXPECT_LT(wet_top, dry_top - 0.1);  // deeper in the wet
 }
+
+TEST(Cutting, AWettingToolWetsWhatItTouchesAndNothingElse)
+{
+    const fs::path d = fresh_dir("cut_wet_tool");
+    auto scene = [](const std::string& action) {
+        return R"({"object": {"phantom": {"shape": "block", "size_mm": [16, 8, 8]}, "levels": 1},
+            "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [17, 9, 0]]}],
+            "tools": [{"name": "sponge", "shape": "sphere", "radius_mm": 2, "action": ")" +
+               action + R"("}],
+            "script": [{"t_s": 0, "tool": "sponge", "position_mm": [3.5, 3.5, 9.5]},
+                       {"t_s": 0.2, "tool": "sponge", "position_mm": [3.5, 3.5, 8.0]}]})";
+    };
+    std::ofstream(d / "wet.json") << scene("wet");
+    std::ofstream(d / "push.json") << scene("push");
+    for (const char* name : {"wet", "push"})
+        ASSERT_EQ(run_voxsculpt("run " + quote((d / (std::string(name) + ".json")).string()) + " --out " + quote((d / name).string()))
+                      .exit_code,
+                  0);
+    auto summary = [&](const char* name) {
+        std::ifstream in(d / name / "stats.json");
+        return nlohmann::json::parse(in)["summary"];
+    };
+    const nlohmann::json wet = summary("wet"), push = summary("push");
+    // The sphere touches a corner region of the 8 x 4 x 4-element block: some elements, not all.
+    EXPECT_GT(wet["wet_elements"].get<int>(), 0);
+    EXPECT_LT(wet["wet_elements"].get<int>(), 128);
+    EXPECT_EQ(push["wet_elements"], 0);
+}
