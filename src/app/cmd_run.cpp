@@ -134,6 +134,7 @@ void add_run_command(CLI::App& app)
                 }
                 tool_frames.push_back({{"position_mm", {t.position_mm.x(), t.position_mm.y(), t.position_mm.z()}},
                                        {"force_n", {t.force_n.x(), t.force_n.y(), t.force_n.z()}},
+                                       {"torque_n_mm", {t.torque_n_mm.x(), t.torque_n_mm.y(), t.torque_n_mm.z()}},
                                        {"pressure_pa", t.pressure_pa},
                                        {"contact_area_mm2", t.contact_area_mm2},
                                        {"cut", t.cut}});
@@ -158,6 +159,7 @@ void add_run_command(CLI::App& app)
                                        {"fem_update_ms", tf.fem_update_ms},
                                        {"removed_voxels", tf.removed_voxels},
                                        {"separated_faces", tf.separated_faces},
+                                       {"separated_voxels", tf.separated_voxels},
                                        {"elements", sim.model().elements().size()},
                                        {"tools", tool_frames}});
             if (f % scene.output.mesh_every_n_frames == 0) {
@@ -175,6 +177,7 @@ void add_run_command(CLI::App& app)
                             {"converged_frames", converged},
                             {"removed_voxels", removed},
                             {"separated_faces", separated},
+                            {"separated_voxels", tools.separated_voxels()},
                             {"voxels", g.voxels().alive_count()},
                             {"cutting_frames", cutting_ms.size()},
                             {"cutting_ms_p95", quantile(cutting_ms, 0.95)},

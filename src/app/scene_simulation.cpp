@@ -4,7 +4,8 @@
 #include "fem/multigrid.hpp"
 #include "fem/rest_cholesky.hpp"
 
-#include <chrono>
+#include "core/stopwatch.hpp"
+
 #include <stdexcept>
 
 namespace vox::app {
@@ -81,24 +82,18 @@ CutTimings SceneSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const 
 {
     if (&grid != m_grid) throw std::invalid_argument("SceneSimulation::apply_cut: not the grid it was built on");
     CutTimings t;
-    auto start = std::chrono::steady_clock::now();
-    auto lap = [&start] {
-        const auto now = std::chrono::steady_clock::now();
-        const double ms = std::chrono::duration<double, std::milli>(now - start).count();
-        start = now;
-        return ms;
-    };
+    Stopwatch clock;
     const grid::UpdateReport report = grid.update(removed, faces);
-    t.grid_update_ms = lap();
+    t.grid_update_ms = clock.lap();
     m_surface->update(grid, removed, faces, report);
-    t.remesh_ms = lap();
+    t.remesh_ms = clock.lap();
     std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
     build(false);
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
-    t.fem_update_ms = lap();
+    t.fem_update_ms = clock.lap();
     return t;
 }
 

@@ -47,7 +47,6 @@ public:
     [[nodiscard]] fem::ImplicitSolver& solver() { return *m_solver; }
     [[nodiscard]] const fem::ImplicitSolver& solver() const { return *m_solver; }
     [[nodiscard]] const cut::ModelSurface& surface() const { return *m_model_surface; }
-    [[nodiscard]] const grid::BranchedGrid& grid() const { return *m_grid; }
     /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
     [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
 

@@ -1,5 +1,6 @@
 #include "app/tool_session.hpp"
 
+#include "core/stopwatch.hpp"
 #include "cut/surface_contact.hpp"
 #include "cut/voxel_cut.hpp"
 #include "io/mesh.hpp"
@@ -7,6 +8,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <utility>
 
 namespace vox::app {
 namespace {
@@ -17,7 +20,7 @@ contact::ToolShape make_shape(const io::ToolSpec& t)
     case io::ToolShape::blade:
         return contact::ToolShape::box(t.size_mm);
     case io::ToolShape::scalpel:
-        return contact::ToolShape::scalpel(t.size_mm.isZero() ? Eigen::Vector3d(30, 0.5, 8) : t.size_mm);
+        return contact::ToolShape::scalpel(t.size_mm); // the scene reader gives scalpels their default size
     case io::ToolShape::sphere:
         return contact::ToolShape::sphere(t.radius_mm);
     case io::ToolShape::mesh: {
@@ -25,26 +28,12 @@ contact::ToolShape make_shape(const io::ToolSpec& t)
         return contact::ToolShape::from_mesh({m.vertices, m.triangles});
     }
     }
-    return contact::ToolShape::sphere(t.radius_mm);
+    throw std::logic_error("make_shape: unknown tool shape");
 }
-
-class Stopwatch {
-public:
-    double lap()
-    {
-        const auto now = std::chrono::steady_clock::now();
-        const double ms = std::chrono::duration<double, std::milli>(now - m_start).count();
-        m_start = now;
-        return ms;
-    }
-
-private:
-    std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now();
-};
 
 } // namespace
 
-ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_stroke_start(scene.tools.size())
+ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_previous_section(scene.tools.size())
 {
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
 }
@@ -70,31 +59,28 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
         fresh[k] = true;
         stats.collision_ms += clock.lap();
         const contact::ContactResult& c = touch[k].contact;
-        // A separating stroke is followed in rest space from the first touch (cut/voxel_cut.hpp).
+        // A separating tool's section, carried back to rest space (cut/voxel_cut.hpp): each frame
+        // sweeps from the previous frame's section to this one.
         std::vector<Eigen::Vector3d> rest_section;
         if (spec.action == io::ToolAction::cut && spec.cut_mode == io::CutMode::separate) {
-            if (c.points.empty()) {
-                m_stroke_start[k].clear();
-            } else {
-                rest_section = cut::section_polygon(m_shapes[k], spec.push_margin_mm, placed[k]);
-                Eigen::AlignedBox3d box;
-                box.setEmpty();
-                for (const Eigen::Vector3d& p : rest_section) box.extend(p);
-                const Eigen::Vector3d moved = cut::mean_displacement_mm(sim.surface(), sim.solver().positions(), box);
-                for (Eigen::Vector3d& p : rest_section) p -= moved;
-                if (m_stroke_start[k].empty()) m_stroke_start[k] = rest_section;
-            }
+            rest_section = cut::section_polygon(m_shapes[k], 0.0, placed[k]);
+            Eigen::AlignedBox3d box;
+            box.setEmpty();
+            for (const Eigen::Vector3d& p : rest_section) box.extend(p);
+            const Eigen::Vector3d moved = cut::mean_displacement_mm(sim.surface(), sim.solver().positions(), box);
+            for (Eigen::Vector3d& p : rest_section) p -= moved;
         }
-        if (spec.action == io::ToolAction::cut && !c.points.empty() && c.pressure_pa >= spec.cut_pressure_pa) {
+        const std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[k], rest_section);
+        // Cutting happens only where the inner shape reaches the material and the contact
+        // pressure is at or above the threshold.
+        if (spec.action == io::ToolAction::cut && c.inner_reaches_surface() && c.pressure_pa >= spec.cut_pressure_pa) {
             std::vector<grid::Coord> removed;
             std::vector<std::pair<grid::Coord, int>> faces;
             if (spec.cut_mode == io::CutMode::remove) {
                 for (std::uint32_t v : cut::voxels_inside(sim.surface(), sim.solver().positions(), placed[k], touch[k].vertices))
                     removed.push_back(grid.voxels().coord(v));
             } else {
-                // Everything the section swept since the stroke began or last cut: material the
-                // blade entered while the pressure was still too low is cut now.
-                faces = cut::faces_crossed(grid.voxels(), cut::sweep_polygons(m_stroke_start[k], rest_section,
+                faces = cut::faces_crossed(grid.voxels(), cut::sweep_polygons(previous.empty() ? rest_section : previous, rest_section,
                                                                                placed[k].orientation * Eigen::Vector3d::UnitY()));
             }
             stats.propagation_ms += clock.lap();
@@ -105,13 +91,20 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
                 stats.fem_update_ms += t.fem_update_ms;
                 stats.removed_voxels += removed.size();
                 stats.separated_faces += faces.size();
+                std::unordered_set<std::uint32_t> sides;
+                for (const auto& [c, axis] : faces)
+                    for (const grid::Coord& side : {c, grid::Coord(c + grid::Coord::Unit(axis))}) {
+                        const std::uint32_t v = grid.voxels().find(side);
+                        sides.insert(v);
+                        m_separated.insert(v);
+                    }
+                stats.separated_voxels += sides.size();
                 out.cut = true;
-                if (!rest_section.empty()) m_stroke_start[k] = rest_section;
                 std::fill(fresh.begin(), fresh.end(), false); // node numbers changed: contacts are carried over
                 clock.lap();
             }
         }
-        if (spec.action == io::ToolAction::wet && fresh[k])
+        if (spec.action == io::ToolAction::wet)
             for (std::uint32_t e : touch[k].elements)
                 sim.solver().set_water(e, sim.solver().water(e) + spec.wet_rate_per_s * dt_s);
     }
@@ -123,6 +116,7 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
         cut::merge_node_contacts(nodes, touch[k].nodes);
         ToolFrame& out = stats.tools[k];
         out.force_n = touch[k].contact.force_on_tool_n;
+        out.torque_n_mm = touch[k].contact.torque_on_tool_n_mm;
         out.pressure_pa = touch[k].contact.pressure_pa;
         out.contact_area_mm2 = touch[k].contact.area_mm2;
     }

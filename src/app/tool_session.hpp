@@ -8,6 +8,7 @@
 #include "app/scene_simulation.hpp"
 #include "contact/tool_shape.hpp"
 
+#include <unordered_set>
 #include <vector>
 
 namespace vox::app {
@@ -17,6 +18,7 @@ struct ToolFrame {
     bool placed = false;
     Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero(); ///< on the tool (the object's reaction)
+    Eigen::Vector3d torque_n_mm = Eigen::Vector3d::Zero(); ///< on the tool, about its origin
     double pressure_pa = 0.0;
     double contact_area_mm2 = 0.0;
     bool cut = false; ///< it cut this frame
@@ -31,6 +33,7 @@ struct ToolFrameStats {
     double fem_update_ms = 0.0;  ///< model rebuilt and state carried over
     std::size_t removed_voxels = 0;
     std::size_t separated_faces = 0;
+    std::size_t separated_voxels = 0; ///< voxels with a face opened this frame
     std::vector<ToolFrame> tools; ///< one per scene tool
     [[nodiscard]] double cutting_ms() const { return collision_ms + propagation_ms + grid_update_ms + remesh_ms; }
 };
@@ -44,15 +47,17 @@ public:
     /// `grid`), and sets the solver's contact forces for the next step of `dt_s`.
     ToolFrameStats frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s);
 
-    [[nodiscard]] const contact::ToolShape& shape(std::size_t tool) const { return m_shapes[tool]; }
+
+    /// Voxels that have had a face opened since the session began.
+    [[nodiscard]] std::size_t separated_voxels() const { return m_separated.size(); }
 
 private:
     const io::Scene& m_scene;
     std::vector<contact::ToolShape> m_shapes;
-    /// Per tool: its cutting section, in rest space, where its current stroke began (first
-    /// contact) or it last cut; a separating cut opens what the section swept since. Empty out of
-    /// contact.
-    std::vector<std::vector<Eigen::Vector3d>> m_stroke_start;
+    /// Per tool: its cutting section at the previous frame, in rest space (separating tools only):
+    /// a frame's cut opens what the section swept since.
+    std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
+    std::unordered_set<std::uint32_t> m_separated; ///< voxel slots with an opened face
 };
 
 } // namespace vox::app

@@ -33,7 +33,11 @@ struct PointContact {
     double depth_mm = 0.0;                  ///< inside the outer shape, > 0
     Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< direction the point is pushed (unit), world
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero(); ///< on the surface point
-    double stiffness_n_per_mm = 0.0;        ///< d |force| / d depth
+    /// d |force| / d depth. The solver takes the contact's stiffness as this times normal
+    /// normal^T: the exact derivative when the tool's surface faces the object's (a flat face, a
+    /// blade's edge head-on), a symmetric positive semidefinite stand-in otherwise (stable, slightly
+    /// off in direction for a sphere touching at a slant).
+    double stiffness_n_per_mm = 0.0;
     bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
 };
 

@@ -108,14 +108,6 @@ Eigen::Vector3d ModelSurface::voxel_centre_mm(std::uint32_t v, const std::vector
     return deformed_mm(e, local, voxel_rest_mm(v), node_positions);
 }
 
-std::span<const std::uint32_t> ModelSurface::element_voxels(std::uint32_t e) const
-{
-    const fem::HexElement& el = m_model.elements()[e];
-    if (m_model.level() == 0) return {&el.grid_element, 1};
-    const std::vector<std::uint32_t>& voxels = m_grid.level(m_model.level()).elements[el.grid_element].voxels;
-    return {voxels.data(), voxels.size()};
-}
-
 std::vector<Eigen::Vector3d> ModelSurface::displacements(const std::vector<Eigen::Vector3d>& node_positions) const
 {
     std::vector<Eigen::Vector3d> out(m_element.size(), Eigen::Vector3d::Zero());

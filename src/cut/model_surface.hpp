@@ -54,8 +54,6 @@ public:
     [[nodiscard]] Eigen::Vector3d voxel_centre_mm(std::uint32_t v, const std::vector<Eigen::Vector3d>& node_positions) const;
     /// Rest centre of fine voxel `v`, world mm.
     [[nodiscard]] Eigen::Vector3d voxel_rest_mm(std::uint32_t v) const;
-    /// Fine voxel slots of model element `e` (level 0: its own voxel).
-    [[nodiscard]] std::span<const std::uint32_t> element_voxels(std::uint32_t e) const;
 
     /// Deformed position (world mm) of the point with trilinear coordinates `local` in model
     /// element `e` whose rest position is `rest_mm`.

@@ -69,7 +69,6 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         c.point = static_cast<std::uint32_t>(out.vertices.size());
         out.vertices.push_back(v);
         out.keys.push_back(surface.embedded().vertices()[v].key);
-        out.positions_mm.push_back(known.at(v));
         out.elements.push_back(surface.vertex_element(v));
     }
     out.nodes = node_contacts(surface, out);

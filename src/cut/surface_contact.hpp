@@ -16,7 +16,6 @@ struct SurfaceContact {
     contact::ContactResult contact;         ///< its points index `vertices`
     std::vector<std::uint32_t> vertices;    ///< surface vertex slot of each contact point
     std::vector<std::uint64_t> keys;        ///< and that vertex's identity (SurfaceVertex::key)
-    std::vector<Eigen::Vector3d> positions_mm; ///< deformed position of each contact point, world mm
     std::vector<fem::NodeContact> nodes;    ///< the forces on the model's nodes (N, N/m)
     std::vector<std::uint32_t> elements;    ///< model elements holding contact points (sorted, unique)
 };

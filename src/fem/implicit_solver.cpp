@@ -108,15 +108,16 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
 
 void ImplicitSolver::set_contact(std::vector<NodeContact> contact)
 {
+    std::vector<unsigned char> listed(m_x.size(), 0); // checked before anything changes
+    for (const NodeContact& c : contact)
+        if (c.node >= m_x.size() || listed[c.node]++)
+            throw std::invalid_argument("ImplicitSolver::set_contact: node out of range or listed twice");
     for (const NodeContact& c : m_contact) m_contact_of_node[c.node] = -1;
     m_contact = std::move(contact);
     m_contact_x0.resize(m_contact.size());
     for (std::size_t c = 0; c < m_contact.size(); ++c) {
-        const std::uint32_t node = m_contact[c].node;
-        if (node >= m_x.size() || m_contact_of_node[node] >= 0)
-            throw std::invalid_argument("ImplicitSolver::set_contact: node out of range or listed twice");
-        m_contact_of_node[node] = static_cast<std::int32_t>(c);
-        m_contact_x0[c] = m_x[node];
+        m_contact_of_node[m_contact[c].node] = static_cast<std::int32_t>(c);
+        m_contact_x0[c] = m_x[m_contact[c].node];
     }
 }
 

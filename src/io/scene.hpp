@@ -174,7 +174,7 @@ enum class ToolShape {
 enum class ToolAction {
     push, ///< deforms the object and never cuts ("push")
     cut,  ///< the inner shape cuts where it reaches material and the mean contact pressure on the
-          ///< outer shape exceeds ToolSpec::cut_pressure_pa ("cut")
+          ///< outer shape is at or above ToolSpec::cut_pressure_pa ("cut")
     wet,  ///< raises the water content of the elements it touches at ToolSpec::wet_rate_per_s ("wet")
 };
 
@@ -198,7 +198,7 @@ enum class CutMode {
 /// the outer (pushing) shape is the inner one grown by push_margin_mm. Where the outer shape
 /// overlaps the object by a depth d it presses with the penalty pressure
 /// contact_stiffness_n_per_mm * d / 1 cm^2. A cut tool cuts only where its inner shape reaches
-/// material and the mean pressure over the outer shape's contact exceeds cut_pressure_pa.
+/// material and the mean pressure over the outer shape's contact is at or above cut_pressure_pa.
 struct ToolSpec {
     /// Unique, non-empty; the script refers to the tool by it.
     std::string name;

@@ -210,3 +210,17 @@ TEST(SolverContact, StiffContactAbsorbsAKickWithoutGainingEnergy)
     EXPECT_LE(largest, std::sqrt(2 * e0 / stiffness) * (1 + 1e-9));
     EXPECT_LT(previous, 1e-6 * e0); // implicit Euler at this dt damps it away
 }
+
+TEST(Contact, ABadContactListIsRefusedAndChangesNothing)
+{
+    const HeldBlock b;
+    ImplicitSolver s = b.solver(quasi_static());
+    s.set_contact({{b.top, {0, 0, -1e-3}, Eigen::Matrix3d::Identity()}});
+    const auto out_of_range = static_cast<std::uint32_t>(b.model.node_count());
+    EXPECT_THROW(s.set_contact({{b.top, {}, {}}, {out_of_range, {}, {}}}), std::invalid_argument);
+    EXPECT_THROW(s.set_contact({{b.top, {}, {}}, {b.top, {}, {}}}), std::invalid_argument);
+    ASSERT_EQ(s.contact().size(), 1u); // the earlier contact still holds
+    EXPECT_EQ(s.contact()[0].node, b.top);
+    s.step(); // and the solver still works with it
+    EXPECT_LT(s.positions()[b.top].z(), b.model.rest_positions()[b.top].z());
+}
