@@ -11,6 +11,7 @@
 #include "core/sample_stats.hpp"
 #include "app/level_choice.hpp"
 #include "app/scene_simulation.hpp"
+#include "app/device_run.hpp"
 #include "app/tool_session.hpp"
 #include "cut/pieces.hpp"
 #include "io/mesh_writer.hpp"
@@ -52,6 +53,7 @@ void add_run_command(CLI::App& app)
         std::string scene;
         std::optional<int> frames;
         std::string out;
+        std::string device, replay, record, tool;
     };
     auto args = std::make_shared<Args>();
     CLI::App* cmd = app.add_subcommand("run", "Simulate a scene headless; write stats.json and the deformed surface");
@@ -59,6 +61,12 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--frames", args->frames, "Number of frames (default: the script's duration / dt_s, else 100)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--out", args->out, "Output folder (default: the scene's output.dir)");
+    cmd->add_option("--device", args->device, "Drive a tool by a device through the haptic loop (lockstep, 1 ms ticks): "
+                                               "\"script\" follows the tool's script")
+        ->check(CLI::IsMember({"script"}));
+    cmd->add_option("--replay", args->replay, "Drive the tool by replaying this recording (docs/recording-format.md)");
+    cmd->add_option("--record", args->record, "Record the device and the force sent at every tick to this file");
+    cmd->add_option("--tool", args->tool, "The tool the device drives (default: the scene's first tool)");
     cmd->callback([args] {
         const io::Scene scene = io::load_scene(args->scene);
         if (scene.solver.type != io::SolverType::dbg)
@@ -80,6 +88,18 @@ void add_run_command(CLI::App& app)
         const int level = choice.level;
         SceneSimulation sim(scene, g, level);
         ToolSession tools(scene);
+        if (!args->record.empty() && args->device.empty() && args->replay.empty())
+            throw InputError("--record: there is no device to record; add --device script or --replay FILE");
+        std::unique_ptr<DeviceRun> device;
+        if (!args->device.empty() || !args->replay.empty()) {
+            DeviceOptions o;
+            o.tool = args->tool;
+            if (!args->replay.empty()) o.replay = args->replay;
+            device = std::make_unique<DeviceRun>(scene, tools, o);
+            log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, lockstep)", scene.tools[device->tool()].name,
+                      device->device_name());
+        }
+        std::vector<ForceSample> tool_forces; // without a device: the first placed tool's, per frame
         // A cut rebuilds the model and solver: always reach them through `sim`.
 
         const double dt = scene.solver.dt_s;
@@ -114,11 +134,18 @@ void add_run_command(CLI::App& app)
         fem::StepStats last;
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
         for (int f = 1; f <= frames; ++f) {
+            if (device) device->frame(sim, tools, (f - 1) * dt, dt);
             const ToolFrameStats tf = tools.frame(sim, g, f * dt, dt);
             removed += tf.removed_voxels;
             separated += tf.separated_faces;
             if (tf.removed_voxels + tf.separated_faces > 0) cutting_ms.push_back(tf.cutting_ms());
-            last = sim.solver().step();
+            if (!tf.hold_object) last = sim.solver().step(); // a two-phase cut is being marked: the object is held
+            if (!device)
+                for (const ToolFrame& t : tf.tools)
+                    if (t.placed) {
+                        tool_forces.push_back({f * dt, t.position_mm, t.force_n});
+                        break;
+                    }
             total_ms += last.step_ms;
             max_ms = std::max(max_ms, last.step_ms);
             converged += last.converged;
@@ -161,6 +188,7 @@ void add_run_command(CLI::App& app)
                                        {"separated_faces", tf.separated_faces},
                                        {"separated_voxels", tf.separated_voxels},
                                        {"elements", sim.model().elements().size()},
+                                       {"object_held", tf.hold_object},
                                        {"tools", tool_frames}});
             if (f % scene.output.mesh_every_n_frames == 0) {
                 char name[32];
@@ -193,6 +221,12 @@ void add_run_command(CLI::App& app)
             stats["linear_solver"] = sim.solver().fallback_note();
         }
         write_surface(out / "final.obj", sim);
+        if (device) {
+            write_forces(out, device->forces(), "force on the device, " + scene.tools[device->tool()].name);
+            if (!args->record.empty()) haptics::write_recording(args->record, device->recording());
+        } else if (!tool_forces.empty()) {
+            write_forces(out, tool_forces, "contact force on the tool");
+        }
         write_atomically(out / "stats.json", [&](const std::filesystem::path& tmp) {
             std::ofstream(tmp) << stats.dump(1) << '\n';
         });

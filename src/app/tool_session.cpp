@@ -33,9 +33,18 @@ contact::ToolShape make_shape(const io::ToolSpec& t)
 
 } // namespace
 
-ToolSession::ToolSession(const io::Scene& scene) : m_scene(scene), m_previous_section(scene.tools.size())
+ToolSession::ToolSession(const io::Scene& scene)
+    : m_scene(scene), m_previous_section(scene.tools.size()), m_marked_from(scene.tools.size()),
+      m_episode_cut(scene.tools.size(), false), m_driven(scene.tools.size(), false), m_driven_pose(scene.tools.size())
 {
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
+}
+
+void ToolSession::drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation)
+{
+    m_driven.at(tool) = true;
+    m_driven_pose[tool].position = position_mm;
+    m_driven_pose[tool].orientation = orientation;
 }
 
 ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s)
@@ -48,7 +57,12 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
     Stopwatch clock;
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
         const io::ToolSpec& spec = m_scene.tools[k];
-        const io::ToolPose pose = io::tool_pose(m_scene, k, t_s);
+        io::ToolPose pose = io::tool_pose(m_scene, k, t_s);
+        if (m_driven[k]) { // a device moves this tool
+            pose.placed = true;
+            pose.position_mm = m_driven_pose[k].position;
+            pose.orientation = m_driven_pose[k].orientation;
+        }
         ToolFrame& out = stats.tools[k];
         out.placed = pose.placed;
         if (!pose.placed) continue;
@@ -70,10 +84,24 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
             const Eigen::Vector3d moved = cut::mean_displacement_mm(sim.surface(), sim.solver().positions(), box);
             for (Eigen::Vector3d& p : rest_section) p -= moved;
         }
-        const std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[k], rest_section);
+        std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[k], rest_section);
+        // Two-phase cutting: from the first touch the object is held and the tool marks its cut;
+        // the whole marked path is cut at once when the condition is met.
+        const bool two_phase = spec.action == io::ToolAction::cut && spec.two_phase;
+        if (two_phase) {
+            if (c.points.empty()) { // let go: the next touch marks a new cut
+                m_marked_from[k].clear();
+                m_episode_cut[k] = false;
+            } else if (!m_episode_cut[k] && !rest_section.empty()) {
+                if (m_marked_from[k].empty()) m_marked_from[k] = rest_section; // the marking starts here
+                previous = m_marked_from[k];                                   // and is cut whole
+            }
+        }
         // Cutting happens only where the inner shape reaches the material and the contact
         // pressure is at or above the threshold.
-        if (spec.action == io::ToolAction::cut && c.inner_reaches_surface() && c.pressure_pa >= spec.cut_pressure_pa) {
+        const bool marking = two_phase && !c.points.empty() && !m_episode_cut[k];
+        if (spec.action == io::ToolAction::cut && (!two_phase || marking) && c.inner_reaches_surface() &&
+            c.pressure_pa >= spec.cut_pressure_pa) {
             std::vector<grid::Coord> removed;
             std::vector<std::pair<grid::Coord, int>> faces;
             if (spec.cut_mode == io::CutMode::remove) {
@@ -92,18 +120,20 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
                 stats.removed_voxels += removed.size();
                 stats.separated_faces += faces.size();
                 std::unordered_set<std::uint32_t> sides;
-                for (const auto& [c, axis] : faces)
-                    for (const grid::Coord& side : {c, grid::Coord(c + grid::Coord::Unit(axis))}) {
+                for (const auto& [coord, axis] : faces)
+                    for (const grid::Coord& side : {coord, grid::Coord(coord + grid::Coord::Unit(axis))}) {
                         const std::uint32_t v = grid.voxels().find(side);
                         sides.insert(v);
                         m_separated.insert(v);
                     }
                 stats.separated_voxels += sides.size();
                 out.cut = true;
+                if (two_phase) m_episode_cut[k] = true; // the simulation resumes
                 std::fill(fresh.begin(), fresh.end(), false); // node numbers changed: contacts are carried over
                 clock.lap();
             }
         }
+        if (marking && !m_episode_cut[k]) stats.hold_object = true;
         if (spec.action == io::ToolAction::wet)
             for (std::uint32_t e : touch[k].elements)
                 sim.solver().set_water(e, sim.solver().water(e) + spec.wet_rate_per_s * dt_s);

@@ -35,6 +35,8 @@ struct ToolFrameStats {
     std::size_t separated_faces = 0;
     std::size_t separated_voxels = 0; ///< voxels with a face opened this frame
     std::vector<ToolFrame> tools; ///< one per scene tool
+    /// A two-phase tool is marking its cut: the object is held still this frame (no solver step).
+    bool hold_object = false;
     [[nodiscard]] double cutting_ms() const { return collision_ms + propagation_ms + grid_update_ms + remesh_ms; }
 };
 
@@ -48,6 +50,12 @@ public:
     ToolFrameStats frame(SceneSimulation& sim, grid::BranchedGrid& grid, double t_s, double dt_s);
 
 
+    /// A device moves `tool` from now on (its script entries are ignored): its pose for the next
+    /// frames, world mm.
+    void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation);
+
+    [[nodiscard]] const contact::ToolShape& shape(std::size_t tool) const { return m_shapes[tool]; }
+
     /// Voxels that have had a face opened since the session began.
     [[nodiscard]] std::size_t separated_voxels() const { return m_separated.size(); }
 
@@ -58,6 +66,12 @@ private:
     /// a frame's cut opens what the section swept since.
     std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
     std::unordered_set<std::uint32_t> m_separated; ///< voxel slots with an opened face
+    /// Two-phase tools: the section where the marking began (rest space), and whether this
+    /// contact has already cut (then the object moves again until the tool lets go).
+    std::vector<std::vector<Eigen::Vector3d>> m_marked_from;
+    std::vector<bool> m_episode_cut;
+    std::vector<bool> m_driven;                   ///< a device moves the tool
+    std::vector<contact::PlacedShape> m_driven_pose;
 };
 
 } // namespace vox::app

@@ -8,11 +8,14 @@
 //     f = -k d a n / (1 cm^2),
 // k the scene's contact_stiffness_n_per_mm: a flat face pressed 1 mm into the object over 1 cm^2
 // pushes with k newtons, whatever the mesh resolution. The contact pressure is the mean over the
-// contact, sum |f| / sum a, which is what decides a cut: a broad tool spreads its force over a
-// large area, a sharp one concentrates it. The force follows the object's normal, not the tool's:
+// part of the contact that carries the load, sum |f| / sum a over the points whose force points
+// within 60 degrees of the net force: what decides a cut. A broad tool spreads its force over a
+// large area, a sharp one concentrates it; the walls of a slit rubbing a blade's sides carry no
+// load and do not dilute the pressure at its edge. The force follows the object's normal, not the tool's:
 // once a thin blade is inside the material the nearest tool face says nothing about which side a
 // point is on, while the two walls of a slit face opposite ways and are pushed apart.
 
+#include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
 
 #include <Eigen/Core>
@@ -46,7 +49,8 @@ struct ContactResult {
     Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();       ///< the reaction: minus the sum of the point forces
     Eigen::Vector3d torque_on_tool_n_mm = Eigen::Vector3d::Zero();   ///< about the tool's origin
     double area_mm2 = 0.0;                   ///< surface area in contact
-    double pressure_pa = 0.0;                ///< sum |f| / area (0 without contact)
+    double load_area_mm2 = 0.0;              ///< the part of it that carries the load
+    double pressure_pa = 0.0;                ///< sum |f| / area over the load-carrying part (0 without contact)
     [[nodiscard]] bool inner_reaches_surface() const
     {
         for (const PointContact& p : points)
@@ -54,6 +58,24 @@ struct ContactResult {
         return false;
     }
 };
+
+/// The totals of a contact, without the per-point list: what the 1 kHz loop needs.
+struct ContactTotals {
+    Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();
+    Eigen::Vector3d torque_on_tool_n_mm = Eigen::Vector3d::Zero();
+    /// -d force_on_tool / d tool position (N/mm): sum of each point's stiffness times
+    /// normal normal^T, for a tool that moves without turning.
+    Eigen::Matrix3d stiffness_n_per_mm = Eigen::Matrix3d::Zero();
+    double area_mm2 = 0.0;
+    double load_area_mm2 = 0.0;
+    double pressure_pa = 0.0;
+    bool inner_reaches_surface = false;
+};
+
+/// The same model as penalty_contact over the first `points.count` points; never allocates,
+/// locks or throws (the haptic loop calls it).
+[[nodiscard]] ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters,
+                                           const SurfacePoints& points) noexcept;
 
 /// Contact of `tool` (its inner shape, placed in the world) with surface points (world mm), each
 /// carrying `areas[i]` mm^2 of surface with outward unit normal `normals[i]` (a zero normal: the

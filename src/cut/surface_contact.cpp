@@ -3,29 +3,26 @@
 #include "grid/hex8.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <unordered_map>
 
 namespace vox::cut {
 
-SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                             const contact::PlacedShape& tool, const contact::ContactParameters& parameters)
+namespace {
+
+/// Surface vertex slots whose deformed position lies in `reach`, with those positions: vertices
+/// of elements whose deformed corner box meets the reach, rest positions filtered first (a
+/// vertex moves by its element's mean displacement give or take the corners' spread).
+void vertices_in(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& reach,
+                 const std::function<void(std::uint32_t, const Eigen::Vector3d&)>& visit)
 {
-    SurfaceContact out;
     const fem::HexModel& model = surface.model();
-    const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    // Candidate points: vertices of elements whose deformed corners' box meets the reach, kept
-    // when inside the outer shape. (Surface vertices lie inside their element's cell, and a
-    // trilinear map keeps points inside its corners' box.)
-    std::vector<std::uint32_t> inside;
-    std::vector<Eigen::Vector3d> inside_mm;
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
         const fem::HexElement& el = model.elements()[e];
         Eigen::AlignedBox3d box;
         box.setEmpty();
         for (std::uint32_t n : el.dof_node) box.extend(1e3 * node_positions[n]);
         if (!box.intersects(reach)) continue;
-        // A vertex moves by the element's mean displacement give or take the corners' spread:
-        // vertices whose rest position is farther than that from the reach are passed over.
         Eigen::Vector3d mean = Eigen::Vector3d::Zero();
         for (std::uint32_t n : el.dof_node) mean += 1e3 * (node_positions[n] - model.rest_positions()[n]) / 8.0;
         double spread = 0.0;
@@ -35,13 +32,45 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         for (std::uint32_t v : surface.element_vertices(e)) {
             if (!rest_reach.contains(surface.vertex_rest_mm(v))) continue;
             const Eigen::Vector3d p = surface.vertex_mm(v, node_positions);
-            if (!reach.contains(p) || tool.signed_distance(p) >= parameters.margin_mm) continue;
-            inside.push_back(v);
-            inside_mm.push_back(p);
+            if (reach.contains(p)) visit(v, p);
         }
     }
+}
+
+/// A third of the deformed area of the triangles around vertex slot `v`, and the area-weighted
+/// mean of their outward normals; `position` gives deformed vertex positions.
+template <class Position>
+void area_and_normal(const ModelSurface& surface, std::uint32_t v, Position&& position, double& area, Eigen::Vector3d& normal)
+{
+    area = 0.0;
+    normal.setZero();
+    const auto& triangles = surface.embedded().triangles();
+    for (std::uint32_t t : surface.vertex_triangles(v)) {
+        const auto& tri = triangles[t];
+        const Eigen::Vector3d a = position(tri[0]), b = position(tri[1]), c = position(tri[2]);
+        const Eigen::Vector3d n = (b - a).cross(c - a);
+        area += n.norm() / 6.0;
+        normal += n;
+    }
+    if (normal.norm() > 0.0) normal *= surface.outward_sign() / normal.norm();
+}
+
+} // namespace
+
+SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                             const contact::PlacedShape& tool, const contact::ContactParameters& parameters)
+{
+    SurfaceContact out;
+    const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    // Candidate points: the vertices near the tool, kept when inside the outer shape.
+    std::vector<std::uint32_t> inside;
+    std::vector<Eigen::Vector3d> inside_mm;
+    vertices_in(surface, node_positions, reach, [&](std::uint32_t v, const Eigen::Vector3d& p) {
+        if (tool.signed_distance(p) >= parameters.margin_mm) return;
+        inside.push_back(v);
+        inside_mm.push_back(p);
+    });
     if (inside.empty()) return out;
-    // Each point carries a third of the deformed area of the triangles around it.
     std::unordered_map<std::uint32_t, Eigen::Vector3d> known;
     for (std::size_t i = 0; i < inside.size(); ++i) known.emplace(inside[i], inside_mm[i]);
     auto position = [&](std::uint32_t v) {
@@ -49,20 +78,9 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         if (found != known.end()) return found->second;
         return known.emplace(v, surface.vertex_mm(v, node_positions)).first->second;
     };
-    // and the area-weighted mean of their normals.
     std::vector<double> areas(inside.size(), 0.0);
     std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
-    const auto& triangles = surface.embedded().triangles();
-    for (std::size_t i = 0; i < inside.size(); ++i) {
-        for (std::uint32_t t : surface.vertex_triangles(inside[i])) {
-            const auto& tri = triangles[t];
-            const Eigen::Vector3d a = position(tri[0]), b = position(tri[1]), c = position(tri[2]);
-            const Eigen::Vector3d n = (b - a).cross(c - a);
-            areas[i] += n.norm() / 6.0;
-            normals[i] += n;
-        }
-        if (normals[i].norm() > 0.0) normals[i] *= surface.outward_sign() / normals[i].norm();
-    }
+    for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
     out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals);
     for (contact::PointContact& c : out.contact.points) {
         const std::uint32_t v = inside[c.point];
@@ -99,6 +117,33 @@ std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const S
         }
     }
     return out;
+}
+
+void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& box,
+                    contact::SurfacePoints& out)
+{
+    out.count = 0;
+    out.truncated = false;
+    std::vector<std::uint32_t> slots;
+    std::unordered_map<std::uint32_t, Eigen::Vector3d> known;
+    vertices_in(surface, node_positions, box, [&](std::uint32_t v, const Eigen::Vector3d& p) {
+        slots.push_back(v);
+        known.emplace(v, p);
+    });
+    auto position = [&](std::uint32_t v) {
+        const auto found = known.find(v);
+        if (found != known.end()) return found->second;
+        return known.emplace(v, surface.vertex_mm(v, node_positions)).first->second;
+    };
+    for (std::uint32_t v : slots) {
+        if (out.count == out.capacity()) {
+            out.truncated = true;
+            break;
+        }
+        out.positions_mm[out.count] = known.at(v);
+        area_and_normal(surface, v, position, out.areas_mm2[out.count], out.normals[out.count]);
+        ++out.count;
+    }
 }
 
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b)

@@ -32,6 +32,12 @@ struct SurfaceContact {
 /// whose surface vertex the cut replaced are dropped (the next frame finds the new ones).
 [[nodiscard]] std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const SurfaceContact& contact);
 
+/// Fills `out` with the surface points within `box` (world mm) of the surface deformed by
+/// `node_positions` (m), each with its area and outward normal: the snapshot the haptic thread
+/// touches. At most out.capacity() points (out.truncated says when more were there).
+void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& box,
+                    contact::SurfacePoints& out);
+
 /// Adds `b`'s node contacts to `a` (several tools on one object).
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b);
 

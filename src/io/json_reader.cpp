@@ -214,6 +214,11 @@ template <class T> T as(const JsonNode& node, const Bound& bound)
             node.fail("must be " + bound.describe() + ", got " + show(v));
         }
         return x;
+    } else if constexpr (std::is_same_v<T, bool>) {
+        if (!v.is_boolean()) {
+            node.fail_type("true or false");
+        }
+        return v.get<bool>();
     } else if constexpr (std::is_same_v<T, std::string>) {
         if (!v.is_string()) {
             node.fail_type("a string");
@@ -235,6 +240,7 @@ template <class T> T as(const JsonNode& node, const Bound& bound)
 template double as<double>(const JsonNode&, const Bound&);
 template int as<int>(const JsonNode&, const Bound&);
 template std::string as<std::string>(const JsonNode&, const Bound&);
+template bool as<bool>(const JsonNode&, const Bound&);
 template Eigen::Vector3d as<Eigen::Vector3d>(const JsonNode&, const Bound&);
 
 std::string_view choose(const JsonNode& node, std::initializer_list<std::string_view> names)

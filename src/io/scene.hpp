@@ -226,6 +226,10 @@ struct ToolSpec {
     /// wet tools: how fast the water content (0..1) of the elements touched rises, per second of
     /// contact, in (0, 1e3]; the content stops at 1.
     double wet_rate_per_s = 1.0;
+    /// Two-phase cutting (the sculpting paper's): while a cut tool touches the object, the object
+    /// is held still and the tool marks its cut; when the cut condition is met the whole marked
+    /// path is cut at once and the simulation resumes. Default false: cuts happen frame by frame.
+    bool two_phase = false;
 };
 
 /// One key frame of the tool script: where a tool is, and how it is turned, at a time. Between two

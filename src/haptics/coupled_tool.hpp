@@ -1,0 +1,43 @@
+#pragma once
+// Virtual coupling between the device and the tool in the simulation (the proxy): a spring-damper
+// pulls the proxy toward the device; the contact with the surface snapshot holds it back. The
+// proxy is massless and found each tick implicitly against the linearised contact,
+//     (k_c I + K) dx = k_c (x_device - x) + F_contact(x),
+// K the contact's stiffness, so stiff contact and a stiff coupling stay stable at 1 kHz (Colgate
+// et al.'s virtual coupling; the adaptive shape matching paper couples the same way). The user
+// feels the spring's force, k_c (x_proxy - x_device) plus damping, which the loop's safety stage
+// then clamps. Everything here runs in the 1 kHz loop: no allocation, lock, log or throw.
+
+#include "contact/penalty_contact.hpp"
+#include "haptics/device.hpp"
+
+namespace vox::haptics {
+
+struct CouplingSettings {
+    double stiffness_n_per_mm = 0.5;   ///< the spring between device and proxy
+    double damping_n_s_per_mm = 0.002; ///< on their relative velocity
+};
+
+class CoupledTool {
+public:
+    CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling);
+
+    /// One tick of `dt_s`: moves the proxy for the device's new state against `surface` and
+    /// returns the force for the device, N. The first call puts the proxy at the device.
+    Eigen::Vector3d update(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept;
+
+    /// The proxy: where the tool is in the simulation.
+    [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
+    /// The contact at the proxy after the last update.
+    [[nodiscard]] const contact::ContactTotals& contact() const { return m_contact; }
+
+private:
+    contact::ContactParameters m_parameters;
+    CouplingSettings m_coupling;
+    contact::PlacedShape m_proxy;
+    contact::ContactTotals m_contact;
+    Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_proxy = Eigen::Vector3d::Zero();
+    bool m_started = false;
+};
+
+} // namespace vox::haptics
