@@ -594,10 +594,12 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     EXPECT_EQ(with_key("cut_mode", "split"),
               "s.json: tools[1].cut_mode: expected one of \"remove\", \"separate\", got \"split\"");
     EXPECT_EQ(with_key("cut_mode", json::object()), "s.json: tools[1].cut_mode: expected a string, got {}");
+    EXPECT_EQ(with_key("two_phase", 1), "s.json: tools[1].two_phase: expected true or false, got 1");
+    EXPECT_EQ(with_key("two_phase", "yes"), "s.json: tools[1].two_phase: expected true or false, got \"yes\"");
     // A misspelt key is still unknown, and the message lists the new keys among the known ones.
     EXPECT_EQ(with_key("cut_pressure", 1e4),
               "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
-              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s)");
+              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, two_phase)");
     // NaN cannot be in a file but can be in a document built in code.
     EXPECT_EQ(with_key("push_margin_mm", std::nan("")).rfind("s.json: tools[1].push_margin_mm: must be in [0, 100]", 0),
               0u);
