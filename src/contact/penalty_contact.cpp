@@ -43,7 +43,8 @@ ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& 
     return out;
 }
 
-ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points) noexcept
+ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
+                             bool with_pressure) noexcept
 {
     ContactTotals out;
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
@@ -67,7 +68,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     // A second pass for the load-carrying part (as penalty_contact): nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
-    for (std::size_t i = 0; i < points.count && out.area_mm2 > 0.0; ++i) {
+    for (std::size_t i = 0; with_pressure && i < points.count && out.area_mm2 > 0.0; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
         if (!reach.contains(p)) continue;
         Eigen::Vector3d normal;

@@ -28,7 +28,7 @@ public:
 
     /// The proxy: where the tool is in the simulation.
     [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
-    /// The contact at the proxy after the last update.
+    /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
     [[nodiscard]] const contact::ContactTotals& contact() const { return m_contact; }
 
 private:
