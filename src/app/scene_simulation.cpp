@@ -90,19 +90,30 @@ CutTimings SceneSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const 
     std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
-    build(false);
+    build(false, old_model.get(), &report);
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
     t.fem_update_ms = clock.lap();
     return t;
 }
 
-void SceneSimulation::build(bool first)
+void SceneSimulation::build(bool first, const fem::HexModel* previous, const grid::UpdateReport* report)
 {
     const io::Scene& scene = m_scene;
     const grid::BranchedGrid& grid = *m_grid;
     const int level = m_level;
-    m_model = std::make_unique<fem::HexModel>(grid, level);
+    if (previous && level >= 1) {
+        // The elements the change touched; all others keep their matrices.
+        std::vector<unsigned char> changed(grid.level(level).elements.size(), 0);
+        if (static_cast<std::size_t>(level) < report->levels.size()) {
+            const grid::LevelChange& c = report->levels[static_cast<std::size_t>(level)];
+            for (const auto& [e, from] : c.created) changed[e] = 1;
+            for (std::uint32_t e : c.updated) changed[e] = 1;
+        }
+        m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);
+    } else {
+        m_model = std::make_unique<fem::HexModel>(grid, level);
+    }
     const fem::HexModel& model = *m_model;
     const std::size_t dofs = 3 * model.node_count();
     const io::PreconditionerChoice choice = resolve(scene.solver.preconditioner, dofs, level < grid.max_level());

@@ -59,7 +59,8 @@ public:
 private:
     /// Model, solver, preconditioner, materials, constraints and loads at m_level; `first`: also
     /// the wet regions, and boxes that catch no node are errors (after a cut they may catch none).
-    void build(bool first);
+    /// After a cut, `previous` and `report` let unchanged elements keep their matrices.
+    void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr);
 
     io::Scene m_scene;
     const grid::BranchedGrid* m_grid;

@@ -41,7 +41,18 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level), 
     if (level == 0)
         build_voxel_level(grid);
     else
-        build_grid_level(grid, level);
+        build_grid_level(grid, level, nullptr, nullptr);
+    add_mass_floor(grid);
+}
+
+HexModel::HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed)
+    : m_level(level), m_materials(grid.materials())
+{
+    if (level < 1 || level > grid.max_level() || previous.level() != level)
+        throw InputError("a model rebuilt from a previous one needs the same level, 1 .. " + std::to_string(grid.max_level()));
+    const Eigen::Matrix4d& t = grid.voxels().index_to_world();
+    m_frame = t.topLeftCorner<3, 3>() * (grid.voxels().voxel_size_m() * 1e3).cwiseInverse().asDiagonal();
+    build_grid_level(grid, level, &previous, &changed);
     add_mass_floor(grid);
 }
 
@@ -96,8 +107,18 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
     }
 }
 
-void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
+void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const HexModel* previous,
+                                const std::vector<unsigned char>* changed)
 {
+    // Elements of `previous` by grid element, for those the change left alone.
+    std::vector<std::uint32_t> kept;
+    if (previous) {
+        kept.assign(grid.level(level).elements.size(), grid::no_index);
+        for (std::uint32_t e = 0; e < previous->elements().size(); ++e) {
+            const std::uint32_t g = previous->elements()[e].grid_element;
+            if (g < kept.size() && !(g < changed->size() && (*changed)[g])) kept[g] = e;
+        }
+    }
     const grid::Level& lv = grid.level(level);
     const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
     const double cell = static_cast<double>(1 << level);
@@ -131,8 +152,12 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
         HexElement el;
         el.grid_element = e;
         for (int c = 0; c < 8; ++c) el.dof_node[c] = m_dense_node[g.nodes[c]];
+        const HexElement* old = previous && kept[e] != grid::no_index ? &previous->elements()[kept[e]] : nullptr;
         if (grid.is_full(level, e)) {
             el.stiffness = &m_full_stiffness[static_cast<std::size_t>(g.content[0].material)];
+        } else if (old) {
+            m_partial_stiffness.push_back(*old->stiffness); // fictitious material included
+            el.stiffness = &m_partial_stiffness.back();
         } else {
             m_partial_stiffness.push_back(grid.stiffness(level, e));
             el.stiffness = &m_partial_stiffness.back();
@@ -145,7 +170,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level)
                 [](const grid::MaterialMoments& a, const grid::MaterialMoments& b) { return a.voxels < b.voxels; })->material);
             m_partial_stiffness.back() += k_fictitious_fraction * m_full_stiffness[dominant];
         }
-        el.mass = grid.mass(level, e);
+        el.mass = old ? old->mass : grid.mass(level, e);
         for (int c = 0; c < 8; ++c) {
             el.rest.segment<3>(3 * c) = grid::BranchedGrid::cell_corner_index(g.cell, level, c).cwiseProduct(h);
             m_nodal_mass[el.dof_node[c]] += el.mass.row(c).sum();

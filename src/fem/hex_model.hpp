@@ -30,6 +30,11 @@ class HexModel {
 public:
     /// Builds the model of `level` of `grid`: 0 (every voxel an element) .. grid.max_level().
     HexModel(const grid::BranchedGrid& grid, int level);
+    /// The same after a change of the grid: elements of `previous` (the model of the same level
+    /// before the change) that `changed` does not flag (per grid element id of the level: created
+    /// or updated by the change) keep their stiffness and mass instead of having them evaluated
+    /// from their moments again, the bulk of a rebuild after a cut.
+    HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed);
 
     [[nodiscard]] int level() const { return m_level; }
     [[nodiscard]] std::size_t node_count() const { return m_rest_world.size(); }
@@ -57,7 +62,8 @@ public:
 
 private:
     void build_voxel_level(const grid::BranchedGrid& grid);
-    void build_grid_level(const grid::BranchedGrid& grid, int level);
+    void build_grid_level(const grid::BranchedGrid& grid, int level, const HexModel* previous,
+                          const std::vector<unsigned char>* changed);
     void add_mass_floor(const grid::BranchedGrid& grid);
 
     int m_level = 1;

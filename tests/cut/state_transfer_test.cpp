@@ -74,4 +74,31 @@ TEST_P(StateTransfer, NodesAndElementsInheritWhatTheCutDidNotChange)
     }
 }
 
+TEST_P(StateTransfer, AModelRebuiltFromTheOldOneEqualsAFreshOne)
+{
+    // Unchanged elements keep their matrices; the result must be the model built from scratch.
+    const int level = GetParam();
+    grid::BranchedGrid grid = test::block_grid({8, 4, 4}, level);
+    const fem::HexModel before(grid, level);
+    std::vector<std::pair<grid::Coord, int>> faces;
+    for (int y = 0; y < 4; ++y)
+        for (int z = 0; z < 4; ++z) faces.emplace_back(grid::Coord(4, y, z), 0);
+    const std::vector<grid::Coord> removed{grid::Coord(7, 3, 3), grid::Coord(0, 0, 0)};
+    const grid::UpdateReport report = grid.update(removed, faces);
+    std::vector<unsigned char> changed(grid.level(level).elements.size(), 0);
+    for (const auto& [e, from] : report.levels[static_cast<std::size_t>(level)].created) changed[e] = 1;
+    for (std::uint32_t e : report.levels[static_cast<std::size_t>(level)].updated) changed[e] = 1;
+    const fem::HexModel fresh(grid, level), reused(grid, level, before, changed);
+    ASSERT_EQ(fresh.elements().size(), reused.elements().size());
+    ASSERT_EQ(fresh.node_count(), reused.node_count());
+    for (std::size_t e = 0; e < fresh.elements().size(); ++e) {
+        const fem::HexElement &a = fresh.elements()[e], &b = reused.elements()[e];
+        EXPECT_EQ(a.grid_element, b.grid_element);
+        EXPECT_EQ(a.dof_node, b.dof_node);
+        EXPECT_EQ(*a.stiffness, *b.stiffness) << e;
+        EXPECT_EQ(a.mass, b.mass) << e;
+    }
+    EXPECT_EQ(fresh.nodal_mass(), reused.nodal_mass());
+}
+
 INSTANTIATE_TEST_SUITE_P(Levels, StateTransfer, ::testing::Values(1, 2));

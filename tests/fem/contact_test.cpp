@@ -217,8 +217,10 @@ TEST(Contact, ABadContactListIsRefusedAndChangesNothing)
     ImplicitSolver s = b.solver(quasi_static());
     s.set_contact({{b.top, {0, 0, -1e-3}, Eigen::Matrix3d::Identity()}});
     const auto out_of_range = static_cast<std::uint32_t>(b.model.node_count());
-    EXPECT_THROW(s.set_contact({{b.top, {}, {}}, {out_of_range, {}, {}}}), std::invalid_argument);
-    EXPECT_THROW(s.set_contact({{b.top, {}, {}}, {b.top, {}, {}}}), std::invalid_argument);
+    const Eigen::Vector3d f0 = Eigen::Vector3d::Zero();
+    const Eigen::Matrix3d k0 = Eigen::Matrix3d::Zero();
+    EXPECT_THROW(s.set_contact({{b.top, f0, k0}, {out_of_range, f0, k0}}), std::invalid_argument);
+    EXPECT_THROW(s.set_contact({{b.top, f0, k0}, {b.top, f0, k0}}), std::invalid_argument);
     ASSERT_EQ(s.contact().size(), 1u); // the earlier contact still holds
     EXPECT_EQ(s.contact()[0].node, b.top);
     s.step(); // and the solver still works with it
