@@ -139,7 +139,14 @@ void add_run_command(CLI::App& app)
             removed += tf.removed_voxels;
             separated += tf.separated_faces;
             if (tf.removed_voxels + tf.separated_faces > 0) cutting_ms.push_back(tf.cutting_ms());
-            if (!tf.hold_object) last = sim.solver().step(); // a two-phase cut is being marked: the object is held
+            if (tf.hold_object) { // a two-phase cut is being marked: the object is held, no step
+                last.step_ms = last.assembly_ms = last.solve_ms = 0.0;
+                last.cg_iterations = last.newton_iterations = last.substeps = 0;
+                last.converged = true;
+                last.energy_guarded = false;
+            } else {
+                last = sim.solver().step();
+            }
             if (!device)
                 for (const ToolFrame& t : tf.tools)
                     if (t.placed) {

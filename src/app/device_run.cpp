@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "cut/surface_contact.hpp"
 #include "haptics/virtual_device.hpp"
 
@@ -44,31 +45,43 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolSession& tools, const Dev
         m_device = std::make_unique<haptics::VirtualDevice>(std::move(frames));
     }
     const io::ToolSpec& spec = scene.tools[m_tool];
+    // The device's own limits where it declares them: its force, and a coupling it renders stably.
+    const haptics::DeviceLimits& limits = m_device->limits();
+    haptics::CouplingSettings coupling;
+    if (limits.max_stiffness_n_per_mm > 0.0) coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, limits.max_stiffness_n_per_mm);
+    haptics::SafetySettings safety;
+    if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
     m_coupled = std::make_unique<haptics::CoupledTool>(tools.shape(m_tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
-                                                       haptics::CouplingSettings{});
+                                                       coupling);
     m_loop = std::make_unique<haptics::HapticLoop>(
         *m_device,
         [this](const haptics::DeviceState& state, double& age) {
             age = state.t_s - m_snapshot.t_s;
-            return m_coupled->update(state, m_snapshot, k_tick_s);
+            return m_coupled->update(state, m_snapshot, m_tick_s);
         },
-        haptics::SafetySettings{}, 0);
+        safety, 0);
 }
 
 void DeviceRun::frame(const SceneSimulation& sim, ToolSession& tools, double t0_s, double dt_s)
 {
     // The snapshot: the surface around where the tool is, as the simulation has it at the frame's start.
-    if (!m_started) {
+    if (!m_started) { // the proxy starts at the device; the reading is recorded so a replay starts alike
         haptics::DeviceState first;
         m_device->read(t0_s, first);
-        m_coupled->update(first, m_snapshot, k_tick_s); // puts the proxy at the device
+        m_coupled->update(first, m_snapshot, k_tick_s);
+        m_recording.push_back({first, Eigen::Vector3d::Zero()});
         m_started = true;
     }
     const io::ToolSpec& spec = m_scene.tools[m_tool];
     cut::sample_surface(sim.surface(), sim.solver().positions(), m_coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm),
                         m_snapshot);
     m_snapshot.t_s = t0_s;
+    if (m_snapshot.truncated && !m_warned_truncated) {
+        log::warn("the surface near the tool has more than {} points; the haptic snapshot keeps the first ones", m_snapshot.capacity());
+        m_warned_truncated = true;
+    }
     const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
+    m_tick_s = dt_s / ticks;
     for (int i = 1; i <= ticks; ++i) {
         const double t = t0_s + i * dt_s / ticks;
         const Eigen::Vector3d f = m_loop->tick(t);

@@ -38,6 +38,8 @@ public:
     /// Throws InputError for an unknown tool, a tool without script entries (script device), or a
     /// bad recording.
     DeviceRun(const io::Scene& scene, const ToolSession& tools, const DeviceOptions& options);
+    DeviceRun(const DeviceRun&) = delete; // the loop's force model refers to this object
+    DeviceRun& operator=(const DeviceRun&) = delete;
 
     /// Runs the haptic ticks of the frame [t0, t0 + dt) against the surface as `sim` has it now,
     /// then tells `tools` where the device put the tool. Appends to forces() and recording().
@@ -58,6 +60,8 @@ private:
     std::vector<ForceSample> m_forces;
     std::vector<haptics::RecordedTick> m_recording;
     bool m_started = false;
+    bool m_warned_truncated = false;
+    double m_tick_s = 1e-3;
 };
 
 /// Writes forces.csv (t_s, x_mm, y_mm, z_mm, fx_n, fy_n, fz_n) and forces.svg (the force's

@@ -7,7 +7,6 @@
 #include "io/tool_script.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 #include <utility>
 

@@ -3,7 +3,6 @@
 #include "grid/hex8.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <unordered_map>
 
 namespace vox::cut {
@@ -13,8 +12,9 @@ namespace {
 /// Surface vertex slots whose deformed position lies in `reach`, with those positions: vertices
 /// of elements whose deformed corner box meets the reach, rest positions filtered first (a
 /// vertex moves by its element's mean displacement give or take the corners' spread).
+template <class Visit>
 void vertices_in(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& reach,
-                 const std::function<void(std::uint32_t, const Eigen::Vector3d&)>& visit)
+                 Visit&& visit)
 {
     const fem::HexModel& model = surface.model();
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {

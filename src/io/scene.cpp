@@ -458,7 +458,11 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
         r.optional("contact_stiffness_n_per_mm", t.contact_stiffness_n_per_mm, half_open_range(0.0, 1e4));
     t.cut_pressure_pa = r.optional("cut_pressure_pa", t.cut_pressure_pa, half_open_range(0.0, 1e9));
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
-    t.two_phase = r.optional("two_phase", t.two_phase);
+    if (const std::optional<JsonNode> node = r.optional_node("two_phase")) {
+        t.two_phase = as<bool>(*node);
+        if (t.two_phase && (t.action != ToolAction::cut || t.cut_mode != CutMode::separate))
+            node->fail("two-phase cutting marks a cut to open whole: it needs \"action\": \"cut\" and \"cut_mode\": \"separate\"");
+    }
     r.finish("for a " + as<std::string>(shape) + " tool");
     return t;
 }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <span>
 #include <vector>
 
@@ -245,4 +246,44 @@ TEST(PenaltyContact, StiffnessIsTheDerivativeOfTheForceWithDepth)
         EXPECT_LT((p.force_n - p.stiffness_n_per_mm * p.depth_mm * p.normal).norm(), 1e-15);
         EXPECT_NEAR(p.normal.norm(), 1.0, 1e-15);
     }
+}
+
+TEST(PenaltyTotals, AreThePointListsSumsForAnyPose)
+{
+    // The 1 kHz loop's allocation-free totals and the per-point contact are one model: same force,
+    // torque, area, load area, pressure and inner-shape test, for a blade turned at random over
+    // a random cloud of points with random normals and areas.
+    const ToolShape blade = ToolShape::box({12, 1, 6});
+    std::srand(7);
+    auto uniform = [](double lo, double hi) { return lo + (hi - lo) * std::rand() / static_cast<double>(RAND_MAX); };
+    SurfacePoints cloud(400);
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    for (std::size_t i = 0; i < cloud.capacity(); ++i) {
+        const Vector3d p(uniform(-8, 8), uniform(-3, 3), uniform(-5, 5));
+        const Vector3d n = i % 7 == 0 ? Vector3d::Zero() : Vector3d(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)).normalized();
+        const double a = uniform(0.1, 2.0);
+        cloud.positions_mm[i] = p, cloud.normals[i] = n, cloud.areas_mm2[i] = a;
+        points.push_back(p), normals.push_back(n), areas.push_back(a);
+    }
+    cloud.count = cloud.capacity();
+    int touching = 0;
+    for (int trial = 0; trial < 20; ++trial) {
+        PlacedShape tool{&blade, Vector3d(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)),
+                         Eigen::Quaterniond(Eigen::AngleAxisd(uniform(0, 3), Vector3d(uniform(-1, 1), 1, uniform(-1, 1)).normalized()))};
+        const ContactParameters parameters{0.5, 5.0};
+        const ContactResult list = penalty_contact(tool, parameters, points, areas, normals);
+        const ContactTotals totals = penalty_totals(tool, parameters, cloud);
+        touching += list.points.size() > 10;
+        EXPECT_LT((list.force_on_tool_n - totals.force_on_tool_n).norm(), 1e-12 * (1.0 + list.force_on_tool_n.norm()));
+        EXPECT_LT((list.torque_on_tool_n_mm - totals.torque_on_tool_n_mm).norm(), 1e-12 * (1.0 + list.torque_on_tool_n_mm.norm()));
+        EXPECT_NEAR(list.area_mm2, totals.area_mm2, 1e-12 * (1.0 + list.area_mm2));
+        EXPECT_NEAR(list.load_area_mm2, totals.load_area_mm2, 1e-12 * (1.0 + list.area_mm2));
+        EXPECT_NEAR(list.pressure_pa, totals.pressure_pa, 1e-9 * (1.0 + list.pressure_pa));
+        EXPECT_EQ(list.inner_reaches_surface(), totals.inner_reaches_surface);
+        Eigen::Matrix3d stiffness = Eigen::Matrix3d::Zero();
+        for (const PointContact& c : list.points) stiffness += c.stiffness_n_per_mm * c.normal * c.normal.transpose();
+        EXPECT_LT((stiffness - totals.stiffness_n_per_mm).norm(), 1e-12 * (1.0 + stiffness.norm()));
+    }
+    EXPECT_EQ(touching, 20); // every pose touches many points: the comparison is not vacuous
 }

@@ -596,6 +596,8 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     EXPECT_EQ(with_key("cut_mode", json::object()), "s.json: tools[1].cut_mode: expected a string, got {}");
     EXPECT_EQ(with_key("two_phase", 1), "s.json: tools[1].two_phase: expected true or false, got 1");
     EXPECT_EQ(with_key("two_phase", "yes"), "s.json: tools[1].two_phase: expected true or false, got \"yes\"");
+    // (A blade's default cut_mode is "remove".)
+    EXPECT_NE(with_key("two_phase", true).find("tools[1].two_phase: two-phase cutting marks a cut to open whole"), std::string::npos);
     // A misspelt key is still unknown, and the message lists the new keys among the known ones.
     EXPECT_EQ(with_key("cut_pressure", 1e4),
               "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
