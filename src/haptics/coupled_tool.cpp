@@ -1,5 +1,9 @@
 #include "haptics/coupled_tool.hpp"
 
+#include "contact/swept_contact.hpp"
+
+#include <algorithm>
+
 namespace vox::haptics {
 
 CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling)
@@ -22,8 +26,19 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false);
     const Eigen::Matrix3d a = kc * Eigen::Matrix3d::Identity() + m_contact.stiffness_n_per_mm;
     const Eigen::Vector3d residual = kc * (device.position_mm - m_proxy.position) + m_contact.force_on_tool_n;
-    const Eigen::Vector3d step = a.ldlt().solve(residual);
-    if (step.allFinite()) m_proxy.position += step;
+    Eigen::Vector3d step = a.ldlt().solve(residual);
+    // In contact, the linearised contact holds only over the penetration depths it was taken at:
+    // a step longer than the margin could carry a thin tool through the points holding it.
+    const double limit = std::max(m_parameters.margin_mm, 0.05);
+    if (m_contact.area_mm2 > 0.0 && step.norm() > limit) step *= limit / step.norm();
+    if (step.allFinite()) {
+        // Continuous collision: a step that would carry the tool past surface points it touches
+        // at neither end (a thin blade moving fast) stops where it first touches one.
+        contact::PlacedShape moved = m_proxy;
+        moved.position += step;
+        const double t = contact::first_missed_contact(m_proxy, moved, m_parameters.margin_mm, surface);
+        m_proxy.position += t * step;
+    }
     const double dt = dt_s > 0.0 ? dt_s : 1e-3;
     const Eigen::Vector3d relative_velocity =
         ((m_proxy.position - m_previous_proxy) - (device.position_mm - m_previous_device)) / dt; // mm/s

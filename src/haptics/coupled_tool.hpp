@@ -6,7 +6,10 @@
 // K the contact's stiffness, so stiff contact and a stiff coupling stay stable at 1 kHz (Colgate
 // et al.'s virtual coupling; the adaptive shape matching paper couples the same way). The user
 // feels the spring's force, k_c (x_proxy - x_device) plus damping, which the loop's safety stage
-// then clamps. Everything here runs in the 1 kHz loop: no allocation, lock, log or throw.
+// then clamps. A step that would carry the tool past points it touches at neither end stops at
+// the first such touch (contact/swept_contact.hpp), so a fast, thin tool cannot tunnel through
+// the surface between ticks. Everything here runs in the 1 kHz loop: no allocation, lock, log
+// or throw.
 
 #include "contact/penalty_contact.hpp"
 #include "haptics/device.hpp"

@@ -1,0 +1,51 @@
+#include "contact/swept_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vox::contact {
+
+double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm, const SurfacePoints& points) noexcept
+{
+    // The largest speed (mm per unit t) of any point of the pushing shape: translation plus
+    // rotation times the shape's radius about the tool origin.
+    const Eigen::AlignedBox3d local = from.shape->bounds(margin_mm);
+    double radius = 0.0;
+    for (int c = 0; c < 8; ++c) radius = std::max(radius, local.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)).norm());
+    const double angle = from.orientation.angularDistance(to.orientation);
+    const double speed = (to.position - from.position).norm() + angle * radius;
+    if (!(speed > 0.0)) return 1.0;
+    Eigen::AlignedBox3d swept = from.world_bounds(margin_mm);
+    swept.extend(to.world_bounds(margin_mm));
+    swept.extend(swept.min() - Eigen::Vector3d::Constant(angle * radius));
+    swept.extend(swept.max() + Eigen::Vector3d::Constant(angle * radius));
+    auto at = [&](double t) {
+        PlacedShape pose = from;
+        pose.position = (1.0 - t) * from.position + t * to.position;
+        pose.orientation = from.orientation.slerp(t, to.orientation);
+        return pose;
+    };
+    // A caught point ends `grip` inside the pushing shape, so that the penalty contact has it (with
+    // its stiffness) from the next step on; a point touched only at depth zero would not resist.
+    const double grip = 1e-3, tolerance = 1e-4; // mm
+    double first = 1.0;
+    for (std::size_t i = 0; i < points.count; ++i) {
+        const Eigen::Vector3d& p = points.positions_mm[i];
+        if (!swept.contains(p)) continue;
+        const double d0 = from.signed_distance(p) - margin_mm + grip, d1 = to.signed_distance(p) - margin_mm;
+        if (d0 <= 0.0 || d1 <= 0.0) continue;    // in the contact at a tick: the discrete contact has it
+        if (d0 + d1 + grip > speed) continue;    // too far to be reached in between
+        double t = d0 / speed;
+        for (int step = 0; step < 64 && t < first; ++step) {
+            const double d = at(t).signed_distance(p) - margin_mm + grip;
+            if (d <= tolerance) {
+                first = std::min(first, t);
+                break;
+            }
+            t += d / speed;
+        }
+    }
+    return first;
+}
+
+} // namespace vox::contact

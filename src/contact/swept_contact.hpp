@@ -1,0 +1,23 @@
+#pragma once
+// Continuous collision for the haptic proxy: between two ticks the tool moves from one pose to
+// the next, and a thin tool moving fast can pass a surface point without the point being inside
+// the pushing shape at either tick (a discrete test misses it: the tool tunnels through). The
+// first time such a point touches the pushing shape is found by conservative advancement on the
+// exact signed distance: the distance from a point to a shape changes no faster than the shape
+// moves, so stepping time by (distance - margin) / (largest speed of any point of the tool) never
+// steps over a contact.
+
+#include "contact/surface_points.hpp"
+#include "contact/tool_shape.hpp"
+
+namespace vox::contact {
+
+/// The earliest time t in [0, 1] at which a point of `points` that is not in the contact at
+/// either `from` or `to` comes 1 um inside the pushing shape (the tool grown by `margin_mm`) while
+/// the tool moves linearly from `from` to `to` (position linear, orientation slerped); 1 when
+/// there is none. Stopping there leaves the point in the penalty contact, which then holds the
+/// tool. Never allocates, locks or throws.
+[[nodiscard]] double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm,
+                                          const SurfacePoints& points) noexcept;
+
+} // namespace vox::contact
