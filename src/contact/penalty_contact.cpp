@@ -1,6 +1,37 @@
 #include "contact/penalty_contact.hpp"
 
 namespace vox::contact {
+namespace {
+
+/// One surface point against the pushing shape: its penalty force (N, on the point), its
+/// stiffness (N/mm per mm of depth) and depth; false when it is outside the pushing shape.
+struct PointPenalty {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< the direction the point is pushed
+    double stiffness = 0.0, depth = 0.0, distance = 0.0;
+};
+
+bool point_penalty(const PlacedShape& tool, const ContactParameters& parameters, const Eigen::AlignedBox3d& reach,
+                   const Eigen::Vector3d& p, double area, const Eigen::Vector3d& outward, PointPenalty& out) noexcept
+{
+    if (!reach.contains(p)) return false;
+    out.distance = tool.signed_distance(p, &out.normal);
+    out.depth = parameters.margin_mm - out.distance;
+    if (!(out.depth > 0.0)) return false;
+    if (outward.squaredNorm() > 0.0) out.normal = -outward; // along the object's normal (see the header)
+    out.stiffness = parameters.stiffness_n_per_mm / 100.0 * area; // per mm^2 of contact
+    out.force = out.stiffness * out.depth * out.normal;
+    return true;
+}
+
+/// Whether a point force carries the load: within 60 degrees of the net force on the object (all
+/// of them when the forces cancel, a squeeze with no net push).
+bool carries_load(const Eigen::Vector3d& force, const Eigen::Vector3d& net) noexcept
+{
+    return net.norm() <= 1e-12 || force.dot(net) >= 0.5 * force.norm() * net.norm();
+}
+
+} // namespace
 
 ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
                               std::span<const Eigen::Vector3d> points, std::span<const double> areas,
@@ -8,34 +39,26 @@ ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& 
 {
     ContactResult out;
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    const double per_mm3 = parameters.stiffness_n_per_mm / 100.0; // N per mm of depth per mm^2
+    PointPenalty pp;
     for (std::size_t i = 0; i < points.size(); ++i) {
-        if (!reach.contains(points[i])) continue;
-        Eigen::Vector3d normal;
-        const double distance = tool.signed_distance(points[i], &normal);
-        if (normals[i].squaredNorm() > 0.0) normal = -normals[i];
-        const double depth = parameters.margin_mm - distance;
-        if (!(depth > 0.0)) continue;
+        if (!point_penalty(tool, parameters, reach, points[i], areas[i], normals[i], pp)) continue;
         PointContact c;
         c.point = static_cast<std::uint32_t>(i);
-        c.depth_mm = depth;
-        c.normal = normal;
-        c.stiffness_n_per_mm = per_mm3 * areas[i];
-        c.force_n = c.stiffness_n_per_mm * depth * normal;
-        c.inside_inner = distance < 0.0;
+        c.depth_mm = pp.depth;
+        c.normal = pp.normal;
+        c.stiffness_n_per_mm = pp.stiffness;
+        c.force_n = pp.force;
+        c.inside_inner = pp.distance < 0.0;
         out.force_on_tool_n -= c.force_n;
         out.torque_on_tool_n_mm -= (points[i] - tool.position).cross(c.force_n);
         out.area_mm2 += areas[i];
         out.points.push_back(c);
     }
-    // The load-carrying part: forces within 60 degrees of the net force on the object (all of
-    // them when the forces cancel, a squeeze with no net push).
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     for (const PointContact& c : out.points) {
-        const double f = c.force_n.norm();
-        if (c.force_n.dot(net) < 0.5 * f * net.norm() && net.norm() > 1e-12) continue;
-        magnitude += f;
+        if (!carries_load(c.force_n, net)) continue;
+        magnitude += c.force_n.norm();
         out.load_area_mm2 += areas[c.point];
     }
     // N / mm^2 = 1e6 Pa.
@@ -48,36 +71,24 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
 {
     ContactTotals out;
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    const double per_mm3 = parameters.stiffness_n_per_mm / 100.0; // N per mm of depth per mm^2
+    PointPenalty pp;
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!reach.contains(p)) continue;
-        Eigen::Vector3d normal;
-        const double distance = tool.signed_distance(p, &normal);
-        const double depth = parameters.margin_mm - distance;
-        if (!(depth > 0.0)) continue;
-        if (points.normals[i].squaredNorm() > 0.0) normal = -points.normals[i];
-        const double k = per_mm3 * points.areas_mm2[i];
-        const Eigen::Vector3d f = k * depth * normal;
-        out.force_on_tool_n -= f;
-        out.torque_on_tool_n_mm -= (p - tool.position).cross(f);
-        out.stiffness_n_per_mm += k * normal * normal.transpose();
+        if (!point_penalty(tool, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp)) continue;
+        out.force_on_tool_n -= pp.force;
+        out.torque_on_tool_n_mm -= (p - tool.position).cross(pp.force);
+        out.stiffness_n_per_mm += pp.stiffness * pp.normal * pp.normal.transpose();
         out.area_mm2 += points.areas_mm2[i];
-        out.inner_reaches_surface = out.inner_reaches_surface || distance < 0.0;
+        out.inner_reaches_surface = out.inner_reaches_surface || pp.distance < 0.0;
     }
-    // A second pass for the load-carrying part (as penalty_contact): nothing is stored per point.
+    if (!with_pressure || out.area_mm2 == 0.0) return out;
+    // A second pass for the load-carrying part: nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
-    for (std::size_t i = 0; with_pressure && i < points.count && out.area_mm2 > 0.0; ++i) {
-        const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!reach.contains(p)) continue;
-        Eigen::Vector3d normal;
-        const double depth = parameters.margin_mm - tool.signed_distance(p, &normal);
-        if (!(depth > 0.0)) continue;
-        if (points.normals[i].squaredNorm() > 0.0) normal = -points.normals[i];
-        const Eigen::Vector3d f = per_mm3 * points.areas_mm2[i] * depth * normal;
-        if (f.dot(net) < 0.5 * f.norm() * net.norm() && net.norm() > 1e-12) continue;
-        magnitude += f.norm();
+    for (std::size_t i = 0; i < points.count; ++i) {
+        if (!point_penalty(tool, parameters, reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp)) continue;
+        if (!carries_load(pp.force, net)) continue;
+        magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
     }
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;

@@ -32,8 +32,11 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
         if (!swept.contains(p)) continue;
-        const double d0 = from.signed_distance(p) - margin_mm + grip, d1 = to.signed_distance(p) - margin_mm;
-        if (d0 <= 0.0 || d1 <= 0.0) continue;    // in the contact at a tick: the discrete contact has it
+        // The end pose's distance only for points the motion can reach at all (few, for a tick).
+        const double d0 = from.signed_distance(p) - margin_mm + grip;
+        if (d0 <= 0.0 || d0 > speed) continue;   // in the contact at the start, or out of reach
+        const double d1 = to.signed_distance(p) - margin_mm;
+        if (d1 <= 0.0) continue;                 // in the contact at the end: the discrete contact has it
         if (d0 + d1 + grip > speed) continue;    // too far to be reached in between
         double t = d0 / speed;
         for (int step = 0; step < 64 && t < first; ++step) {
