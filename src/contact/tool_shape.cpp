@@ -256,7 +256,7 @@ TriangleMesh ToolShape::mesh(double margin, int detail) const
     switch (m_kind) {
     case Kind::box:
     case Kind::scalpel: {
-        const std::vector<Eigen::Vector2d> poly = offset_polygon(m_profile, margin);
+        const std::vector<Eigen::Vector2d> poly = profile(margin);
         const int n = static_cast<int>(poly.size());
         const double hy = m_size.y() / 2 + margin;
         for (double y : {-hy, hy})
@@ -290,6 +290,12 @@ TriangleMesh ToolShape::mesh(double margin, int detail) const
     }
     }
     return m;
+}
+
+std::vector<Eigen::Vector2d> ToolShape::profile(double margin) const
+{
+    if (m_kind != Kind::box && m_kind != Kind::scalpel) return {};
+    return offset_polygon(m_profile, margin);
 }
 
 double PlacedShape::signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient) const

@@ -49,6 +49,10 @@ public:
     /// Bounds of the shape grown by `margin` (mm), tool frame.
     [[nodiscard]] Eigen::AlignedBox3d bounds(double margin = 0.0) const;
 
+    /// Box and scalpel: their x-z profile grown by `margin` (each edge moved out, corners not
+    /// rounded), counter-clockwise (x right, z up); empty for other shapes.
+    [[nodiscard]] std::vector<Eigen::Vector2d> profile(double margin = 0.0) const;
+
     /// A triangle mesh of the shape grown by `margin`, for pictures and continuous collision:
     /// boxes and scalpels keep their flat faces (each face moved out by the margin, corners not
     /// rounded), spheres are subdivided icosahedra (`detail` subdivisions) of radius + margin,

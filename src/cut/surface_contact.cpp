@@ -37,10 +37,31 @@ void vertices_in(const ModelSurface& surface, const std::vector<Eigen::Vector3d>
     }
 }
 
+/// Deformed vertex positions (world mm) computed once each: those already known are given up
+/// front, the neighbours' looked up as the triangles around them ask.
+class DeformedPositions {
+public:
+    DeformedPositions(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions)
+        : m_surface(surface), m_nodes(node_positions)
+    {
+    }
+    void add(std::uint32_t v, const Eigen::Vector3d& p) { m_known.emplace(v, p); }
+    const Eigen::Vector3d& operator()(std::uint32_t v)
+    {
+        const auto found = m_known.find(v);
+        if (found != m_known.end()) return found->second;
+        return m_known.emplace(v, m_surface.vertex_mm(v, m_nodes)).first->second;
+    }
+
+private:
+    const ModelSurface& m_surface;
+    const std::vector<Eigen::Vector3d>& m_nodes;
+    std::unordered_map<std::uint32_t, Eigen::Vector3d> m_known;
+};
+
 /// A third of the deformed area of the triangles around vertex slot `v`, and the area-weighted
 /// mean of their outward normals; `position` gives deformed vertex positions.
-template <class Position>
-void area_and_normal(const ModelSurface& surface, std::uint32_t v, Position&& position, double& area, Eigen::Vector3d& normal)
+void area_and_normal(const ModelSurface& surface, std::uint32_t v, DeformedPositions& position, double& area, Eigen::Vector3d& normal)
 {
     area = 0.0;
     normal.setZero();
@@ -71,13 +92,8 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         inside_mm.push_back(p);
     });
     if (inside.empty()) return out;
-    std::unordered_map<std::uint32_t, Eigen::Vector3d> known;
-    for (std::size_t i = 0; i < inside.size(); ++i) known.emplace(inside[i], inside_mm[i]);
-    auto position = [&](std::uint32_t v) {
-        const auto found = known.find(v);
-        if (found != known.end()) return found->second;
-        return known.emplace(v, surface.vertex_mm(v, node_positions)).first->second;
-    };
+    DeformedPositions position(surface, node_positions);
+    for (std::size_t i = 0; i < inside.size(); ++i) position.add(inside[i], inside_mm[i]);
     std::vector<double> areas(inside.size(), 0.0);
     std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
@@ -125,22 +141,17 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
     out.count = 0;
     out.truncated = false;
     std::vector<std::uint32_t> slots;
-    std::unordered_map<std::uint32_t, Eigen::Vector3d> known;
+    DeformedPositions position(surface, node_positions);
     vertices_in(surface, node_positions, box, [&](std::uint32_t v, const Eigen::Vector3d& p) {
         slots.push_back(v);
-        known.emplace(v, p);
+        position.add(v, p);
     });
-    auto position = [&](std::uint32_t v) {
-        const auto found = known.find(v);
-        if (found != known.end()) return found->second;
-        return known.emplace(v, surface.vertex_mm(v, node_positions)).first->second;
-    };
     for (std::uint32_t v : slots) {
         if (out.count == out.capacity()) {
             out.truncated = true;
             break;
         }
-        out.positions_mm[out.count] = known.at(v);
+        out.positions_mm[out.count] = position(v);
         area_and_normal(surface, v, position, out.areas_mm2[out.count], out.normals[out.count]);
         ++out.count;
     }

@@ -23,12 +23,9 @@ std::vector<Eigen::Vector3d> section(const contact::ToolShape& shape, double mar
         return out;
     }
     case contact::ToolShape::Kind::box:
-    case contact::ToolShape::Kind::scalpel: {
-        // The mesh's first ring is the profile at -y; keep x and z.
-        const contact::TriangleMesh m = shape.mesh(margin);
-        for (std::size_t i = 0; i < m.positions.size() / 2; ++i) out.emplace_back(m.positions[i].x(), 0.0, m.positions[i].z());
+    case contact::ToolShape::Kind::scalpel:
+        for (const Eigen::Vector2d& q : shape.profile(margin)) out.emplace_back(q.x(), 0.0, q.y());
         return out;
-    }
     case contact::ToolShape::Kind::mesh: {
         const Eigen::AlignedBox3d b = shape.bounds(margin);
         return {{b.min().x(), 0, b.min().z()}, {b.max().x(), 0, b.min().z()}, {b.max().x(), 0, b.max().z()}, {b.min().x(), 0, b.max().z()}};

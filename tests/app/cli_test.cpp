@@ -11,17 +11,9 @@
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
+using vox::test::info_json;
 using vox::test::quote;
 using vox::test::run_voxsculpt;
-
-namespace {
-nlohmann::json info_json(const fs::path& file)
-{
-    const auto r = run_voxsculpt("info --json " + quote(file.string()));
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return nlohmann::json::parse(r.out);
-}
-} // namespace
 
 TEST(Cli, LiverImportRoundTripKeepsCountsAndTransform)
 {

@@ -15,17 +15,12 @@
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
+using vox::test::info_json;
 using vox::test::quote;
 using vox::test::run_voxsculpt;
 
 namespace {
 
-nlohmann::json info_json(const fs::path& file)
-{
-    const auto r = run_voxsculpt("info --json " + quote(file.string()));
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return nlohmann::json::parse(r.out);
-}
 
 /// Runs a bundled scene (data/scenes/NAME.json) into `out` with extra options; returns stats.json.
 nlohmann::json run_bundled(const std::string& name, const fs::path& out, const std::string& options = "")

@@ -1,5 +1,6 @@
 #include "app/run_command.hpp"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <atomic>
@@ -41,6 +42,13 @@ CommandResult run_voxsculpt(const std::string& args)
     std::filesystem::remove(base.string() + ".out");
     std::filesystem::remove(base.string() + ".err");
     return r;
+}
+
+nlohmann::json info_json(const std::filesystem::path& file)
+{
+    const CommandResult r = run_voxsculpt("info --json " + quote(file.string()));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out);
 }
 
 } // namespace vox::test

@@ -1,6 +1,9 @@
 #pragma once
 // Runs the voxsculpt program the way a user does and captures what it printed.
 
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
 #include <string>
 
 namespace vox::test {
@@ -16,5 +19,8 @@ CommandResult run_voxsculpt(const std::string& args);
 
 /// Single-quotes `s` for the shell.
 std::string quote(const std::string& s);
+
+/// What `voxsculpt info --json FILE` reports (a failed run is a test failure).
+nlohmann::json info_json(const std::filesystem::path& file);
 
 } // namespace vox::test
