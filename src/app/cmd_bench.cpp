@@ -71,11 +71,10 @@ Solution solve_static(const nlohmann::json& document)
     out.cg_iterations = s.cg_iterations;
     const std::vector<Eigen::Vector3d> u = sim.surface().displacements(sim.solver().positions());
     const auto& vertices = sim.surface().embedded().vertices();
-    const Eigen::Matrix4d& t = g.voxels().index_to_world();
     for (std::size_t i = 0; i < vertices.size(); ++i) {
         if (vertices[i].users == 0) continue;
         out.displacement[vertices[i].key] = u[i] * 1e3;
-        out.rest[vertices[i].key] = t.topLeftCorner<3, 3>() * vertices[i].rest + t.topRightCorner<3, 1>();
+        out.rest[vertices[i].key] = g.voxels().world_mm(vertices[i].rest);
     }
     return out;
 }

@@ -178,15 +178,12 @@ void SceneSimulation::build(bool first, const fem::HexModel* previous, const gri
     }
     auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
         std::vector<unsigned char> kept(model.node_count(), 0);
-        const Eigen::Matrix4d& t = grid.voxels().index_to_world();
         const Eigen::Vector3d half = 0.5e3 * grid.voxels().voxel_size_m();
         for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
             bool touches = !superimposed[e];
             if (!touches)
                 for (std::uint32_t v : grid.level(level).elements[model.elements()[e].grid_element].voxels) {
-                    const grid::Coord c = grid.voxels().coord(v);
-                    const Eigen::Vector3d p = t.topLeftCorner<3, 3>() * Eigen::Vector3d(c.x(), c.y(), c.z()) + t.topRightCorner<3, 1>();
-                    if (in_box(p, lo - half, hi + half)) {
+                    if (in_box(grid.voxels().world_mm(grid.voxels().coord(v).cast<double>()), lo - half, hi + half)) {
                         touches = true;
                         break;
                     }

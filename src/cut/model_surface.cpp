@@ -5,11 +5,6 @@
 namespace vox::cut {
 namespace {
 
-Eigen::Vector3d to_world_mm(const Eigen::Matrix4d& t, const Eigen::Vector3d& index)
-{
-    return t.topLeftCorner<3, 3>() * index + t.topRightCorner<3, 1>();
-}
-
 /// CSR grouping of `item_count` items by key (keys < key_count; no_index skipped).
 void group(const std::vector<std::uint32_t>& key_of_item, std::size_t key_count, std::vector<std::uint32_t>& start,
            std::vector<std::uint32_t>& items)
@@ -34,14 +29,13 @@ ModelSurface::ModelSurface(const grid::BranchedGrid& grid, const fem::HexModel& 
     m_model_element.assign(level == 0 ? grid.voxels().slots() : grid.level(level).elements.size(), grid::no_index);
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) m_model_element[model.elements()[e].grid_element] = e;
     const auto& vertices = surface.vertices();
-    const Eigen::Matrix4d& t = grid.voxels().index_to_world();
     m_element.assign(vertices.size(), grid::no_index);
     m_local.assign(vertices.size(), Eigen::Vector3d::Zero());
     m_rest_mm.assign(vertices.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < vertices.size(); ++i) {
         const surface::SurfaceVertex& v = vertices[i];
         if (v.users == 0) continue;
-        m_rest_mm[i] = to_world_mm(t, v.rest);
+        m_rest_mm[i] = grid.voxels().world_mm(v.rest);
         if (level == 0) {
             m_element[i] = m_model_element[v.voxel];
             m_local[i] = v.rest - grid::BranchedGrid::cell_corner_index(grid.voxels().coord(v.voxel), 0, 0);
@@ -98,7 +92,7 @@ std::uint32_t ModelSurface::voxel_element(std::uint32_t v, Eigen::Vector3d& loca
 Eigen::Vector3d ModelSurface::voxel_rest_mm(std::uint32_t v) const
 {
     const grid::Coord ijk = m_grid.voxels().coord(v);
-    return to_world_mm(m_grid.voxels().index_to_world(), Eigen::Vector3d(ijk.x(), ijk.y(), ijk.z()));
+    return m_grid.voxels().world_mm(ijk.cast<double>());
 }
 
 Eigen::Vector3d ModelSurface::voxel_centre_mm(std::uint32_t v, const std::vector<Eigen::Vector3d>& node_positions) const

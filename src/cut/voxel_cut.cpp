@@ -161,7 +161,7 @@ std::vector<std::pair<grid::Coord, int>> faces_crossed(const grid::FineVoxels& v
     const grid::Coord first = (index_box.min().array() - 1.0).floor().cast<int>();
     const grid::Coord last = (index_box.max().array() + 1.0).ceil().cast<int>();
     auto rest = [&](const grid::Coord& c) {
-        return Eigen::Vector3d(to_world.topLeftCorner<3, 3>() * c.cast<double>() + to_world.topRightCorner<3, 1>());
+        return voxels.world_mm(c.cast<double>());
     };
     // Each triangle's oriented plane, computed as segment_crosses does: a pair on one side of it
     // (most pairs, for most triangles) is passed over without the full test.

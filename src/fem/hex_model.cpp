@@ -76,7 +76,6 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
     std::vector<Matrix8d> mass;
     for (const grid::VoxelMaterial& m : grid.materials()) mass.push_back(grid::hex8_mass(h, m.density_kg_m3));
     const Eigen::Matrix<double, 8, 3> gradient = corner_gradients(Eigen::Vector3d::Constant(0.5), h);
-    const Eigen::Matrix4d& t = v.index_to_world();
 
     std::vector<std::uint32_t> dense(8 * std::size_t{v.slots()}, grid::no_index);
     for (std::uint32_t a = 0; a < v.slots(); ++a) {
@@ -90,14 +89,14 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
         el.material = v.material(a);
         el.volume_m3 = h.prod();
         const Eigen::Vector3d centre = v.coord(a).cast<double>();
-        el.centroid = (t.topLeftCorner<3, 3>() * centre + t.topRightCorner<3, 1>()) * 1e-3;
+        el.centroid = v.world_mm(centre) * 1e-3;
         for (int c = 0; c < 8; ++c) {
             const Eigen::Vector3d corner = grid::BranchedGrid::cell_corner_index(v.coord(a), 0, c);
             el.rest.segment<3>(3 * c) = corner.cwiseProduct(h);
             std::uint32_t& id = dense[sets.find(8 * a + static_cast<std::uint32_t>(c))];
             if (id == grid::no_index) {
                 id = static_cast<std::uint32_t>(m_rest_world.size());
-                m_rest_world.push_back((t.topLeftCorner<3, 3>() * corner + t.topRightCorner<3, 1>()) * 1e-3);
+                m_rest_world.push_back(v.world_mm(corner) * 1e-3);
                 m_nodal_mass.push_back(0.0);
             }
             el.dof_node[c] = id;
@@ -122,7 +121,6 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     const grid::Level& lv = grid.level(level);
     const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
     const double cell = static_cast<double>(1 << level);
-    const Eigen::Matrix4d& index_to_world = grid.voxels().index_to_world();
 
     // Dense numbering of the nodes the alive elements use.
     m_dense_node.assign(lv.node_users.size(), grid::no_index);
@@ -194,7 +192,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
         el.gradient = corner_gradients(local, cell * h);
         el.volume_m3 = voxels * h.prod();
         const Eigen::Vector3d centre = grid::BranchedGrid::cell_corner_index(g.cell, level, 0) + cell * local;
-        el.centroid = (index_to_world.topLeftCorner<3, 3>() * centre + index_to_world.topRightCorner<3, 1>()) * 1e-3;
+        el.centroid = grid.voxels().world_mm(centre) * 1e-3;
         m_elements.push_back(el);
     }
 }

@@ -501,11 +501,10 @@ std::vector<Eigen::Vector3d> BranchedGrid::rest_node_positions(int l) const
 {
     const Level& lv = level(l);
     std::vector<Eigen::Vector3d> out(lv.node_users.size(), Eigen::Vector3d::Constant(std::nan("")));
-    const Eigen::Matrix4d& t = m_voxels.index_to_world();
     for (const Element& e : lv.elements) {
         if (!e.alive) continue;
         for (int c = 0; c < 8; ++c)
-            out[e.nodes[c]] = t.topLeftCorner<3, 3>() * cell_corner_index(e.cell, l, c) + t.topRightCorner<3, 1>();
+            out[e.nodes[c]] = m_voxels.world_mm(cell_corner_index(e.cell, l, c));
     }
     return out;
 }

@@ -51,6 +51,11 @@ public:
     /// (up to 6) keep their boundaries when indices are taken relative to it.
     [[nodiscard]] const Coord& origin() const { return m_origin; }
     [[nodiscard]] const Eigen::Matrix4d& index_to_world() const { return m_index_to_world; }
+    /// A point of the source index space (a voxel's centre is its integer coordinate) in world mm.
+    [[nodiscard]] Eigen::Vector3d world_mm(const Eigen::Vector3d& index) const
+    {
+        return m_index_to_world.topLeftCorner<3, 3>() * index + m_index_to_world.topRightCorner<3, 1>();
+    }
     /// Fine voxel edges in metres (the grid's mechanics are SI).
     [[nodiscard]] const Eigen::Vector3d& voxel_size_m() const { return m_voxel_size_m; }
 

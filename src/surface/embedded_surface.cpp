@@ -277,9 +277,8 @@ void EmbeddedSurface::deform(const grid::BranchedGrid& grid, std::span<const Eig
 SurfaceMesh EmbeddedSurface::mesh(const grid::BranchedGrid& grid) const
 {
     std::vector<Eigen::Vector3d> world(m_vertices.size());
-    const Eigen::Matrix4d& t = grid.voxels().index_to_world();
     for (std::size_t i = 0; i < m_vertices.size(); ++i)
-        if (m_vertices[i].users) world[i] = t.topLeftCorner<3, 3>() * m_vertices[i].rest + t.topRightCorner<3, 1>();
+        if (m_vertices[i].users) world[i] = grid.voxels().world_mm(m_vertices[i].rest);
     SurfaceMesh out;
     std::vector<std::uint32_t> compact(m_vertices.size(), grid::no_index);
     for (std::size_t i = 0; i < m_vertices.size(); ++i)
