@@ -52,7 +52,7 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolSession& tools, const Dev
     haptics::SafetySettings safety;
     if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
     m_coupled = std::make_unique<haptics::CoupledTool>(tools.shape(m_tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
-                                                       coupling);
+                                                       coupling, m_snapshot.capacity());
     m_loop = std::make_unique<haptics::HapticLoop>(
         *m_device,
         [this](const haptics::DeviceState& state, double& age) {

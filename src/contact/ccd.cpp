@@ -2,7 +2,7 @@
 
 #include "contact/interval.hpp"
 
-#include <functional>
+#include <limits>
 
 namespace vox::contact {
 namespace {
@@ -33,15 +33,18 @@ IVec3 at(const Motion& m, int i, const Interval& t)
     return s + t * (m.end[static_cast<std::size_t>(i)] - s);
 }
 
-/// True when no contact is possible anywhere in the time interval t.
-using Excluder = std::function<bool(const Interval& t)>;
-
-bool search(const Excluder& excluded, double lo, double hi, int depth, int max_depth)
+/// The earliest time in [lo, hi] that `excluded` (true when no contact is possible anywhere in
+/// the time interval it is given) cannot rule out: the start of the first interval that survives
+/// max_depth halvings, taking earlier halves first; infinity when every interval is ruled out. A
+/// template, not a std::function, so that the haptic loop's calls never allocate.
+template <class Excluded>
+double first_surviving(const Excluded& excluded, double lo, double hi, int depth, int max_depth)
 {
-    if (excluded(Interval(lo, hi))) return false;
-    if (depth == max_depth) return true;
+    if (excluded(Interval(lo, hi))) return std::numeric_limits<double>::infinity();
+    if (depth == max_depth) return lo;
     const double mid = 0.5 * (lo + hi);
-    return search(excluded, lo, mid, depth + 1, max_depth) || search(excluded, mid, hi, depth + 1, max_depth);
+    const double early = first_surviving(excluded, lo, mid, depth + 1, max_depth);
+    return early <= mid ? early : first_surviving(excluded, mid, hi, depth + 1, max_depth);
 }
 
 /// The boxes of the two groups of points (indices [0, split) and [split, 4)) over t do not meet.
@@ -80,13 +83,13 @@ bool never_coplanar(const IVec3& q0, const IVec3& q1, const IVec3& b0, const IVe
 
 } // namespace
 
-bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options) noexcept
 {
     const Motion m = motion(at0, at1, options.input_ulps);
     if (never_coplanar(m.start[0] - m.start[1], m.end[0] - m.end[1], m.start[2] - m.start[1], m.end[2] - m.end[1],
                        m.start[3] - m.start[1], m.end[3] - m.end[1]))
-        return false;
-    const Excluder excluded = [&m](const Interval& t) {
+        return std::numeric_limits<double>::infinity();
+    const auto excluded = [&m](const Interval& t) {
         const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
         if (boxes_apart(p, 1)) return true;
         const IVec3 b = p[2] - p[1], c = p[3] - p[1], q = p[0] - p[1];
@@ -97,17 +100,17 @@ bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array
         if (dot(cross(q, c), n).below_zero()) return true;
         return dot(cross(c - b, q - b), n).below_zero();
     };
-    return search(excluded, 0.0, 1.0, 0, options.max_depth);
+    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth);
 }
 
-bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options) noexcept
 {
     const Motion m = motion(at0, at1, options.input_ulps);
     // Coplanarity of d = b0 - a0 with ea and eb: the same cubic filter.
     if (never_coplanar(m.start[2] - m.start[0], m.end[2] - m.end[0], m.start[1] - m.start[0], m.end[1] - m.end[0],
                        m.start[3] - m.start[2], m.end[3] - m.end[2]))
-        return false;
-    const Excluder excluded = [&m](const Interval& t) {
+        return std::numeric_limits<double>::infinity();
+    const auto excluded = [&m](const Interval& t) {
         const std::array<IVec3, 4> p{at(m, 0, t), at(m, 1, t), at(m, 2, t), at(m, 3, t)};
         if (boxes_apart(p, 2)) return true;
         const IVec3 ea = p[1] - p[0], eb = p[3] - p[2], d = p[2] - p[0];
@@ -119,7 +122,17 @@ bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<E
         const Interval s = dot(cross(d, eb), n), u = dot(cross(d, ea), n);
         return s.below_zero() || (nn - s).below_zero() || u.below_zero() || (nn - u).below_zero();
     };
-    return search(excluded, 0.0, 1.0, 0, options.max_depth);
+    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth);
+}
+
+bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+{
+    return vertex_face_toi(at0, at1, options) <= 1.0;
+}
+
+bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)
+{
+    return edge_edge_toi(at0, at1, options) <= 1.0;
 }
 
 } // namespace vox::contact

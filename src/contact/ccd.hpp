@@ -30,4 +30,12 @@ struct CcdOptions {
 [[nodiscard]] bool edge_edge_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
                                  const CcdOptions& options = {});
 
+/// The time of first possible contact in [0, 1] of the same queries: a lower bound on the true
+/// one (never later; at most 2^-max_depth earlier when the contact is real), infinity when the
+/// query has none. Never allocates or throws (the haptic loop calls them).
+[[nodiscard]] double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
+                                     const CcdOptions& options = {}) noexcept;
+[[nodiscard]] double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
+                                   const CcdOptions& options = {}) noexcept;
+
 } // namespace vox::contact

@@ -8,26 +8,28 @@
 
 namespace vox::contact {
 
-void swept_box(const MovingMesh& mesh, std::size_t triangle, Eigen::Vector3d& lo, Eigen::Vector3d& hi)
+void swept_box(std::span<const Eigen::Vector3d> start, std::span<const Eigen::Vector3d> end, const Eigen::Vector3i& triangle,
+               Eigen::Vector3d& lo, Eigen::Vector3d& hi) noexcept
 {
     lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     hi = -lo;
-    for (int c = 0; c < 3; ++c)
-        for (const auto* positions : {&mesh.start, &mesh.end}) {
-            const Eigen::Vector3d& p = (*positions)[static_cast<std::size_t>(mesh.triangles[triangle][c])];
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-        }
+    for (int c = 0; c < 3; ++c) {
+        const auto v = static_cast<std::size_t>(triangle[c]);
+        lo = lo.cwiseMin(start[v]).cwiseMin(end[v]);
+        hi = hi.cwiseMax(start[v]).cwiseMax(end[v]);
+    }
 }
 
-SweptBvh::SweptBvh(const MovingMesh& mesh)
+void SweptBvh::rebuild(std::span<const Eigen::Vector3d> start, std::span<const Eigen::Vector3d> end,
+                       std::span<const Eigen::Vector3i> triangles)
 {
-    const std::size_t n = mesh.triangles.size();
+    const std::size_t n = triangles.size();
     m_triangle_lo.resize(n);
     m_triangle_hi.resize(n);
-    for (std::size_t t = 0; t < n; ++t) swept_box(mesh, t, m_triangle_lo[t], m_triangle_hi[t]);
+    for (std::size_t t = 0; t < n; ++t) swept_box(start, end, triangles[t], m_triangle_lo[t], m_triangle_hi[t]);
     m_order.resize(n);
     for (std::uint32_t t = 0; t < n; ++t) m_order[t] = t;
+    m_nodes.clear();
     if (n) {
         m_nodes.reserve(2 * n);
         build(0, static_cast<std::uint32_t>(n));
@@ -83,7 +85,7 @@ std::vector<MeshContact> mesh_ccd(const MovingMesh& a, const MovingMesh& b, cons
     for (std::uint32_t ta = 0; ta < a.triangles.size(); ++ta) {
         const Eigen::Vector3i& fa = a.triangles[ta];
         Eigen::Vector3d lo, hi;
-        swept_box(a, ta, lo, hi);
+        swept_box(a.start, a.end, fa, lo, hi);
         tree.query(lo, hi, [&](std::uint32_t tb) {
             const Eigen::Vector3i& fb = b.triangles[tb];
             for (int i = 0; i < 3; ++i) {

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace vox::contact {
@@ -19,12 +20,17 @@ struct MovingMesh {
 };
 
 /// The box a triangle sweeps over the step (its corners at t = 0 and t = 1).
-void swept_box(const MovingMesh& mesh, std::size_t triangle, Eigen::Vector3d& lo, Eigen::Vector3d& hi);
+void swept_box(std::span<const Eigen::Vector3d> start, std::span<const Eigen::Vector3d> end, const Eigen::Vector3i& triangle,
+               Eigen::Vector3d& lo, Eigen::Vector3d& hi) noexcept;
 
 /// A box tree over a mesh's swept triangles (median split on the longest axis, leaves of up to 4).
 class SweptBvh {
 public:
-    explicit SweptBvh(const MovingMesh& mesh);
+    SweptBvh() = default;
+    explicit SweptBvh(const MovingMesh& mesh) { rebuild(mesh.start, mesh.end, mesh.triangles); }
+    /// Rebuilds the tree over `triangles` with corners at `start` and `end` (the same span for a
+    /// mesh that does not move), reusing the storage it already has.
+    void rebuild(std::span<const Eigen::Vector3d> start, std::span<const Eigen::Vector3d> end, std::span<const Eigen::Vector3i> triangles);
     /// Calls visit(triangle) for every triangle whose swept box overlaps [lo, hi].
     template <class F> void query(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, F&& visit) const;
 

@@ -1,7 +1,10 @@
 #pragma once
-// Points of the object's surface with their area and outward normal, world mm: what the haptic
-// thread touches. The simulation thread fills one (the surface near the tool) and publishes it;
-// the vectors are sized once, up front, so the haptic thread never allocates.
+// Points of the object's surface with their area and outward normal, world mm, and the triangles
+// between them: what the haptic thread touches. The simulation thread fills one (the surface near
+// the tool, with a box tree over its triangles) and publishes it; the haptic thread only reads it,
+// so it never allocates.
+
+#include "contact/mesh_ccd.hpp"
 
 #include <Eigen/Core>
 
@@ -17,10 +20,15 @@ struct SurfacePoints {
     std::vector<Eigen::Vector3d> normals;     ///< outward, unit
     std::vector<double> areas_mm2;
     bool truncated = false;                   ///< more points were near than the capacity holds
+    /// Surface triangles whose three corners are among the points (indices into them), and a box
+    /// tree over them (a static mesh: start = end) for the continuous tool-mesh check.
+    std::vector<Eigen::Vector3i> triangles;
+    SweptBvh triangle_tree;
 
     explicit SurfacePoints(std::size_t capacity = 0)
         : positions_mm(capacity), normals(capacity), areas_mm2(capacity)
     {
+        triangles.reserve(2 * capacity);
     }
     [[nodiscard]] std::size_t capacity() const { return positions_mm.size(); }
 };

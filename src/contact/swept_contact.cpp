@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace vox::contact {
 
-double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm, const SurfacePoints& points) noexcept
+double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm, const SurfacePoints& points,
+                            std::span<double> clearance) noexcept
 {
+    constexpr double far = std::numeric_limits<double>::infinity();
+    const bool keep = clearance.size() >= points.count;
+    if (keep) std::fill_n(clearance.begin(), points.count, far);
     // The largest speed (mm per unit t) of any point of the pushing shape: translation plus
     // rotation times the shape's radius about the tool origin.
     const Eigen::AlignedBox3d local = from.shape->bounds(margin_mm);
@@ -14,7 +19,7 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
     for (int c = 0; c < 8; ++c) radius = std::max(radius, local.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)).norm());
     const double angle = from.orientation.angularDistance(to.orientation);
     const double speed = (to.position - from.position).norm() + angle * radius;
-    if (!(speed > 0.0)) return 1.0;
+    if (!(speed > 0.0)) return 1.0; // nothing moves: nothing is reached
     Eigen::AlignedBox3d swept = from.world_bounds(margin_mm);
     swept.extend(to.world_bounds(margin_mm));
     swept.extend(swept.min() - Eigen::Vector3d::Constant(angle * radius));
@@ -34,9 +39,13 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
         if (!swept.contains(p)) continue;
         // The end pose's distance only for points the motion can reach at all (few, for a tick).
         const double d0 = from.signed_distance(p) - margin_mm + grip;
+        if (keep) clearance[i] = d0 - grip <= 0.0 ? -far : d0 - grip;
         if (d0 <= 0.0 || d0 > speed) continue;   // in the contact at the start, or out of reach
         const double d1 = to.signed_distance(p) - margin_mm;
-        if (d1 <= 0.0) continue;                 // in the contact at the end: the discrete contact has it
+        if (d1 <= 0.0) {                         // in the contact at the end: the discrete contact has it
+            if (keep) clearance[i] = -far;
+            continue;
+        }
         if (d0 + d1 + grip > speed) continue;    // too far to be reached in between
         double t = d0 / speed;
         for (int step = 0; step < 64 && t < first; ++step) {

@@ -10,6 +10,8 @@
 #include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
 
+#include <span>
+
 namespace vox::contact {
 
 /// The earliest time t in [0, 1] at which a point of `points` that is not in the contact at
@@ -17,7 +19,11 @@ namespace vox::contact {
 /// the tool moves linearly from `from` to `to` (position linear, orientation slerped); 1 when
 /// there is none. Stopping there leaves the point in the penalty contact, which then holds the
 /// tool. Never allocates, locks or throws.
+/// `clearance`, when given (at least points.count long), receives for each point its distance
+/// outside the pushing shape at `from`, mm, or -infinity when the point is in the contact at
+/// either end; points outside the box the move sweeps (in the contact at neither end) are left at
+/// +infinity, unmeasured.
 [[nodiscard]] double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm,
-                                          const SurfacePoints& points) noexcept;
+                                          const SurfacePoints& points, std::span<double> clearance = {}) noexcept;
 
 } // namespace vox::contact

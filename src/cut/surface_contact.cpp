@@ -146,15 +146,33 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
         slots.push_back(v);
         position.add(v, p);
     });
+    std::unordered_map<std::uint32_t, int> point_of; // vertex slot -> point index
     for (std::uint32_t v : slots) {
         if (out.count == out.capacity()) {
             out.truncated = true;
             break;
         }
+        point_of.emplace(v, static_cast<int>(out.count));
         out.positions_mm[out.count] = position(v);
         area_and_normal(surface, v, position, out.areas_mm2[out.count], out.normals[out.count]);
         ++out.count;
     }
+    // The triangles among the points, each once (from its lowest-numbered corner), and their tree.
+    out.triangles.clear();
+    const auto& triangles = surface.embedded().triangles();
+    for (const auto& [v, point] : point_of)
+        for (std::uint32_t t : surface.vertex_triangles(v)) {
+            Eigen::Vector3i corners;
+            bool all = true;
+            for (int c = 0; c < 3 && all; ++c) {
+                const auto found = point_of.find(triangles[t][static_cast<std::size_t>(c)]);
+                all = found != point_of.end();
+                if (all) corners[c] = found->second;
+            }
+            if (all && corners.minCoeff() == point) out.triangles.push_back(corners);
+        }
+    const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
+    out.triangle_tree.rebuild(positions, positions, out.triangles);
 }
 
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b)

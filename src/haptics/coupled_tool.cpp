@@ -1,13 +1,12 @@
 #include "haptics/coupled_tool.hpp"
 
-#include "contact/swept_contact.hpp"
-
 #include <algorithm>
 
 namespace vox::haptics {
 
-CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling)
-    : m_parameters(contact), m_coupling(coupling)
+CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling,
+                         std::size_t snapshot_capacity)
+    : m_parameters(contact), m_coupling(coupling), m_sweep(shape, contact.margin_mm, snapshot_capacity)
 {
     m_proxy.shape = &shape;
 }
@@ -33,10 +32,11 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     if (m_contact.area_mm2 > 0.0 && step.norm() > limit) step *= limit / step.norm();
     if (step.allFinite()) {
         // Continuous collision: a step that would carry the tool past surface points it touches
-        // at neither end (a thin blade moving fast) stops where it first touches one.
+        // at neither end, or through a face or across an edge between them (a thin blade moving
+        // fast), stops where it first touches.
         contact::PlacedShape moved = m_proxy;
         moved.position += step;
-        const double t = contact::first_missed_contact(m_proxy, moved, m_parameters.margin_mm, surface);
+        const double t = m_sweep.first_stop(m_proxy, moved, surface);
         m_proxy.position += t * step;
     }
     const double dt = dt_s > 0.0 ? dt_s : 1e-3;

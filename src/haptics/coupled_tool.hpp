@@ -7,11 +7,13 @@
 // et al.'s virtual coupling; the adaptive shape matching paper couples the same way). The user
 // feels the spring's force, k_c (x_proxy - x_device) plus damping, which the loop's safety stage
 // then clamps. A step that would carry the tool past points it touches at neither end stops at
-// the first such touch (contact/swept_contact.hpp), so a fast, thin tool cannot tunnel through
-// the surface between ticks. Everything here runs in the 1 kHz loop: no allocation, lock, log
+// the first such touch, and the tool's triangle mesh is swept against the snapshot's triangles
+// for features thinner than the gaps between surface points (contact/tool_sweep.hpp), so a fast,
+// thin tool cannot tunnel through the surface between ticks. Everything here runs in the 1 kHz loop: no allocation, lock, log
 // or throw.
 
 #include "contact/penalty_contact.hpp"
+#include "contact/tool_sweep.hpp"
 #include "haptics/device.hpp"
 
 namespace vox::haptics {
@@ -23,7 +25,9 @@ struct CouplingSettings {
 
 class CoupledTool {
 public:
-    CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling);
+    /// `snapshot_capacity`: the capacity() of the surface snapshots update() will be given.
+    CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling,
+                std::size_t snapshot_capacity);
 
     /// One tick of `dt_s`: moves the proxy for the device's new state against `surface` and
     /// returns the force for the device, N. The first call puts the proxy at the device.
@@ -31,6 +35,8 @@ public:
 
     /// The proxy: where the tool is in the simulation.
     [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
+    /// The continuous check of the last update (whether it swept the tool's mesh, and stopped on it).
+    [[nodiscard]] const contact::ToolSweep& sweep() const { return m_sweep; }
     /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
     [[nodiscard]] const contact::ContactTotals& contact() const { return m_contact; }
 
@@ -39,6 +45,7 @@ private:
     CouplingSettings m_coupling;
     contact::PlacedShape m_proxy;
     contact::ContactTotals m_contact;
+    contact::ToolSweep m_sweep;
     Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_proxy = Eigen::Vector3d::Zero();
     bool m_started = false;
 };

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 using namespace vox::contact;
 using Eigen::Vector3d;
@@ -67,6 +68,24 @@ TEST(Ccd, EdgesCrossingOrApart)
     const Points par0{Vector3d(0, 0, 1), Vector3d(1, 0, 1), Vector3d(0, 1, 0), Vector3d(1, 1, 0)};
     const Points par1{Vector3d(0, 0, 0.5), Vector3d(1, 0, 0.5), Vector3d(0, 1, 0), Vector3d(1, 1, 0)};
     EXPECT_FALSE(edge_edge_ccd(par0, par1));
+}
+
+TEST(Ccd, TimeOfImpactIsALowerBoundWithinTheResolution)
+{
+    // The vertex falls from z = 1 to z = -3: it meets the face at t = 1/4.
+    const double vf = vertex_face_toi(triangle_at0, moved(triangle_at0, {0.2, 0.2, -3.0}));
+    EXPECT_LE(vf, 0.25);
+    EXPECT_GT(vf, 0.25 - 1e-6);
+    // Edge (0,0,1)-(1,0,1) dropping to z = -1 meets edge (0.5,-1,0)-(0.5,1,0) at t = 1/2.
+    const Points e0{Vector3d(0, 0, 1), Vector3d(1, 0, 1), Vector3d(0.5, -1, 0), Vector3d(0.5, 1, 0)};
+    const Points e1{Vector3d(0, 0, -1), Vector3d(1, 0, -1), Vector3d(0.5, -1, 0), Vector3d(0.5, 1, 0)};
+    const double ee = edge_edge_toi(e0, e1);
+    EXPECT_LE(ee, 0.5);
+    EXPECT_GT(ee, 0.5 - 1e-6);
+    // No contact: infinity, and the yes/no tests agree.
+    EXPECT_EQ(vertex_face_toi(moved(triangle_at0, {0.8, 0.8, 1.0}), moved(triangle_at0, {0.8, 0.8, -1.0})),
+              std::numeric_limits<double>::infinity());
+    EXPECT_TRUE(vertex_face_ccd(triangle_at0, moved(triangle_at0, {0.2, 0.2, -3.0})));
 }
 
 TEST(Ccd, BenchmarkQueriesHaveNoFalseNegatives)

@@ -39,7 +39,7 @@ haptics::DeviceState at(double z)
 TEST(CoupledTool, InFreeSpaceTheProxyIsTheDeviceAndNothingIsFelt)
 {
     const contact::ToolShape ball = contact::ToolShape::sphere(2.0);
-    haptics::CoupledTool tool(ball, {0.5, 5.0}, {0.5, 0.0});
+    haptics::CoupledTool tool(ball, {0.5, 5.0}, {0.5, 0.0}, 41 * 41);
     const contact::SurfacePoints nothing(16);
     for (int k = 0; k < 10; ++k) {
         const Eigen::Vector3d f = tool.update(at(10.0 - k), nothing, 1e-3);
@@ -54,7 +54,7 @@ TEST(CoupledTool, AgainstAWallTheProxyStopsWhereSpringAndContactBalance)
     // stops where the spring kc (proxy - device) balances the contact, and the force felt is both.
     const contact::ToolShape punch = contact::ToolShape::box({10, 10, 4});
     const double kc = 0.5, k = 5.0;
-    haptics::CoupledTool tool(punch, {0.5, k}, {kc, 0.0});
+    haptics::CoupledTool tool(punch, {0.5, k}, {kc, 0.0}, 41 * 41);
     const contact::SurfacePoints surface = wall();
     tool.update(at(2.0 + 0.5), surface, 1e-3); // the face touching the wall's margin
     Eigen::Vector3d f;
@@ -79,7 +79,7 @@ TEST(CoupledTool, AStiffContactStaysStable)
     // Contact 100 times stiffer than the coupling: the implicit proxy update neither overshoots
     // nor oscillates when the device jumps into the wall.
     const contact::ToolShape ball = contact::ToolShape::sphere(3.0);
-    haptics::CoupledTool tool(ball, {0.5, 500.0}, {0.5, 0.0});
+    haptics::CoupledTool tool(ball, {0.5, 500.0}, {0.5, 0.0}, 41 * 41);
     const contact::SurfacePoints surface = wall();
     tool.update(at(5.0), surface, 1e-3);
     // The proxy stops where the ball first touches, then settles tick by tick; the force never
@@ -105,7 +105,7 @@ TEST(CoupledTool, AFastThinToolDoesNotTunnelThroughTheSurface)
     // discrete test sees nothing; the proxy must stop at the wall, and a contact stiff enough to
     // carry the spring's pull (a row of 11 points under the edge) keeps it there.
     const contact::ToolShape blade = contact::ToolShape::box({10, 0.5, 0.5});
-    haptics::CoupledTool tool(blade, {0.25, 500.0}, {0.5, 0.0});
+    haptics::CoupledTool tool(blade, {0.25, 500.0}, {0.5, 0.0}, 41 * 41);
     const contact::SurfacePoints surface = wall();
     tool.update(at(3.0), surface, 1e-3);
     tool.update(at(-5.0), surface, 1e-3);
@@ -116,4 +116,30 @@ TEST(CoupledTool, AFastThinToolDoesNotTunnelThroughTheSurface)
     for (int tick = 0; tick < 50; ++tick) f = tool.update(at(-5.0), surface, 1e-3);
     EXPECT_GT(tool.proxy().position.z(), 0.25); // the blade itself stays above the wall
     EXPECT_GT(f.z(), 2.0);                       // the hand, 5.4 mm below, is pushed back up
+}
+
+TEST(CoupledTool, ANeedleIsHeldAtAFaceBetweenDistantPoints)
+{
+    // Two triangles 20 mm across, sampled only at their corners: a 0.2 mm needle jerked through
+    // the middle touches no point, ever. The mesh sweep stops it at the face; the hand, 2 mm
+    // below, feels the coupling spring (0.5 N/mm x 2.2 mm) pushing it back up.
+    contact::SurfacePoints square(4);
+    for (const Eigen::Vector3d& c : {Eigen::Vector3d(-10, -10, 0), Eigen::Vector3d(10, -10, 0), Eigen::Vector3d(10, 10, 0), Eigen::Vector3d(-10, 10, 0)}) {
+        square.positions_mm[square.count] = c;
+        square.normals[square.count] = Eigen::Vector3d::UnitZ();
+        square.areas_mm2[square.count++] = 100.0;
+    }
+    square.triangles = {{0, 1, 2}, {0, 2, 3}};
+    const std::span<const Eigen::Vector3d> corners(square.positions_mm.data(), square.count);
+    square.triangle_tree.rebuild(corners, corners, square.triangles);
+    square.t_s = 0.0;
+    const contact::ToolShape needle = contact::ToolShape::sphere(0.2);
+    haptics::CoupledTool tool(needle, {0.1, 5.0}, {0.5, 0.0}, square.capacity());
+    Eigen::Vector3d f;
+    tool.update(at(2.0), square, 1e-3);
+    for (int tick = 0; tick < 40; ++tick) f = tool.update(at(-2.0), square, 1e-3); // a jump, then held down
+    EXPECT_GT(tool.proxy().position.z(), 0.19); // the needle's mesh is above the face
+    EXPECT_LT(tool.proxy().position.z(), 0.25);
+    EXPECT_NEAR(f.z(), 0.5 * (tool.proxy().position.z() + 2.0), 1e-9);
+    EXPECT_GT(f.z(), 1.0);
 }
