@@ -34,7 +34,8 @@ contact::ToolShape make_shape(const io::ToolSpec& t)
 
 ToolSession::ToolSession(const io::Scene& scene)
     : m_scene(scene), m_previous_section(scene.tools.size()), m_marked_from(scene.tools.size()),
-      m_episode_cut(scene.tools.size(), false), m_driven(scene.tools.size(), false), m_driven_pose(scene.tools.size())
+      m_episode_cut(scene.tools.size(), false), m_driven(scene.tools.size(), false), m_driven_pose(scene.tools.size()),
+      m_last_pose(scene.tools.size())
 {
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
 }
@@ -64,11 +65,18 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
         }
         ToolFrame& out = stats.tools[k];
         out.placed = pose.placed;
-        if (!pose.placed) continue;
+        if (!pose.placed) {
+            m_last_pose[k] = {}; // back later: from wherever it reappears
+            continue;
+        }
         out.position_mm = pose.position_mm;
         placed[k] = {&m_shapes[k], pose.position_mm, pose.orientation};
         const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
-        touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k], parameters);
+        // The penalty integrated over the tool's move since the last frame (continuous penalty):
+        // a tool arriving between two frames pushes for the part of the frame it was there.
+        const bool moved_on = m_last_pose[k].shape == placed[k].shape;
+        touch[k] = cut::touch_surface(sim.surface(), sim.solver().positions(), placed[k], parameters, moved_on ? &m_last_pose[k] : nullptr);
+        m_last_pose[k] = placed[k];
         fresh[k] = true;
         stats.collision_ms += clock.lap();
         const contact::ContactResult& c = touch[k].contact;

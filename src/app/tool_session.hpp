@@ -72,6 +72,7 @@ private:
     std::vector<bool> m_episode_cut;
     std::vector<bool> m_driven;                   ///< a device moves the tool
     std::vector<contact::PlacedShape> m_driven_pose;
+    std::vector<contact::PlacedShape> m_last_pose; ///< per tool, at the last frame it was placed (no shape: not placed)
 };
 
 } // namespace vox::app

@@ -1,5 +1,8 @@
 #include "contact/penalty_contact.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace vox::contact {
 namespace {
 
@@ -11,16 +14,22 @@ struct PointPenalty {
     double stiffness = 0.0, depth = 0.0, distance = 0.0;
 };
 
-bool point_penalty(const PlacedShape& tool, const ContactParameters& parameters, const Eigen::AlignedBox3d& reach,
+/// With `from` (the tool's pose at the start of the step), the depth is the mean over the step
+/// of the penetration, linear between the two poses' depths, and the stiffness is scaled by the
+/// share of the step spent inside (the derivative of that mean with the point's position).
+bool point_penalty(const PlacedShape& tool, const PlacedShape* from, const ContactParameters& parameters, const Eigen::AlignedBox3d& reach,
                    const Eigen::Vector3d& p, double area, const Eigen::Vector3d& outward, PointPenalty& out) noexcept
 {
     if (!reach.contains(p)) return false;
     out.distance = tool.signed_distance(p, &out.normal);
     out.depth = parameters.margin_mm - out.distance;
+    double inside = out.depth > 0.0 ? 1.0 : 0.0;
+    if (from) out.depth = mean_penetration(parameters.margin_mm - from->signed_distance(p), out.depth, inside);
     if (!(out.depth > 0.0)) return false;
     if (outward.squaredNorm() > 0.0) out.normal = -outward; // along the object's normal (see the header)
-    out.stiffness = parameters.stiffness_n_per_mm / 100.0 * area; // per mm^2 of contact
-    out.force = out.stiffness * out.depth * out.normal;
+    const double k = parameters.stiffness_n_per_mm / 100.0 * area; // per mm^2 of contact
+    out.force = k * out.depth * out.normal;
+    out.stiffness = k * inside;
     return true;
 }
 
@@ -33,15 +42,31 @@ bool carries_load(const Eigen::Vector3d& force, const Eigen::Vector3d& net) noex
 
 } // namespace
 
+double mean_penetration(double d0, double d1, double& inside) noexcept
+{
+    if (d0 >= 0.0 && d1 >= 0.0) { // inside throughout
+        inside = 1.0;
+        return 0.5 * (d0 + d1);
+    }
+    if (d0 <= 0.0 && d1 <= 0.0) { // outside throughout
+        inside = 0.0;
+        return 0.0;
+    }
+    const double deeper = std::max(d0, d1), span = std::abs(d1 - d0);
+    inside = deeper / span;
+    return 0.5 * deeper * inside;
+}
+
 ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
                               std::span<const Eigen::Vector3d> points, std::span<const double> areas,
-                              std::span<const Eigen::Vector3d> normals)
+                              std::span<const Eigen::Vector3d> normals, const PlacedShape* from)
 {
     ContactResult out;
-    const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    if (from) reach.extend(from->world_bounds(parameters.margin_mm));
     PointPenalty pp;
     for (std::size_t i = 0; i < points.size(); ++i) {
-        if (!point_penalty(tool, parameters, reach, points[i], areas[i], normals[i], pp)) continue;
+        if (!point_penalty(tool, from, parameters, reach, points[i], areas[i], normals[i], pp)) continue;
         PointContact c;
         c.point = static_cast<std::uint32_t>(i);
         c.depth_mm = pp.depth;
@@ -74,7 +99,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     PointPenalty pp;
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!point_penalty(tool, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp)) continue;
+        if (!point_penalty(tool, nullptr, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp)) continue;
         out.force_on_tool_n -= pp.force;
         out.torque_on_tool_n_mm -= (p - tool.position).cross(pp.force);
         out.stiffness_n_per_mm += pp.stiffness * pp.normal * pp.normal.transpose();
@@ -86,7 +111,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     for (std::size_t i = 0; i < points.count; ++i) {
-        if (!point_penalty(tool, parameters, reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp)) continue;
+        if (!point_penalty(tool, nullptr, parameters, reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp)) continue;
         if (!carries_load(pp.force, net)) continue;
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];

@@ -81,8 +81,20 @@ struct ContactTotals {
 /// Contact of `tool` (its inner shape, placed in the world) with surface points (world mm), each
 /// carrying `areas[i]` mm^2 of surface with outward unit normal `normals[i]` (a zero normal: the
 /// point is pushed along the tool's outward normal instead). Points outside the outer shape are skipped.
+///
+/// With `from`, the tool's pose at the start of the step (it moved from there to `tool` over the
+/// step), the penalty is integrated over each point's penetration interval instead (Tang, Manocha,
+/// Otaduy and Tong 2012, continuous penalty forces): the depth varies linearly between its values
+/// at the two poses, and a point's force is its mean over the step, so a tool that arrives between
+/// two steps pushes for the part of the step it was in contact, not as if it had been there all
+/// along; the force rises with the time in contact instead of jumping. A point inside at either
+/// pose counts. The stiffness is scaled by the share of the step spent inside.
 [[nodiscard]] ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
                                             std::span<const Eigen::Vector3d> points, std::span<const double> areas,
-                                            std::span<const Eigen::Vector3d> normals);
+                                            std::span<const Eigen::Vector3d> normals, const PlacedShape* from = nullptr);
+
+/// The mean over a step of a penetration depth going linearly from d0 to d1 (negative: outside),
+/// counting only the part inside; `inside` receives the share of the step spent inside.
+[[nodiscard]] double mean_penetration(double d0, double d1, double& inside) noexcept;
 
 } // namespace vox::contact

@@ -79,15 +79,17 @@ void area_and_normal(const ModelSurface& surface, std::uint32_t v, DeformedPosit
 } // namespace
 
 SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                             const contact::PlacedShape& tool, const contact::ContactParameters& parameters)
+                             const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                             const contact::PlacedShape* from)
 {
     SurfaceContact out;
-    const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    // Candidate points: the vertices near the tool, kept when inside the outer shape.
+    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    if (from) reach.extend(from->world_bounds(parameters.margin_mm));
+    // Candidate points: the vertices near the tool, kept when inside the outer shape (at either pose).
     std::vector<std::uint32_t> inside;
     std::vector<Eigen::Vector3d> inside_mm;
     vertices_in(surface, node_positions, reach, [&](std::uint32_t v, const Eigen::Vector3d& p) {
-        if (tool.signed_distance(p) >= parameters.margin_mm) return;
+        if (tool.signed_distance(p) >= parameters.margin_mm && !(from && from->signed_distance(p) < parameters.margin_mm)) return;
         inside.push_back(v);
         inside_mm.push_back(p);
     });
@@ -97,7 +99,7 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
     std::vector<double> areas(inside.size(), 0.0);
     std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
-    out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals);
+    out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals, from);
     for (contact::PointContact& c : out.contact.points) {
         const std::uint32_t v = inside[c.point];
         c.point = static_cast<std::uint32_t>(out.vertices.size());

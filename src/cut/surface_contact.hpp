@@ -22,9 +22,12 @@ struct SurfaceContact {
 
 /// Contact of `tool` (its inner shape; the outer is grown by parameters.margin_mm) with the
 /// surface deformed by `node_positions` (m). Only elements whose deformed corner box meets the
-/// tool's reach are visited.
+/// tool's reach are visited. With `from`, the tool's pose at the previous step, the penalty is
+/// integrated over each point's penetration interval as the tool moved from there
+/// (contact::penalty_contact).
 [[nodiscard]] SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                           const contact::PlacedShape& tool, const contact::ContactParameters& parameters);
+                                           const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                                           const contact::PlacedShape* from = nullptr);
 
 /// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
 /// the corners of its element with the trilinear weights, the penalty stiffness lumped the same

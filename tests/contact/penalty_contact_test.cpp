@@ -287,3 +287,60 @@ TEST(PenaltyTotals, AreThePointListsSumsForAnyPose)
     }
     EXPECT_EQ(touching, 20); // every pose touches many points: the comparison is not vacuous
 }
+
+TEST(ContinuousPenalty, MeanPenetrationOverAStep)
+{
+    double inside = -1.0;
+    EXPECT_DOUBLE_EQ(mean_penetration(0.2, 0.4, inside), 0.3); // inside throughout
+    EXPECT_DOUBLE_EQ(inside, 1.0);
+    EXPECT_DOUBLE_EQ(mean_penetration(-0.3, -0.1, inside), 0.0); // outside throughout
+    EXPECT_DOUBLE_EQ(inside, 0.0);
+    // Entering at t = 1/4 and reaching 0.3: the mean of the ramp over [1/4, 1] is 0.15 * 3/4.
+    EXPECT_NEAR(mean_penetration(-0.1, 0.3, inside), 0.1125, 1e-15);
+    EXPECT_DOUBLE_EQ(inside, 0.75);
+    // Leaving is the same ramp backwards.
+    EXPECT_NEAR(mean_penetration(0.3, -0.1, inside), 0.1125, 1e-15);
+}
+
+TEST(ContinuousPenalty, TheImpulseOfAnApproachIsExactWhereverTheStepsFall)
+{
+    // The plate comes down at 40 mm/s onto the patch and keeps going for 60 ms; the contact force
+    // is taken once a step of 10 ms. Integrated over each step, the force times dt adds up to the
+    // exact impulse of the penalty (k A / 1 cm^2 times the integral of the depth) wherever the
+    // steps fall; the discrete force, taken at each step's end as if the plate had been there all
+    // step, overshoots it by half a step of travel (here a sixth).
+    const ContactParameters c{1.0, 5.0};
+    const Patch patch;
+    const double speed = 40.0, dt = 0.01, k_area = c.stiffness_n_per_mm / 100.0 * 100.0; // N/mm over the 1 cm^2 patch
+    auto depth_at = [&](double t) { return speed * t; };                                   // contact begins at t = 0
+    auto pose = [&](double t) { return plate_pressing(depth_at(t), c); };
+    const double end = 0.06, exact = k_area * 0.5 * speed * end * end; // N s
+    double worst_continuous = 0.0, least_discrete = 1e9, first_discrete = 0.0, first_continuous = 0.0;
+    for (double phase : {0.1, 0.35, 0.6, 0.85}) {
+        double continuous = 0.0, discrete = 0.0;
+        bool first = true;
+        double t0 = -2 * dt;
+        for (double t = t0 + phase * dt;; t += dt) {
+            const double t1 = std::min(t, end);
+            const PlacedShape from = pose(t0), to = pose(t1);
+            const double f_cont = penalty_contact(to, c, patch.points, patch.areas, patch.normals, &from).force_on_tool_n.z();
+            const double f_disc = patch.contact(to, c).force_on_tool_n.z();
+            continuous += f_cont * (t1 - t0);
+            discrete += f_disc * (t1 - t0);
+            if (first && f_disc > 0.0) {
+                first = false;
+                first_discrete = f_disc;
+                first_continuous = f_cont;
+            }
+            if (t1 >= end) break;
+            t0 = t1;
+        }
+        worst_continuous = std::max(worst_continuous, std::abs(continuous - exact) / exact);
+        least_discrete = std::min(least_discrete, (discrete - exact) / exact);
+        // The first step in contact: the continuous force is the discrete one times half the
+        // share of the step in contact, so it starts at most half as high.
+        EXPECT_LE(first_continuous, 0.5 * first_discrete + 1e-12);
+    }
+    EXPECT_LT(worst_continuous, 1e-9);
+    EXPECT_GT(least_discrete, 0.1);
+}
