@@ -18,5 +18,6 @@ void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_ccd_check_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 
 } // namespace vox::app

@@ -41,6 +41,7 @@ int main(int argc, char** argv)
     vox::app::add_bench_command(app);
     vox::app::add_ccd_check_command(app);
     vox::app::add_devices_command(app);
+    vox::app::add_render_command(app);
 
     try {
         vox::check_memory_limit_environment();

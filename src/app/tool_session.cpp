@@ -42,7 +42,8 @@ ToolSession::ToolSession(const io::Scene& scene)
 
 void ToolSession::drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation)
 {
-    m_driven.at(tool) = true;
+    if (!m_driven.at(tool)) m_last_pose[tool] = {}; // the device's first pose is no move from the script's
+    m_driven[tool] = true;
     m_driven_pose[tool].position = position_mm;
     m_driven_pose[tool].orientation = orientation;
 }

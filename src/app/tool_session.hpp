@@ -56,6 +56,9 @@ public:
 
     [[nodiscard]] const contact::ToolShape& shape(std::size_t tool) const { return m_shapes[tool]; }
 
+    /// Where `tool` was at the last frame (its shape null when it was not placed).
+    [[nodiscard]] const contact::PlacedShape& placed(std::size_t tool) const { return m_last_pose[tool]; }
+
     /// Voxels that have had a face opened since the session began.
     [[nodiscard]] std::size_t separated_voxels() const { return m_separated.size(); }
 

@@ -37,14 +37,15 @@ IVec3 at(const Motion& m, int i, const Interval& t)
 /// the time interval it is given) cannot rule out: the start of the first interval that survives
 /// max_depth halvings, taking earlier halves first; infinity when every interval is ruled out. A
 /// template, not a std::function, so that the haptic loop's calls never allocate.
+/// Intervals starting at or after `before` are not searched (an earlier contact is known).
 template <class Excluded>
-double first_surviving(const Excluded& excluded, double lo, double hi, int depth, int max_depth)
+double first_surviving(const Excluded& excluded, double lo, double hi, int depth, int max_depth, double before)
 {
-    if (excluded(Interval(lo, hi))) return std::numeric_limits<double>::infinity();
+    if (lo >= before || excluded(Interval(lo, hi))) return std::numeric_limits<double>::infinity();
     if (depth == max_depth) return lo;
     const double mid = 0.5 * (lo + hi);
-    const double early = first_surviving(excluded, lo, mid, depth + 1, max_depth);
-    return early <= mid ? early : first_surviving(excluded, mid, hi, depth + 1, max_depth);
+    const double early = first_surviving(excluded, lo, mid, depth + 1, max_depth, before);
+    return early <= mid ? early : first_surviving(excluded, mid, hi, depth + 1, max_depth, before);
 }
 
 /// The boxes of the two groups of points (indices [0, split) and [split, 4)) over t do not meet.
@@ -83,7 +84,8 @@ bool never_coplanar(const IVec3& q0, const IVec3& q1, const IVec3& b0, const IVe
 
 } // namespace
 
-double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options) noexcept
+double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options,
+                       double before) noexcept
 {
     const Motion m = motion(at0, at1, options.input_ulps);
     if (never_coplanar(m.start[0] - m.start[1], m.end[0] - m.end[1], m.start[2] - m.start[1], m.end[2] - m.end[1],
@@ -100,10 +102,11 @@ double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::arr
         if (dot(cross(q, c), n).below_zero()) return true;
         return dot(cross(c - b, q - b), n).below_zero();
     };
-    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth);
+    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth, before);
 }
 
-double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options) noexcept
+double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options,
+                     double before) noexcept
 {
     const Motion m = motion(at0, at1, options.input_ulps);
     // Coplanarity of d = b0 - a0 with ea and eb: the same cubic filter.
@@ -122,7 +125,7 @@ double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array
         const Interval s = dot(cross(d, eb), n), u = dot(cross(d, ea), n);
         return s.below_zero() || (nn - s).below_zero() || u.below_zero() || (nn - u).below_zero();
     };
-    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth);
+    return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth, before);
 }
 
 bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)

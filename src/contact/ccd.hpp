@@ -31,11 +31,15 @@ struct CcdOptions {
                                  const CcdOptions& options = {});
 
 /// The time of first possible contact in [0, 1] of the same queries: a lower bound on the true
-/// one (never later; at most 2^-max_depth earlier when the contact is real), infinity when the
-/// query has none. Never allocates or throws (the haptic loop calls them).
+/// one (never later; within 2^-max_depth when the contact is real and the primitives are not
+/// degenerate), infinity when the query has none. For degenerate pairs (parallel edges, a
+/// sliver face) the bounds may not rule out the time the two boxes first overlap, which is then
+/// what is returned: conservative, possibly early. Times at or after `before` are not searched
+/// (infinity is returned instead): a caller after the earliest contact of many pairs passes the
+/// earliest so far. Never allocates or throws (the haptic loop calls them).
 [[nodiscard]] double vertex_face_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
-                                     const CcdOptions& options = {}) noexcept;
+                                     const CcdOptions& options = {}, double before = 2.0) noexcept;
 [[nodiscard]] double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
-                                   const CcdOptions& options = {}) noexcept;
+                                   const CcdOptions& options = {}, double before = 2.0) noexcept;
 
 } // namespace vox::contact

@@ -1,8 +1,8 @@
 #pragma once
 // Points of the object's surface with their area and outward normal, world mm, and the triangles
 // between them: what the haptic thread touches. The simulation thread fills one (the surface near
-// the tool, with a box tree over its triangles) and publishes it; the haptic thread only reads it,
-// so it never allocates.
+// the tool, with a box tree over its triangles; the triangle list and tree grow there as needed)
+// and publishes it; the haptic thread only reads it, so it never allocates.
 
 #include "contact/mesh_ccd.hpp"
 
@@ -28,7 +28,6 @@ struct SurfacePoints {
     explicit SurfacePoints(std::size_t capacity = 0)
         : positions_mm(capacity), normals(capacity), areas_mm2(capacity)
     {
-        triangles.reserve(2 * capacity);
     }
     [[nodiscard]] std::size_t capacity() const { return positions_mm.size(); }
 };

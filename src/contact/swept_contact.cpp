@@ -42,10 +42,7 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
         if (keep) clearance[i] = d0 - grip <= 0.0 ? -far : d0 - grip;
         if (d0 <= 0.0 || d0 > speed) continue;   // in the contact at the start, or out of reach
         const double d1 = to.signed_distance(p) - margin_mm;
-        if (d1 <= 0.0) {                         // in the contact at the end: the discrete contact has it
-            if (keep) clearance[i] = -far;
-            continue;
-        }
+        if (d1 <= 0.0) continue;                 // in the contact at the end: the discrete contact has it
         if (d0 + d1 + grip > speed) continue;    // too far to be reached in between
         double t = d0 / speed;
         for (int step = 0; step < 64 && t < first; ++step) {

@@ -20,9 +20,8 @@ namespace vox::contact {
 /// there is none. Stopping there leaves the point in the penalty contact, which then holds the
 /// tool. Never allocates, locks or throws.
 /// `clearance`, when given (at least points.count long), receives for each point its distance
-/// outside the pushing shape at `from`, mm, or -infinity when the point is in the contact at
-/// either end; points outside the box the move sweeps (in the contact at neither end) are left at
-/// +infinity, unmeasured.
+/// outside the pushing shape at `from`, mm, or -infinity when the point is in the contact there;
+/// points outside the box the move sweeps are left at +infinity, unmeasured.
 [[nodiscard]] double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm,
                                           const SurfacePoints& points, std::span<double> clearance = {}) noexcept;
 

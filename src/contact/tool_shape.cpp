@@ -185,7 +185,7 @@ ToolShape ToolShape::from_mesh(TriangleMesh mesh)
     return s;
 }
 
-double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
 {
     Eigen::Vector2d g2;
     const double d2 = polygon_distance(m_profile, Eigen::Vector2d(p.x(), p.z()), g2);
@@ -205,7 +205,7 @@ double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* grad
     return d;
 }
 
-double ToolShape::mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+double ToolShape::mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
 {
     double best = std::numeric_limits<double>::infinity();
     Eigen::Vector3d nearest = p, face_normal(0, 0, 1);
@@ -227,7 +227,7 @@ double ToolShape::mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradi
     return inside ? -distance : distance;
 }
 
-double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const
+double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
 {
     switch (m_kind) {
     case Kind::box:
@@ -298,7 +298,7 @@ std::vector<Eigen::Vector2d> ToolShape::profile(double margin) const
     return offset_polygon(m_profile, margin);
 }
 
-double PlacedShape::signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient) const
+double PlacedShape::signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient) const noexcept
 {
     const double d = shape->signed_distance(orientation.conjugate() * (world - position), gradient);
     if (gradient) *gradient = orientation * *gradient;

@@ -44,7 +44,7 @@ public:
     /// Signed distance from p (tool frame, mm) to the surface: negative inside. `gradient`, when
     /// given, receives the unit direction in which the distance grows fastest (the outward normal
     /// of the nearest surface point).
-    [[nodiscard]] double signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const;
+    [[nodiscard]] double signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const noexcept;
 
     /// Bounds of the shape grown by `margin` (mm), tool frame.
     [[nodiscard]] Eigen::AlignedBox3d bounds(double margin = 0.0) const;
@@ -61,8 +61,8 @@ public:
 
 private:
     ToolShape() = default;
-    [[nodiscard]] double prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const;
-    [[nodiscard]] double mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const;
+    [[nodiscard]] double prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept;
+    [[nodiscard]] double mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept;
 
     Kind m_kind = Kind::box;
     Eigen::Vector3d m_size = Eigen::Vector3d::Zero();
@@ -80,7 +80,7 @@ struct PlacedShape {
     Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 
     /// Signed distance of a world point (mm); `gradient` in world frame.
-    [[nodiscard]] double signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient = nullptr) const;
+    [[nodiscard]] double signed_distance(const Eigen::Vector3d& world, Eigen::Vector3d* gradient = nullptr) const noexcept;
     /// World-axis box holding the shape grown by `margin`.
     [[nodiscard]] Eigen::AlignedBox3d world_bounds(double margin = 0.0) const;
 };

@@ -10,9 +10,11 @@
 //
 // It runs on ticks whose move is longer than the margin (a jump, which is how a thin tool passes
 // a thin wall); slower moves let the tool's edge into a face between points, as the point contact
-// always has (cutting needs the blade to reach the points it cuts). Only surface triangles none
-// of whose corners is in the contact at either end of the tick take part (the penalty contact
-// holds the rest), and only those the move can reach. A contact
+// always has (cutting needs the blade to reach the points it cuts), and a tool that already
+// straddles a face at the start of a tick is in it, not crossing it. Only surface triangles none
+// of whose corners is in the contact at the start of the tick take part (the penalty contact
+// holds the rest), and only those the move can reach: a jab that would end with the tool deep in
+// the object, its far face against the surface, stops where it first meets it. A contact
 // found there stops the tool 1 um before it: it is held at the face like a god-object, and the
 // user feels the coupling spring. Everything here runs in the 1 kHz loop: the buffers are sized
 // at construction; no allocation, lock, log or throw.
@@ -27,7 +29,8 @@ namespace vox::contact {
 
 class ToolSweep {
 public:
-    /// `point_capacity`: the largest snapshot the loop will see (its capacity()).
+    /// `point_capacity`: the largest snapshot the loop will see (its capacity()); a larger one
+    /// gets the point test only.
     ToolSweep(const ToolShape& shape, double margin_mm, std::size_t point_capacity);
 
     /// The earliest time t in [0, 1] of the move from `from` to `to` (same shape as given at

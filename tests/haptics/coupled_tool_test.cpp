@@ -3,6 +3,7 @@
 // pointing out of the wall, steady from tick to tick however stiff the contact.
 
 #include "haptics/coupled_tool.hpp"
+#include "surface_snapshots.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,20 +13,7 @@ using namespace vox;
 
 namespace {
 
-/// A flat wall z <= 0 sampled on a 1 mm grid of 41 x 41 points, 1 mm^2 each, outward normal +z.
-contact::SurfacePoints wall()
-{
-    contact::SurfacePoints s(41 * 41);
-    for (int i = 0; i < 41; ++i)
-        for (int j = 0; j < 41; ++j) {
-            s.positions_mm[s.count] = Eigen::Vector3d(i - 20.0, j - 20.0, 0.0);
-            s.normals[s.count] = Eigen::Vector3d::UnitZ();
-            s.areas_mm2[s.count] = 1.0;
-            ++s.count;
-        }
-    s.t_s = 0.0;
-    return s;
-}
+contact::SurfacePoints wall() { return test::flat_wall(); }
 
 haptics::DeviceState at(double z)
 {
@@ -123,16 +111,7 @@ TEST(CoupledTool, ANeedleIsHeldAtAFaceBetweenDistantPoints)
     // Two triangles 20 mm across, sampled only at their corners: a 0.2 mm needle jerked through
     // the middle touches no point, ever. The mesh sweep stops it at the face; the hand, 2 mm
     // below, feels the coupling spring (0.5 N/mm x 2.2 mm) pushing it back up.
-    contact::SurfacePoints square(4);
-    for (const Eigen::Vector3d& c : {Eigen::Vector3d(-10, -10, 0), Eigen::Vector3d(10, -10, 0), Eigen::Vector3d(10, 10, 0), Eigen::Vector3d(-10, 10, 0)}) {
-        square.positions_mm[square.count] = c;
-        square.normals[square.count] = Eigen::Vector3d::UnitZ();
-        square.areas_mm2[square.count++] = 100.0;
-    }
-    square.triangles = {{0, 1, 2}, {0, 2, 3}};
-    const std::span<const Eigen::Vector3d> corners(square.positions_mm.data(), square.count);
-    square.triangle_tree.rebuild(corners, corners, square.triangles);
-    square.t_s = 0.0;
+    const contact::SurfacePoints square = test::coarse_square();
     const contact::ToolShape needle = contact::ToolShape::sphere(0.2);
     haptics::CoupledTool tool(needle, {0.1, 5.0}, {0.5, 0.0}, square.capacity());
     Eigen::Vector3d f;

@@ -1,16 +1,18 @@
 // The 1 kHz path never allocates: a lockstep loop ticking a scripted device through free space,
-// a press into a surface snapshot, a jab that sweeps the tool's mesh and a pull back, counted by
-// this test program's own operator new. (Locks and logs would show here too: spdlog formats into
-// allocated buffers, and the mutexes the loop could take are in allocating code.)
+// a press into a surface snapshot, a jab that the tool's mesh sweep stops at the surface and a
+// pull back, counted by this test program's own operator new (plain and aligned). Eigen's own
+// heap use goes to malloc and is not counted; the loop uses fixed-size Eigen types only.
 
 #include "haptics/coupled_tool.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/virtual_device.hpp"
+#include "surface_snapshots.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
+#include <algorithm>
 #include <new>
 
 namespace {
@@ -24,32 +26,23 @@ void* operator new(std::size_t size)
     if (void* p = std::malloc(size ? size : 1)) return p;
     throw std::bad_alloc();
 }
+void* operator new(std::size_t size, std::align_val_t align)
+{
+    if (g_counting.load(std::memory_order_relaxed)) ++g_allocations;
+    const auto a = static_cast<std::size_t>(align);
+    if (void* p = std::aligned_alloc(a, (std::max<std::size_t>(size, 1) + a - 1) / a * a)) return p;
+    throw std::bad_alloc();
+}
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 using namespace vox;
 
 TEST(HapticLoop, TicksNeverAllocate)
 {
-    // A 40 x 40 mm wall of 1 mm triangles at z = 0, with its tree, as the simulation publishes it.
-    constexpr int n = 41;
-    contact::SurfacePoints wall(n * n);
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-            wall.positions_mm[wall.count] = Eigen::Vector3d(i - 20.0, j - 20.0, 0.0);
-            wall.normals[wall.count] = Eigen::Vector3d::UnitZ();
-            wall.areas_mm2[wall.count++] = 1.0;
-        }
-    for (int i = 0; i + 1 < n; ++i)
-        for (int j = 0; j + 1 < n; ++j) {
-            const int a = i * n + j;
-            wall.triangles.emplace_back(a, a + n, a + n + 1);
-            wall.triangles.emplace_back(a, a + n + 1, a + 1);
-        }
-    const std::span<const Eigen::Vector3d> p(wall.positions_mm.data(), wall.count);
-    wall.triangle_tree.rebuild(p, p, wall.triangles);
-    wall.t_s = 0.0;
-
+    const contact::SurfacePoints wall = test::flat_wall(41, true); // 1 mm triangles, with their tree
     const contact::ToolShape blade = contact::ToolShape::box({10, 0.5, 4});
     haptics::CoupledTool tool(blade, {0.25, 5.0}, {}, wall.capacity());
     const Eigen::Quaterniond level = Eigen::Quaterniond::Identity();
@@ -66,16 +59,24 @@ TEST(HapticLoop, TicksNeverAllocate)
         },
         haptics::SafetySettings{});
     loop.tick(0.0);
-    int swept = 0;
-    double peak = 0.0;
+    int swept = 0, stopped = 0;
+    double peak = 0.0, after_jab = 0.0;
     g_allocations = 0;
     g_counting = true;
     for (int k = 1; k <= 500; ++k) {
         peak = std::max(peak, loop.tick(1e-3 * k).norm());
         swept += tool.sweep().swept_mesh();
+        stopped += tool.sweep().stopped_by_mesh();
+        if (k == 301) after_jab = tool.proxy().position.z();
     }
     g_counting = false;
     EXPECT_EQ(g_allocations.load(), 0);
-    EXPECT_GT(swept, 0);  // the jab ran the mesh sweep
-    EXPECT_GT(peak, 0.05); // and the contact was felt
+    EXPECT_GT(swept, 0);
+    EXPECT_GT(stopped, 0);     // the jab was stopped at the surface by the mesh sweep
+    // The jab's tick ends with the blade's lower face (2 mm below its centre) at the wall (within
+    // a quarter of the 0.25 mm margin above it), not 4 mm into it; the penalty then lets it sink
+    // in at most a margin a tick.
+    EXPECT_GE(after_jab, 2.0);
+    EXPECT_LT(after_jab, 2.0 + 0.25 / 4 + 0.0011);
+    EXPECT_GT(peak, 0.05);     // and the contact was felt
 }

@@ -1,0 +1,74 @@
+#include "app/scene_pictures.hpp"
+
+#include "core/error.hpp"
+
+#include <sstream>
+
+namespace vox::app {
+
+std::pair<int, int> parse_size(const std::string& size)
+{
+    std::istringstream in(size);
+    int w = 0, h = 0;
+    char x = 0;
+    if (in >> w >> x >> h && (x == 'x' || x == 'X') && in.peek() == std::char_traits<char>::eof() && w >= 1 && h >= 1 && w <= 8192 &&
+        h <= 8192)
+        return {w, h};
+    throw InputError("--size \"" + size + "\": expected WIDTHxHEIGHT in pixels, each 1 to 8192 (for example 960x720)");
+}
+
+render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh)
+{
+    render::DrawMesh d;
+    d.positions.reserve(mesh.positions.size());
+    for (const Eigen::Vector3d& p : mesh.positions) d.positions.push_back(p.cast<float>());
+    d.colors.reserve(mesh.positions.size());
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) d.colors.push_back(render::label_color(v < mesh.labels.size() ? mesh.labels[v] : 0));
+    d.indices.reserve(3 * mesh.triangles.size());
+    for (const Eigen::Vector3i& t : mesh.triangles)
+        for (int c = 0; c < 3; ++c) d.indices.push_back(static_cast<std::uint32_t>(t[c]));
+    render::compute_normals(d);
+    return d;
+}
+
+void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out)
+{
+    if (!tool.shape) return;
+    auto drawing = [&](double margin, const Eigen::Vector3f& color, float alpha) {
+        const contact::TriangleMesh m = tool.shape->mesh(margin);
+        render::DrawMesh d;
+        for (const Eigen::Vector3d& p : m.positions) d.positions.push_back((tool.position + tool.orientation * p).cast<float>());
+        d.colors.assign(d.positions.size(), color);
+        for (const Eigen::Vector3i& t : m.triangles)
+            for (int c = 0; c < 3; ++c) d.indices.push_back(static_cast<std::uint32_t>(t[c]));
+        render::compute_normals(d);
+        d.alpha = alpha;
+        out.push_back(std::move(d));
+    };
+    drawing(0.0, {0.55f, 0.58f, 0.62f}, 1.0f); // steel
+    if (margin_mm > 0.05) drawing(margin_mm, {0.35f, 0.55f, 0.85f}, 0.25f);
+}
+
+ScenePictures::ScenePictures(const PictureOptions& options) : m_options(options) {}
+
+void ScenePictures::write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes)
+{
+    if (!m_camera) {
+        Eigen::AlignedBox3d bounds;
+        bounds.setEmpty();
+        for (const render::DrawMesh& m : meshes)
+            for (const Eigen::Vector3f& p : m.positions) bounds.extend(p.cast<double>());
+        if (bounds.isEmpty()) bounds.extend(Eigen::Vector3d::Zero());
+        m_camera = render::fit_camera(m_options.camera, bounds, static_cast<double>(m_options.width) / m_options.height);
+    }
+    render::write_png(path, m_renderer.render(meshes, *m_camera, m_options.width, m_options.height));
+}
+
+void ScenePictures::write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene)
+{
+    std::vector<render::DrawMesh> meshes{surface_drawing(sim.surface().mesh(sim.solver().positions()))};
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
+    write(path, meshes);
+}
+
+} // namespace vox::app

@@ -1,0 +1,52 @@
+#pragma once
+// Pictures of a simulation: the deformed surface shaded per material label, and each placed
+// tool (its cutting shape in steel, its pushing shape as a translucent shell), rendered offscreen
+// to PNG files. A sequence keeps one camera, framed on the first picture, so frames line up.
+
+#include "app/scene_simulation.hpp"
+#include "app/tool_session.hpp"
+#include "render/camera.hpp"
+#include "render/offscreen_context.hpp"
+#include "render/renderer.hpp"
+#include "surface/embedded_surface.hpp"
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+namespace vox::app {
+
+struct PictureOptions {
+    render::CameraSpec camera;
+    int width = 960, height = 720;
+};
+
+/// Parses "WxH" (each 1 to 8192); throws InputError naming the value.
+[[nodiscard]] std::pair<int, int> parse_size(const std::string& size);
+
+/// The surface mesh (world mm, labels per vertex) as a drawable mesh.
+[[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh);
+/// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
+/// `margin_mm`) translucent when the margin is visible.
+void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);
+
+class ScenePictures {
+public:
+    /// Makes the offscreen context (throws render::NoOpenGL when there is none).
+    explicit ScenePictures(const PictureOptions& options);
+
+    /// Writes the picture of `meshes` to `path` (PNG), framing the camera on them the first time.
+    void write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes);
+    /// The simulation's surface and placed tools.
+    void write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene);
+
+    [[nodiscard]] const std::string& context_description() const { return m_context.description(); }
+
+private:
+    PictureOptions m_options;
+    render::OffscreenContext m_context;
+    render::Renderer m_renderer;
+    std::optional<render::Camera> m_camera;
+};
+
+} // namespace vox::app

@@ -1,0 +1,107 @@
+#include "render/camera.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace vox::render {
+
+CameraSpec parse_camera(const std::string& spec)
+{
+    CameraSpec c;
+    std::string view = spec;
+    const std::string ortho = ",ortho";
+    if (view.size() >= ortho.size() && view.compare(view.size() - ortho.size(), ortho.size(), ortho) == 0) {
+        c.orthographic = true;
+        view.resize(view.size() - ortho.size());
+    }
+    struct Named {
+        const char* name;
+        double yaw, pitch;
+    };
+    static constexpr Named named[] = {{"iso", 35, 25},   {"front", 0, 0},  {"back", 180, 0},  {"left", -90, 0},
+                                      {"right", 90, 0},  {"top", 0, 89.9}, {"bottom", 0, -89.9}};
+    for (const Named& n : named)
+        if (view == n.name) {
+            c.yaw_deg = n.yaw;
+            c.pitch_deg = n.pitch;
+            return c;
+        }
+    std::istringstream in(view);
+    char comma = 0;
+    double yaw = 0, pitch = 0;
+    if (in >> yaw >> comma >> pitch && comma == ',' && in.peek() == std::char_traits<char>::eof() && std::abs(pitch) <= 90.0) {
+        c.yaw_deg = yaw;
+        c.pitch_deg = std::clamp(pitch, -89.9, 89.9);
+        return c;
+    }
+    throw InputError("--camera \"" + spec + "\": expected iso, front, back, left, right, top, bottom or YAW,PITCH in degrees "
+                     "(pitch within +-90), optionally followed by \",ortho\"");
+}
+
+Eigen::Matrix4f Camera::view() const
+{
+    const Eigen::Vector3d f = (target - eye).normalized();
+    const Eigen::Vector3d s = f.cross(up).normalized();
+    const Eigen::Vector3d u = s.cross(f);
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.block<1, 3>(0, 0) = s.transpose();
+    m.block<1, 3>(1, 0) = u.transpose();
+    m.block<1, 3>(2, 0) = -f.transpose();
+    m(0, 3) = -s.dot(eye);
+    m(1, 3) = -u.dot(eye);
+    m(2, 3) = f.dot(eye);
+    return m.cast<float>();
+}
+
+Eigen::Matrix4f Camera::projection(double aspect) const
+{
+    Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+    if (orthographic) {
+        const double h = 0.5 * ortho_height_mm, w = h * aspect;
+        p(0, 0) = 1.0 / w;
+        p(1, 1) = 1.0 / h;
+        p(2, 2) = -2.0 / (far_mm - near_mm);
+        p(2, 3) = -(far_mm + near_mm) / (far_mm - near_mm);
+        p(3, 3) = 1.0;
+    } else {
+        const double t = 1.0 / std::tan(0.5 * fov_y_deg * M_PI / 180.0);
+        p(0, 0) = t / aspect;
+        p(1, 1) = t;
+        p(2, 2) = -(far_mm + near_mm) / (far_mm - near_mm);
+        p(2, 3) = -2.0 * far_mm * near_mm / (far_mm - near_mm);
+        p(3, 2) = -1.0;
+    }
+    return p.cast<float>();
+}
+
+Camera fit_camera(const CameraSpec& spec, const Eigen::AlignedBox3d& bounds, double aspect)
+{
+    Camera c;
+    c.orthographic = spec.orthographic;
+    c.up = spec.up;
+    c.target = bounds.center();
+    const double radius = std::max(0.5 * bounds.diagonal().norm(), 1e-3) * 1.05; // a little margin
+    // Direction from the target to the eye: yaw about up, pitch above the horizon; yaw 0 looks
+    // along -y, from the -y side (the front of a scan in patient coordinates faces -y).
+    const double yaw = spec.yaw_deg * M_PI / 180.0, pitch = spec.pitch_deg * M_PI / 180.0;
+    Eigen::Vector3d back = Eigen::Vector3d(std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch));
+    if (spec.up != Eigen::Vector3d::UnitZ()) back = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), spec.up) * back;
+    const double fit = std::min(aspect, 1.0); // the narrower side of the frame must hold the sphere
+    double distance = 0.0;
+    if (c.orthographic) {
+        c.ortho_height_mm = 2.0 * radius / fit;
+        distance = 3.0 * radius;
+    } else {
+        const double half = std::atan(std::tan(0.5 * c.fov_y_deg * M_PI / 180.0) * fit);
+        distance = radius / std::sin(half);
+    }
+    c.eye = c.target + distance * back;
+    c.near_mm = std::max(1e-3, distance - 2.0 * radius);
+    c.far_mm = distance + 2.0 * radius;
+    return c;
+}
+
+} // namespace vox::render

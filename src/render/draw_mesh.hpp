@@ -1,0 +1,28 @@
+#pragma once
+// What the renderer draws: triangle meshes (or line sets) in world millimetres with a colour per
+// vertex. Built by the caller from the surface, the tools or the element cage.
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace vox::render {
+
+struct DrawMesh {
+    std::vector<Eigen::Vector3f> positions; ///< world mm
+    std::vector<Eigen::Vector3f> normals;   ///< per vertex, unit (ignored for lines)
+    std::vector<Eigen::Vector3f> colors;    ///< per vertex, linear RGB in [0, 1]
+    std::vector<std::uint32_t> indices;     ///< triangles (three per), or line segments (two per)
+    float alpha = 1.0f;                     ///< below 1: blended over the opaque meshes
+    bool lines = false;                     ///< indices are segments, drawn unlit
+};
+
+/// Area-weighted vertex normals of a triangle mesh (into mesh.normals).
+void compute_normals(DrawMesh& mesh);
+
+/// A colour for a material label, the same every time: a palette of tissue and clay tones
+/// (label 0 and unlabelled objects get clay).
+[[nodiscard]] Eigen::Vector3f label_color(std::int32_t label);
+
+} // namespace vox::render
