@@ -30,6 +30,7 @@ void add_render_command(CLI::App& app)
 {
     struct Args {
         std::string input, out, camera = "iso", size = "960x720";
+        int smooth = 30;
         SelectionOptions selection;
     };
     auto args = std::make_shared<Args>();
@@ -39,20 +40,24 @@ void add_render_command(CLI::App& app)
     cmd->add_option("--camera", args->camera,
                     "iso (default), front, back, left, right, top, bottom, or YAW,PITCH in degrees; add \",ortho\" for an orthographic view");
     cmd->add_option("--size", args->size, "WIDTHxHEIGHT in pixels (default 960x720)");
+    cmd->add_option("--smooth", args->smooth, "Display smoothing of the surface, Taubin iterations (default 30; 0 shows the voxel steps)")
+        ->check(CLI::Range(0, 200));
     add_selection_options(*cmd, args->selection);
     cmd->callback([args] {
         if (!ends_with(args->out, ".png")) throw InputError(args->out + ": the picture must be a .png file");
         PictureOptions options;
         options.camera = render::parse_camera(args->camera);
         std::tie(options.width, options.height) = parse_size(args->size);
+        options.smooth = args->smooth;
         std::vector<render::DrawMesh> meshes;
         if (ends_with(args->input, ".json")) {
             const io::Scene scene = io::load_scene(args->input);
+            options.camera.up = scene_up(scene);
             const grid::LabelGrid labels = io::load_scene_object(scene);
             const int level = std::max(scene.object.levels, 1);
             grid::BranchedGrid g = build_scene_grid(scene, labels, level);
             const SceneSimulation sim(scene, g, level);
-            meshes.push_back(surface_drawing(sim.surface().mesh(sim.solver().positions())));
+            meshes.push_back(surface_drawing(sim.surface().mesh(sim.solver().positions()), options.smooth));
             const ToolSession tools(scene);
             for (std::size_t k = 0; k < scene.tools.size(); ++k) {
                 const io::ToolPose pose = io::tool_pose(scene, k, 0.0);
@@ -60,12 +65,12 @@ void add_render_command(CLI::App& app)
             }
         } else if (io::is_mesh_path(args->input)) {
             const io::TriangleMesh m = io::read_mesh(args->input);
-            meshes.push_back(surface_drawing({m.vertices, m.triangles, {}}));
+            meshes.push_back(surface_drawing({m.vertices, m.triangles, {}}, options.smooth));
         } else {
             const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, MeshOptions{}));
             const io::MaterialTable table = io::default_material_table();
             const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }), table.materials, 1);
-            meshes.push_back(surface_drawing(surface::EmbeddedSurface(g, 1).mesh(g)));
+            meshes.push_back(surface_drawing(surface::EmbeddedSurface(g, 1).mesh(g), options.smooth));
         }
         ScenePictures pictures(options);
         pictures.write(args->out, meshes);

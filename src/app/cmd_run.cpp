@@ -10,6 +10,7 @@
 #include "core/progress.hpp"
 #include "core/sample_stats.hpp"
 #include "app/level_choice.hpp"
+#include "app/scene_pictures.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/device_run.hpp"
 #include "app/tool_session.hpp"
@@ -54,6 +55,8 @@ void add_run_command(CLI::App& app)
         std::optional<int> frames;
         std::string out;
         std::string device, replay, record, tool;
+        int render_every = 0;
+        std::string camera = "iso", size = "960x720";
     };
     auto args = std::make_shared<Args>();
     CLI::App* cmd = app.add_subcommand("run", "Simulate a scene headless; write stats.json and the deformed surface");
@@ -67,8 +70,18 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--replay", args->replay, "Drive the tool by replaying this recording (docs/recording-format.md)");
     cmd->add_option("--record", args->record, "Record the device and the force sent at every tick to this file");
     cmd->add_option("--tool", args->tool, "The tool the device drives (default: the scene's first tool)");
+    cmd->add_option("--render-every", args->render_every,
+                    "Also draw DIR/frame_NNNNN.png every N frames and DIR/final.png, headless (offscreen OpenGL)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--camera", args->camera, "Camera of the pictures (see `voxsculpt render --help`; default iso)");
+    cmd->add_option("--size", args->size, "Size of the pictures, WIDTHxHEIGHT (default 960x720)");
     cmd->callback([args] {
         const io::Scene scene = io::load_scene(args->scene);
+        // Pictures only when asked for: no OpenGL context otherwise. Options checked up front.
+        PictureOptions picture_options;
+        picture_options.camera = render::parse_camera(args->camera);
+        picture_options.camera.up = scene_up(scene);
+        std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
         if (scene.solver.type != io::SolverType::dbg)
             throw scene.error("solver.type", "\"isxfem\" runs are not available yet; use \"dbg\"");
         const grid::LabelGrid labels = io::load_scene_object(scene);
@@ -98,6 +111,12 @@ void add_run_command(CLI::App& app)
             device = std::make_unique<DeviceRun>(scene, tools, o);
             log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, lockstep)", scene.tools[device->tool()].name,
                       device->device_name());
+        }
+        std::unique_ptr<ScenePictures> pictures;
+        if (args->render_every > 0) {
+            pictures = std::make_unique<ScenePictures>(picture_options);
+            log::info("pictures every {} frames ({} x {}, {})", args->render_every, picture_options.width, picture_options.height,
+                      pictures->context_description());
         }
         std::vector<ForceSample> tool_forces; // without a device: the first placed tool's, per frame
         // A cut rebuilds the model and solver: always reach them through `sim`.
@@ -197,6 +216,11 @@ void add_run_command(CLI::App& app)
                                        {"elements", sim.model().elements().size()},
                                        {"object_held", tf.hold_object},
                                        {"tools", tool_frames}});
+            if (pictures && f % args->render_every == 0) {
+                char name[32];
+                std::snprintf(name, sizeof name, "frame_%05d.png", f);
+                pictures->write(out / name, sim, tools, scene);
+            }
             if (f % scene.output.mesh_every_n_frames == 0) {
                 char name[32];
                 std::snprintf(name, sizeof name, "frame_%05d.obj", f);
@@ -228,6 +252,7 @@ void add_run_command(CLI::App& app)
             stats["linear_solver"] = sim.solver().fallback_note();
         }
         write_surface(out / "final.obj", sim);
+        if (pictures) pictures->write(out / "final.png", sim, tools, scene);
         if (device) {
             write_forces(out, device->forces(), "force on the device, " + scene.tools[device->tool()].name);
             if (!args->record.empty()) haptics::write_recording(args->record, device->recording());

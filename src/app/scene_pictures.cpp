@@ -6,6 +6,12 @@
 
 namespace vox::app {
 
+Eigen::Vector3d scene_up(const io::Scene& scene)
+{
+    const double g = scene.gravity_m_s2.norm();
+    return g > 0.0 ? Eigen::Vector3d(-scene.gravity_m_s2 / g) : Eigen::Vector3d::UnitZ();
+}
+
 std::pair<int, int> parse_size(const std::string& size)
 {
     std::istringstream in(size);
@@ -17,7 +23,7 @@ std::pair<int, int> parse_size(const std::string& size)
     throw InputError("--size \"" + size + "\": expected WIDTHxHEIGHT in pixels, each 1 to 8192 (for example 960x720)");
 }
 
-render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh)
+render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth)
 {
     render::DrawMesh d;
     d.positions.reserve(mesh.positions.size());
@@ -27,6 +33,7 @@ render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh)
     d.indices.reserve(3 * mesh.triangles.size());
     for (const Eigen::Vector3i& t : mesh.triangles)
         for (int c = 0; c < 3; ++c) d.indices.push_back(static_cast<std::uint32_t>(t[c]));
+    render::smooth_for_display(d, smooth);
     render::compute_normals(d);
     return d;
 }
@@ -54,19 +61,29 @@ ScenePictures::ScenePictures(const PictureOptions& options) : m_options(options)
 void ScenePictures::write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes)
 {
     if (!m_camera) {
-        Eigen::AlignedBox3d bounds;
-        bounds.setEmpty();
+        std::vector<Eigen::Vector3f> used; // the vertices in use (a surface keeps free slots)
         for (const render::DrawMesh& m : meshes)
-            for (const Eigen::Vector3f& p : m.positions) bounds.extend(p.cast<double>());
-        if (bounds.isEmpty()) bounds.extend(Eigen::Vector3d::Zero());
-        m_camera = render::fit_camera(m_options.camera, bounds, static_cast<double>(m_options.width) / m_options.height);
+            for (const std::uint32_t i : m.indices) used.push_back(m.positions[i]);
+        m_camera = render::fit_camera(m_options.camera, used, static_cast<double>(m_options.width) / m_options.height);
     }
     render::write_png(path, m_renderer.render(meshes, *m_camera, m_options.width, m_options.height));
 }
 
 void ScenePictures::write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene)
 {
-    std::vector<render::DrawMesh> meshes{surface_drawing(sim.surface().mesh(sim.solver().positions()))};
+    std::vector<render::DrawMesh> meshes{surface_drawing(sim.surface().mesh(sim.solver().positions()), m_options.smooth)};
+    // Wet material shows darker and cooler, by its element's water content (what a sculptor sees
+    // on soaked clay).
+    const cut::ModelSurface& surface = sim.surface();
+    const auto& slots = surface.embedded().vertices();
+    std::vector<Eigen::Vector3f>& colors = meshes.front().colors;
+    for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < colors.size(); ++slot) {
+        if (!slots[slot].users) continue; // the mesh lists the slots in use, in order
+        const std::uint32_t e = surface.vertex_element(slot);
+        const auto w = e < sim.model().elements().size() ? static_cast<float>(sim.solver().water(e)) : 0.0f;
+        if (w > 0.0f) colors[v] = (1.0f - 0.5f * w) * colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);
+        ++v;
+    }
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
     write(path, meshes);
 }

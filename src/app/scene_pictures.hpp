@@ -19,13 +19,19 @@ namespace vox::app {
 struct PictureOptions {
     render::CameraSpec camera;
     int width = 960, height = 720;
+    int smooth = 30; ///< display smoothing of the surface (Taubin iterations; 0: the voxel steps as they are)
 };
+
+/// The picture's up for a scene: against gravity (a patient on the table is seen from above, the
+/// anterior side up), or +z without gravity.
+[[nodiscard]] Eigen::Vector3d scene_up(const io::Scene& scene);
 
 /// Parses "WxH" (each 1 to 8192); throws InputError naming the value.
 [[nodiscard]] std::pair<int, int> parse_size(const std::string& size);
 
-/// The surface mesh (world mm, labels per vertex) as a drawable mesh.
-[[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh);
+/// The surface mesh (world mm, labels per vertex) as a drawable mesh, smoothed for display by
+/// `smooth` Taubin iterations.
+[[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth);
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
 /// `margin_mm`) translucent when the margin is visible.
 void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);

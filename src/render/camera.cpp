@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <span>
 
 namespace vox::render {
 
@@ -77,30 +78,52 @@ Eigen::Matrix4f Camera::projection(double aspect) const
     return p.cast<float>();
 }
 
-Camera fit_camera(const CameraSpec& spec, const Eigen::AlignedBox3d& bounds, double aspect)
+Camera fit_camera(const CameraSpec& spec, std::span<const Eigen::Vector3f> points, double aspect)
 {
     Camera c;
     c.orthographic = spec.orthographic;
     c.up = spec.up;
-    c.target = bounds.center();
-    const double radius = std::max(0.5 * bounds.diagonal().norm(), 1e-3) * 1.05; // a little margin
+    Eigen::AlignedBox3d bounds;
+    bounds.setEmpty();
+    for (const Eigen::Vector3f& p : points) bounds.extend(p.cast<double>());
+    if (bounds.isEmpty()) bounds.extend(Eigen::Vector3d::Zero());
+    const double radius = std::max(0.5 * bounds.diagonal().norm(), 1e-3);
     // Direction from the target to the eye: yaw about up, pitch above the horizon; yaw 0 looks
     // along -y, from the -y side (the front of a scan in patient coordinates faces -y).
     const double yaw = spec.yaw_deg * M_PI / 180.0, pitch = spec.pitch_deg * M_PI / 180.0;
     Eigen::Vector3d back = Eigen::Vector3d(std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch));
     if (spec.up != Eigen::Vector3d::UnitZ()) back = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), spec.up) * back;
-    const double fit = std::min(aspect, 1.0); // the narrower side of the frame must hold the sphere
-    double distance = 0.0;
-    if (c.orthographic) {
-        c.ortho_height_mm = 2.0 * radius / fit;
-        distance = 3.0 * radius;
-    } else {
-        const double half = std::atan(std::tan(0.5 * c.fov_y_deg * M_PI / 180.0) * fit);
-        distance = radius / std::sin(half);
+    const Eigen::Vector3d right = (-back).cross(c.up).normalized(), up = right.cross(-back);
+    // Centre the points' extent across the view, then step back until every point is in the
+    // frame with 10 % of margin (the points themselves, not their box: a round object fills
+    // little of its box's outline).
+    double x_lo = 1e300, x_hi = -1e300, y_lo = 1e300, y_hi = -1e300;
+    const Eigen::Vector3d centre = bounds.center();
+    for (const Eigen::Vector3f& pf : points) {
+        const Eigen::Vector3d d = pf.cast<double>() - centre;
+        x_lo = std::min(x_lo, d.dot(right));
+        x_hi = std::max(x_hi, d.dot(right));
+        y_lo = std::min(y_lo, d.dot(up));
+        y_hi = std::max(y_hi, d.dot(up));
     }
+    if (points.empty()) x_lo = x_hi = y_lo = y_hi = 0.0;
+    c.target = centre + 0.5 * (x_lo + x_hi) * right + 0.5 * (y_lo + y_hi) * up;
+    const double tan_v = std::tan(0.5 * c.fov_y_deg * M_PI / 180.0), tan_h = tan_v * aspect;
+    double distance = 0.0, half_height = 1e-3;
+    for (const Eigen::Vector3f& pf : points) {
+        const Eigen::Vector3d d = pf.cast<double>() - c.target;
+        const double x = 1.1 * std::abs(d.dot(right)), y = 1.1 * std::abs(d.dot(up)), z = d.dot(back);
+        half_height = std::max({half_height, y, x / aspect});
+        distance = std::max({distance, z + y / tan_v, z + x / tan_h});
+    }
+    if (c.orthographic) {
+        c.ortho_height_mm = 2.0 * half_height;
+        distance = 3.0 * radius;
+    }
+    distance = std::max(distance, 1e-2 * radius);
     c.eye = c.target + distance * back;
-    c.near_mm = std::max(1e-3, distance - 2.0 * radius);
-    c.far_mm = distance + 2.0 * radius;
+    c.near_mm = std::max(1e-3 * distance, distance - 2.2 * radius);
+    c.far_mm = distance + 2.2 * radius;
     return c;
 }
 

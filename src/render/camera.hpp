@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <span>
 #include <string>
 
 namespace vox::render {
@@ -31,8 +32,8 @@ struct Camera {
     [[nodiscard]] Eigen::Matrix4f projection(double aspect) const;
 };
 
-/// A camera looking as `spec` says at the centre of `bounds` (world mm), far enough for the whole
-/// box to fit a frame of width / height `aspect`, with a small margin.
-[[nodiscard]] Camera fit_camera(const CameraSpec& spec, const Eigen::AlignedBox3d& bounds, double aspect);
+/// A camera looking as `spec` says at `points` (world mm), centred on them and far enough for
+/// all of them to fit a frame of width / height `aspect`, with a small margin.
+[[nodiscard]] Camera fit_camera(const CameraSpec& spec, std::span<const Eigen::Vector3f> points, double aspect);
 
 } // namespace vox::render

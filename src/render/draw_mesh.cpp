@@ -22,6 +22,37 @@ void compute_normals(DrawMesh& mesh)
     }
 }
 
+void smooth_for_display(DrawMesh& mesh, int iterations)
+{
+    if (iterations <= 0 || mesh.lines) return;
+    // Neighbours of each vertex along the triangles' edges (each edge from both of its triangles:
+    // the weights stay uniform on a closed mesh).
+    const std::size_t n = mesh.positions.size();
+    std::vector<std::uint32_t> start(n + 1, 0), neighbours;
+    for (const std::uint32_t v : mesh.indices) start[v + 1] += 2;
+    for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+    neighbours.resize(start[n]);
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+        for (int c = 0; c < 3; ++c) {
+            const std::uint32_t v = mesh.indices[t + static_cast<std::size_t>(c)];
+            neighbours[fill[v]++] = mesh.indices[t + static_cast<std::size_t>((c + 1) % 3)];
+            neighbours[fill[v]++] = mesh.indices[t + static_cast<std::size_t>((c + 2) % 3)];
+        }
+    std::vector<Eigen::Vector3f> next(mesh.positions);
+    for (int it = 0; it < 2 * iterations; ++it) {
+        const float factor = it % 2 == 0 ? 0.5f : -0.53f;
+        for (std::size_t v = 0; v < n; ++v) {
+            if (start[v] == start[v + 1]) continue;
+            Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+            for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) mean += mesh.positions[neighbours[k]];
+            mean /= static_cast<float>(start[v + 1] - start[v]);
+            next[v] = mesh.positions[v] + factor * (mean - mesh.positions[v]);
+        }
+        mesh.positions.swap(next);
+    }
+}
+
 Eigen::Vector3f label_color(std::int32_t label)
 {
     // Ordered so that the hash below gives the bundled liver (255) its red-brown and the lesion
@@ -36,7 +67,7 @@ Eigen::Vector3f label_color(std::int32_t label)
         Eigen::Vector3f(0.75f, 0.35f, 0.40f), // pink (muscle)
         Eigen::Vector3f(0.50f, 0.70f, 0.75f), // teal
     };
-    if (label == 0) return {0.76f, 0.60f, 0.48f}; // clay
+    if (label <= 1) return {0.76f, 0.60f, 0.48f}; // clay: unlabelled objects and the phantoms (label 1)
     // Multiplicative hashing spreads neighbouring labels (1, 2, 3 or 127, 255) over the palette.
     const auto h = static_cast<std::uint32_t>(label) * 2654435761u;
     return palette[(h >> 29) % palette.size()];

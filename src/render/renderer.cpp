@@ -37,10 +37,10 @@ void main() {
     vec3 to_eye = orthographic ? vec3(0, 0, 1) : normalize(-v_eye_position);
     if (dot(n, to_eye) < 0.0) n = -n; // lit from both sides
     vec3 key = normalize(vec3(-0.45, 0.6, 0.65)), fill = normalize(vec3(0.6, -0.2, 0.4));
-    float diffuse = 0.68 * max(dot(n, key), 0.0) + 0.25 * max(dot(n, fill), 0.0) + 0.22;
-    float specular = 0.22 * pow(max(dot(n, normalize(key + to_eye)), 0.0), 40.0);
+    float diffuse = 0.62 * max(dot(n, key), 0.0) + 0.3 * max(dot(n, fill), 0.0) + 0.3;
+    float specular = 0.12 * pow(max(dot(n, normalize(key + to_eye)), 0.0), 40.0);
     vec3 c = v_color * diffuse + vec3(specular);
-    frag = vec4(pow(c, vec3(1.0 / 2.2)), alpha); // to sRGB
+    frag = vec4(min(c, vec3(1.0)), alpha); // colours are display colours
 })";
 
 const char* const line_vertex = R"(#version 330 core
@@ -57,7 +57,7 @@ const char* const line_fragment = R"(#version 330 core
 in vec3 v_color;
 uniform float alpha;
 out vec4 frag;
-void main() { frag = vec4(pow(v_color, vec3(1.0 / 2.2)), alpha); })";
+void main() { frag = vec4(v_color, alpha); })";
 
 unsigned compile(GLenum type, const char* source)
 {
