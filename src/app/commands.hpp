@@ -19,5 +19,6 @@ void add_bench_command(CLI::App& app);
 void add_ccd_check_command(CLI::App& app);
 void add_devices_command(CLI::App& app);
 void add_render_command(CLI::App& app);
+void add_view_command(CLI::App& app);
 
 } // namespace vox::app

@@ -42,6 +42,7 @@ int main(int argc, char** argv)
     vox::app::add_ccd_check_command(app);
     vox::app::add_devices_command(app);
     vox::app::add_render_command(app);
+    vox::app::add_view_command(app);
 
     try {
         vox::check_memory_limit_environment();

@@ -71,21 +71,40 @@ void ScenePictures::write(const std::filesystem::path& path, const std::vector<r
 
 void ScenePictures::write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene)
 {
-    std::vector<render::DrawMesh> meshes{surface_drawing(sim.surface().mesh(sim.solver().positions()), m_options.smooth)};
+    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth)};
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
+    write(path, meshes);
+}
+
+render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth)
+{
+    render::DrawMesh d = surface_drawing(sim.surface().mesh(sim.solver().positions()), smooth);
     // Wet material shows darker and cooler, by its element's water content (what a sculptor sees
     // on soaked clay).
     const cut::ModelSurface& surface = sim.surface();
     const auto& slots = surface.embedded().vertices();
-    std::vector<Eigen::Vector3f>& colors = meshes.front().colors;
-    for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < colors.size(); ++slot) {
+    for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < d.colors.size(); ++slot) {
         if (!slots[slot].users) continue; // the mesh lists the slots in use, in order
         const std::uint32_t e = surface.vertex_element(slot);
         const auto w = e < sim.model().elements().size() ? static_cast<float>(sim.solver().water(e)) : 0.0f;
-        if (w > 0.0f) colors[v] = (1.0f - 0.5f * w) * colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);
+        if (w > 0.0f) d.colors[v] = (1.0f - 0.5f * w) * d.colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);
         ++v;
     }
-    for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
-    write(path, meshes);
+    return d;
+}
+
+render::DrawMesh element_cage(const SceneSimulation& sim)
+{
+    render::DrawMesh d;
+    d.lines = true;
+    const auto& x = sim.solver().positions();
+    for (const Eigen::Vector3d& p : x) d.positions.push_back((1e3 * p).cast<float>());
+    d.colors.assign(d.positions.size(), Eigen::Vector3f(0.15f, 0.2f, 0.3f));
+    // The 12 edges of a hexahedron by corner numbers (bit 0: +x, bit 1: +y, bit 2: +z).
+    static constexpr int edges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    for (const fem::HexElement& e : sim.model().elements())
+        for (const auto& [a, b] : edges) d.indices.insert(d.indices.end(), {e.dof_node[static_cast<std::size_t>(a)], e.dof_node[static_cast<std::size_t>(b)]});
+    return d;
 }
 
 } // namespace vox::app

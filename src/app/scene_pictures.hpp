@@ -32,6 +32,10 @@ struct PictureOptions {
 /// The surface mesh (world mm, labels per vertex) as a drawable mesh, smoothed for display by
 /// `smooth` Taubin iterations.
 [[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth);
+/// The simulation's deformed surface as drawn: label colours, wet material darker.
+[[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth);
+/// The simulated level's elements as a wire cage (their corner nodes where they are now).
+[[nodiscard]] render::DrawMesh element_cage(const SceneSimulation& sim);
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
 /// `margin_mm`) translucent when the margin is visible.
 void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);

@@ -53,6 +53,12 @@ public:
     /// A device moves `tool` from now on (its script entries are ignored): its pose for the next
     /// frames, world mm.
     void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation);
+    /// The device lets go of `tool`: the script places it again (nowhere, without entries).
+    void release(std::size_t tool)
+    {
+        m_driven.at(tool) = false;
+        m_last_pose[tool] = {};
+    }
 
     [[nodiscard]] const contact::ToolShape& shape(std::size_t tool) const { return m_shapes[tool]; }
 

@@ -78,6 +78,15 @@ Eigen::Matrix4f Camera::projection(double aspect) const
     return p.cast<float>();
 }
 
+Eigen::Vector3d view_direction(const CameraSpec& spec)
+{
+    // Yaw about up, pitch above the horizon; yaw 0 looks along -y, from the -y side (the front of
+    // a scan in patient coordinates faces -y), for up = +z; other ups turn that frame.
+    const double yaw = spec.yaw_deg * M_PI / 180.0, pitch = spec.pitch_deg * M_PI / 180.0;
+    const Eigen::Vector3d back(std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch));
+    return spec.up == Eigen::Vector3d::UnitZ() ? back : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), spec.up) * back;
+}
+
 Camera fit_camera(const CameraSpec& spec, std::span<const Eigen::Vector3f> points, double aspect)
 {
     Camera c;
@@ -88,11 +97,7 @@ Camera fit_camera(const CameraSpec& spec, std::span<const Eigen::Vector3f> point
     for (const Eigen::Vector3f& p : points) bounds.extend(p.cast<double>());
     if (bounds.isEmpty()) bounds.extend(Eigen::Vector3d::Zero());
     const double radius = std::max(0.5 * bounds.diagonal().norm(), 1e-3);
-    // Direction from the target to the eye: yaw about up, pitch above the horizon; yaw 0 looks
-    // along -y, from the -y side (the front of a scan in patient coordinates faces -y).
-    const double yaw = spec.yaw_deg * M_PI / 180.0, pitch = spec.pitch_deg * M_PI / 180.0;
-    Eigen::Vector3d back = Eigen::Vector3d(std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch));
-    if (spec.up != Eigen::Vector3d::UnitZ()) back = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), spec.up) * back;
+    const Eigen::Vector3d back = view_direction(spec);
     const Eigen::Vector3d right = (-back).cross(c.up).normalized(), up = right.cross(-back);
     // Centre the points' extent across the view, then step back until every point is in the
     // frame with 10 % of margin (the points themselves, not their box: a round object fills

@@ -32,6 +32,9 @@ struct Camera {
     [[nodiscard]] Eigen::Matrix4f projection(double aspect) const;
 };
 
+/// The unit direction from what the camera looks at to the camera, for `spec`'s yaw, pitch and up.
+[[nodiscard]] Eigen::Vector3d view_direction(const CameraSpec& spec);
+
 /// A camera looking as `spec` says at `points` (world mm), centred on them and far enough for
 /// all of them to fit a frame of width / height `aspect`, with a small margin.
 [[nodiscard]] Camera fit_camera(const CameraSpec& spec, std::span<const Eigen::Vector3f> points, double aspect);

@@ -162,19 +162,15 @@ void Renderer::resize(int width, int height)
     m_height = height;
 }
 
-Image Renderer::render(const std::vector<DrawMesh>& meshes, const Camera& camera, int width, int height)
+void Renderer::draw(const std::vector<DrawMesh>& meshes, const Camera& camera, int width, int height)
 {
-    if (width < 1 || height < 1 || width > 8192 || height > 8192)
-        throw InputError("picture size " + std::to_string(width) + " x " + std::to_string(height) + ": each side must be 1 to 8192 pixels");
-    resize(width, height);
-    glBindFramebuffer(GL_FRAMEBUFFER, m_msaa_fbo);
     glViewport(0, 0, width, height);
     glClearColor(background[0] / 255.0f, background[1] / 255.0f, background[2] / 255.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_MULTISAMPLE);
     const Eigen::Matrix4f view = camera.view(), projection = camera.projection(static_cast<double>(width) / height);
-    auto draw = [&](const DrawMesh& m) {
+    auto draw_one = [&](const DrawMesh& m) {
         if (m.indices.empty()) return;
         const GLuint program = m.lines ? m_line_program : m_program;
         glUseProgram(program);
@@ -186,19 +182,18 @@ Image Renderer::render(const std::vector<DrawMesh>& meshes, const Camera& camera
         glDrawElements(m.lines ? GL_LINES : GL_TRIANGLES, static_cast<GLsizei>(m.indices.size()), GL_UNSIGNED_INT, nullptr);
     };
     for (const DrawMesh& m : meshes)
-        if (m.alpha >= 1.0f) draw(m);
+        if (m.alpha >= 1.0f) draw_one(m);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     glDepthMask(GL_FALSE);
     for (const DrawMesh& m : meshes)
-        if (m.alpha < 1.0f) draw(m);
+        if (m.alpha < 1.0f) draw_one(m);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
-    // Resolve the samples, read back, flip to rows from the top.
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_msaa_fbo);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m_fbo);
-    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
+}
+
+Image read_pixels(int width, int height)
+{
     Image image;
     image.width = width;
     image.height = height;
@@ -206,11 +201,28 @@ Image Renderer::render(const std::vector<DrawMesh>& meshes, const Camera& camera
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba.data());
     const std::size_t row = static_cast<std::size_t>(width) * 4;
-    for (int y = 0; y < height / 2; ++y)
+    for (int y = 0; y < height / 2; ++y) // OpenGL's rows run from the bottom
         std::swap_ranges(image.rgba.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)),
                          image.rgba.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y + 1)),
                          image.rgba.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height - 1 - y)));
     for (std::size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = 255;
+    return image;
+}
+
+Image Renderer::render(const std::vector<DrawMesh>& meshes, const Camera& camera, int width, int height)
+{
+    if (width < 1 || height < 1 || width > 8192 || height > 8192)
+        throw InputError("picture size " + std::to_string(width) + " x " + std::to_string(height) + ": each side must be 1 to 8192 pixels");
+    resize(width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, m_msaa_fbo);
+    draw(meshes, camera, width, height);
+    // Resolve the samples, then read back.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_msaa_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m_fbo);
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, m_fbo);
+    Image image = read_pixels(width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (glGetError() != GL_NO_ERROR) throw std::runtime_error("render: OpenGL reported an error while drawing");
     return image;
 }

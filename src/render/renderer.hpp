@@ -24,8 +24,10 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     /// The picture of `meshes` seen by `camera`, `width` x `height` pixels (1 to 8192 each; throws
-    /// InputError otherwise). Opaque meshes first, then the translucent ones over them.
+    /// InputError otherwise), drawn offscreen. Opaque meshes first, then the translucent ones.
     [[nodiscard]] Image render(const std::vector<DrawMesh>& meshes, const Camera& camera, int width, int height);
+    /// Draws them into the framebuffer now bound (a window's), clearing it first.
+    void draw(const std::vector<DrawMesh>& meshes, const Camera& camera, int width, int height);
 
 private:
     void resize(int width, int height);
@@ -34,5 +36,8 @@ private:
     unsigned m_msaa_fbo = 0, m_msaa_color = 0, m_msaa_depth = 0, m_fbo = 0, m_color = 0;
     int m_width = 0, m_height = 0;
 };
+
+/// The bound read framebuffer's pixels, rows from the top.
+[[nodiscard]] Image read_pixels(int width, int height);
 
 } // namespace vox::render

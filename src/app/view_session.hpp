@@ -1,0 +1,30 @@
+#pragma once
+// voxsculpt view: interactive sculpting in a window. Three threads, as in a live session:
+//  - the haptic thread: the 1 kHz loop reads the device (the mouse and keyboard as a 3-DoF
+//    pointer when no haptic device is present), couples the tool to it against the newest surface
+//    snapshot, publishes the tool's pose;
+//  - the simulation thread: puts the tool there, lets it push, cut and wet, steps the FEM paced to
+//    wall time, publishes the surface near the tool (for the haptic thread) and the whole surface
+//    with the tools (for the window);
+//  - this thread: the window, input, camera and drawing. Neither other thread ever waits for it:
+//    they share triple buffers and atomics only.
+
+#include <string>
+
+namespace vox::app {
+
+struct ViewOptions {
+    std::string camera = "iso";
+    int width = 1280, height = 800;
+    int smooth = 4;                       ///< display smoothing (Taubin iterations)
+    std::size_t display_triangles = 150000; ///< draw a clustered copy above this many triangles (0: always the full surface)
+    double exit_after_s = 0.0;            ///< > 0: close by itself after this long (tests, recordings)
+    std::string screenshot;               ///< with exit_after_s: the last picture, PNG
+    std::string out_dir = ".";            ///< where screenshots and saved surfaces go
+};
+
+/// Runs the viewer on `scene_path` until the window closes. Throws InputError for a bad scene or
+/// option, render::NoOpenGL without a display.
+void run_view(const std::string& scene_path, const ViewOptions& options);
+
+} // namespace vox::app

@@ -1,0 +1,31 @@
+#pragma once
+// The mouse and keyboard as a 3-DoF device (no force output): the viewer's input thread sets
+// the position it points at, the haptic loop reads the newest one, neither waits (a triple
+// buffer). Used when no haptic device is present.
+
+#include "haptics/device.hpp"
+#include "haptics/triple_buffer.hpp"
+
+namespace vox::haptics {
+
+class PointerDevice final : public Device {
+public:
+    /// Starts at `start_mm`; the tool keeps `orientation` (a 3-DoF device does not turn it).
+    PointerDevice(const Eigen::Vector3d& start_mm, const Eigen::Quaterniond& orientation);
+    [[nodiscard]] std::string name() const override { return "mouse and keyboard (3-DoF, no force)"; }
+    [[nodiscard]] const DeviceLimits& limits() const override { return m_limits; }
+    bool read(double t_s, DeviceState& state) noexcept override;
+
+    /// Input thread: the tool's position from now on, world mm.
+    void point_at(const Eigen::Vector3d& position_mm) noexcept;
+    /// Input thread: the last position given.
+    [[nodiscard]] const Eigen::Vector3d& pointed() const noexcept { return m_pointed; }
+
+private:
+    TripleBuffer<Eigen::Vector3d> m_position;
+    Eigen::Vector3d m_pointed;
+    Eigen::Quaterniond m_orientation;
+    DeviceLimits m_limits;
+};
+
+} // namespace vox::haptics

@@ -1,0 +1,48 @@
+// The interactive viewer, run as CI runs it: in a window on a virtual display (xvfb-run), closing
+// by itself after a while with a screenshot; and without any display, one clear message.
+
+#include "app/run_command.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <stb/stb_image.h>
+
+#include <cstdlib>
+#include <memory>
+
+using namespace vox::test;
+namespace fs = std::filesystem;
+
+TEST(View, AWindowOnAVirtualDisplayShowsTheObjectAndTheRates)
+{
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+    ScratchDir dir;
+    const std::string program = VOX_VOXSCULPT_EXE;
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/wet_push.json");
+    const std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " + quote(program) + " view " + scene +
+                                " --size 640x480 --exit-after 3 --screenshot " + quote(dir.path("view.png")) + " > " + quote(dir.path("log.txt")) + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    int w = 0, h = 0, channels = 0;
+    std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load(dir.path("view.png").c_str(), &w, &h, &channels, 3), stbi_image_free);
+    ASSERT_TRUE(data);
+    EXPECT_EQ(w, 640);
+    EXPECT_EQ(h, 480);
+    // The clay block covers a good part of the window; the overlay's dark text is there too.
+    int clay = 0, text = 0;
+    for (int i = 0; i < w * h; ++i) {
+        const unsigned char* c = data.get() + 3 * i;
+        clay += c[0] > c[2] + 30 && c[0] > 100;
+        text += c[0] < 40 && c[1] < 40 && c[2] < 40;
+    }
+    EXPECT_GT(clay, w * h / 20);
+    EXPECT_GT(text, 100);
+}
+
+TEST(View, WithoutADisplayItSaysSoAndExits)
+{
+    if (std::getenv("DISPLAY") && *std::getenv("DISPLAY")) GTEST_SKIP() << "a display is present";
+    const auto r = run_voxsculpt("view " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/wet_push.json") + " --exit-after 1");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("no window"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("xvfb-run"), std::string::npos) << r.err;
+}
