@@ -26,6 +26,9 @@ void add_view_command(CLI::App& app)
     cmd->add_option("--exit-after", args->options.exit_after_s, "Close by itself after this many seconds (0: when you close it)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--screenshot", args->options.screenshot, "With --exit-after: write the last picture to this PNG file");
+    cmd->add_option("--device", args->options.device,
+                    "What drives the tool: auto (a 6-DoF controller if one can be opened, else the mouse; default), mouse, hid")
+        ->check(CLI::IsMember({"auto", "mouse", "hid"}));
     cmd->add_option("--out", args->options.out_dir, "Folder for screenshots (P) and saved surfaces (S) (default: the current folder)");
     cmd->callback([args] {
         std::tie(args->options.width, args->options.height) = parse_size(args->size);

@@ -121,6 +121,7 @@ ToolFrameStats ToolSession::frame(SceneSimulation& sim, grid::BranchedGrid& grid
             }
             stats.propagation_ms += clock.lap();
             if (!removed.empty() || !faces.empty()) {
+                if (m_cut_log) m_cut_log->push_back({removed, faces});
                 const CutTimings t = sim.apply_cut(grid, removed, faces);
                 stats.grid_update_ms += t.grid_update_ms;
                 stats.remesh_ms += t.remesh_ms;

@@ -40,6 +40,13 @@ struct ToolFrameStats {
     [[nodiscard]] double cutting_ms() const { return collision_ms + propagation_ms + grid_update_ms + remesh_ms; }
 };
 
+/// The voxels one cut removed and the faces it opened, in the order the cuts were made: replaying
+/// them on the same object rebuilds the same grid (the viewer's undo).
+struct CutRecord {
+    std::vector<grid::Coord> removed;
+    std::vector<std::pair<grid::Coord, int>> faces;
+};
+
 class ToolSession {
 public:
     /// Throws InputError when a mesh tool's file cannot be read.
@@ -65,6 +72,9 @@ public:
     /// Where `tool` was at the last frame (its shape null when it was not placed).
     [[nodiscard]] const contact::PlacedShape& placed(std::size_t tool) const { return m_last_pose[tool]; }
 
+    /// Every cut from now on is appended to `log` (null: no record).
+    void log_cuts(std::vector<CutRecord>* log) { m_cut_log = log; }
+
     /// Voxels that have had a face opened since the session began.
     [[nodiscard]] std::size_t separated_voxels() const { return m_separated.size(); }
 
@@ -82,6 +92,7 @@ private:
     std::vector<bool> m_driven;                   ///< a device moves the tool
     std::vector<contact::PlacedShape> m_driven_pose;
     std::vector<contact::PlacedShape> m_last_pose; ///< per tool, at the last frame it was placed (no shape: not placed)
+    std::vector<CutRecord>* m_cut_log = nullptr;
 };
 
 } // namespace vox::app

@@ -8,7 +8,9 @@
 #include "cut/surface_contact.hpp"
 #include "haptics/coupled_tool.hpp"
 #include "haptics/haptic_loop.hpp"
+#include "haptics/hid_devices.hpp"
 #include "haptics/pointer_device.hpp"
+#include "haptics/spacemouse_device.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -36,6 +38,17 @@ struct RenderState {
     std::vector<render::DrawMesh> meshes; ///< the surface first, then the tools (and the cage)
     double t_s = 0.0;
     std::size_t elements = 0;
+    int level = 0;
+    std::string tool;                     ///< the active tool and what it does
+};
+
+/// The state before a stroke, to undo it: how many cuts had been made, and the solver's state on
+/// the model those cuts give (rebuilt by replaying them, the same model node for node).
+struct Checkpoint {
+    std::size_t cuts = 0;
+    std::vector<Eigen::Vector3d> positions, velocities;
+    std::vector<double> water;
+    std::vector<Eigen::Matrix3d> plastic;
 };
 
 /// The tool the haptic thread moved, and where.
@@ -61,11 +74,14 @@ struct Orbit {
     }
 };
 
-const char* const key_map = "mouse left: move the tool in the view plane    wheel: tool nearer / farther\n"
-                            "mouse right: orbit    middle: pan    shift + wheel: zoom    R: reset the view\n"
-                            "TAB: next tool    SPACE: pause / run    N: one step while paused\n"
-                            "C: element cage    L: full surface / display level of detail\n"
-                            "S: save the surface (.obj)    P: screenshot (.png)    H or ?: this help    Q, ESC: quit";
+const char* const key_map = "mouse left: move the tool (a stroke)   wheel: nearer / farther\n"
+                            "mouse right: orbit   middle: pan   shift + wheel: zoom\n"
+                            "R: reset the view   TAB: next tool   1 push  2 cut  3 wet\n"
+                            "M: cut mode (remove / separate)   U: undo the last stroke\n"
+                            "SPACE: pause / run   N: one step while paused\n"
+                            "+ / -: coarser / finer level (deformation restarts)\n"
+                            "C: element cage   V: voxel steps   L: level of detail\n"
+                            "S: save (.obj, .vdb)   P: screenshot   H, ?: help   Q, ESC: quit";
 
 } // namespace
 
@@ -80,19 +96,46 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     spec.up = scene_up(scene);
     const grid::LabelGrid labels = io::load_scene_object(scene);
     const int level = std::max(scene.object.levels, 1);
-    grid::BranchedGrid g = build_scene_grid(scene, labels, level);
-    SceneSimulation sim(scene, g, level);
+    // The grid has two levels above the scene's, for the coarser-level key.
+    const int grid_levels = std::min(6, level + 2);
+    auto g = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, labels, grid_levels));
+    auto sim = std::make_unique<SceneSimulation>(scene, *g, level);
     ToolSession tools(scene);
+    std::vector<CutRecord> cut_log;
+    tools.log_cuts(&cut_log);
 
     // Where the first tool starts: where the scene's script puts it, else above the object.
-    render::DrawMesh first = surface_picture(sim, 0);
+    render::DrawMesh first = surface_picture(*sim, 0);
     Eigen::AlignedBox3d bounds;
     bounds.setEmpty();
     for (const std::uint32_t i : first.indices) bounds.extend(first.positions[i].cast<double>());
     const double radius = 0.5 * bounds.diagonal().norm();
     const io::ToolPose scripted = io::tool_pose(loaded, 0, 0.0);
     const Eigen::Vector3d start = scripted.placed ? scripted.position_mm : Eigen::Vector3d(bounds.center() + (radius + 10.0) * spec.up);
-    haptics::PointerDevice pointer(start, scripted.placed ? scripted.orientation : Eigen::Quaterniond::Identity());
+    const Eigen::Quaterniond start_orientation = scripted.placed ? scripted.orientation : Eigen::Quaterniond::Identity();
+    haptics::PointerDevice pointer(start, start_orientation);
+    // The device: a 6-DoF controller when there is one (the mouse then only moves the camera),
+    // else the mouse as a pointer.
+    std::unique_ptr<haptics::SpaceMouseDevice> controller;
+    if (options.device != "mouse") {
+        std::vector<haptics::HidDevice> found;
+        try {
+            found = haptics::enumerate_hid_devices();
+        } catch (const InputError& e) {
+            if (options.device == "hid") throw;
+            log::info("no HID devices ({}); the mouse drives the tool", e.what());
+        }
+        for (const haptics::HidDevice& d : found)
+            if (d.six_dof && d.openable) {
+                controller = std::make_unique<haptics::SpaceMouseDevice>(d.path, d.product, start, start_orientation);
+                break;
+            }
+        if (!controller && options.device == "hid")
+            throw InputError("--device hid: no 6-DoF controller can be opened. " +
+                             (found.empty() ? haptics::explain_no_hid_devices() : haptics::udev_rule_advice()));
+    }
+    haptics::Device& device = controller ? static_cast<haptics::Device&>(*controller) : static_cast<haptics::Device&>(pointer);
+    log::info("the tool is driven by: {}", device.name());
 
     // The haptic side: one coupled tool per scene tool, the active one used.
     constexpr std::size_t snapshot_capacity = 50000;
@@ -105,13 +148,15 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     haptics::TripleBuffer<ProxyPose> proxies;
     haptics::TripleBuffer<RenderState> pictures;
     std::atomic<int> active{0};
-    std::atomic<bool> stop{false}, paused{false}, step_once{false}, show_cage{false}, save_surface{false}, picture_taken{true};
+    std::atomic<bool> stop{false}, paused{false}, step_once{false}, show_cage{false}, show_voxels{false}, save_object{false}, picture_taken{true};
+    std::atomic<bool> stroke_started{false}, undo{false}, toggle_cut_mode{false};
+    std::atomic<int> level_change{0}, set_action{-1}; // requests from the window to the simulation thread
     std::atomic<std::uint64_t> ticks{0}, frames{0};
     const auto t0 = clock_type::now();
     auto now_s = [&t0] { return std::chrono::duration<double>(clock_type::now() - t0).count(); };
 
     haptics::HapticLoop loop(
-        pointer,
+        device,
         [&](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
             snapshots.update();
             const contact::SurfacePoints& surface = snapshots.read_slot();
@@ -125,17 +170,80 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         },
         haptics::SafetySettings{});
 
-    // The simulation thread.
+    log::info("viewer: {} ({} elements at level {}), tools: {}; press H for the keys", scene_path, sim->model().elements().size(), level,
+              scene.tools.size());
+    // The simulation thread (from here on the only one to touch the grid, the simulation, the
+    // tools' session and the scene's tool settings).
     std::string failure;
     std::thread simulation([&] {
         try {
             const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1); // the other core is the loop's
             const double dt = scene.solver.dt_s;
-            int driven = -1;
+            int driven = -1, simulated = level;
             contact::PlacedShape pose{&tools.shape(0), start, Eigen::Quaterniond::Identity()};
+            std::vector<Checkpoint> checkpoints;
+            // The object as it was after the first `cuts` cuts, at level `at`, from rest.
+            auto rebuild = [&](int at, std::size_t cuts) {
+                sim.reset();
+                g = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, labels, grid_levels));
+                sim = std::make_unique<SceneSimulation>(scene, *g, at);
+                for (std::size_t c = 0; c < cuts; ++c) sim->apply_cut(*g, cut_log[c].removed, cut_log[c].faces);
+                cut_log.resize(cuts);
+                if (driven >= 0) tools.release(static_cast<std::size_t>(driven));
+                driven = -1;
+                simulated = at;
+            };
             std::uint64_t frame = 0;
             auto next = clock_type::now();
             while (!stop.load()) {
+                // Requests from the window.
+                if (const int d = level_change.exchange(0); d != 0) {
+                    const int at = std::clamp(simulated + d, 1, grid_levels);
+                    if (at != simulated) {
+                        rebuild(at, cut_log.size());
+                        checkpoints.clear(); // the deformation restarts from rest at the new level
+                        log::info("level {}: {} elements (the cuts kept, the deformation from rest)", at, sim->model().elements().size());
+                    }
+                }
+                if (stroke_started.exchange(false)) {
+                    Checkpoint c;
+                    c.cuts = cut_log.size();
+                    c.positions = sim->solver().positions();
+                    c.velocities = sim->solver().velocities();
+                    for (std::uint32_t e = 0; e < sim->model().elements().size(); ++e) {
+                        c.water.push_back(sim->solver().water(e));
+                        c.plastic.push_back(sim->solver().plastic_strain(e));
+                    }
+                    checkpoints.push_back(std::move(c));
+                    if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
+                }
+                if (undo.exchange(false)) {
+                    if (checkpoints.empty()) {
+                        log::info("undo: nothing to undo");
+                    } else {
+                        const Checkpoint c = std::move(checkpoints.back());
+                        checkpoints.pop_back();
+                        rebuild(simulated, c.cuts);
+                        fem::ImplicitSolver& s = sim->solver();
+                        if (s.positions().size() == c.positions.size()) {
+                            s.positions() = c.positions;
+                            s.velocities() = c.velocities;
+                            for (std::uint32_t e = 0; e < c.water.size() && e < sim->model().elements().size(); ++e) {
+                                s.set_water(e, c.water[e]);
+                                s.set_plastic_strain(e, c.plastic[e]);
+                            }
+                        }
+                        log::info("undo: back to before the last stroke ({} cuts)", c.cuts);
+                    }
+                }
+                if (const int a = set_action.exchange(-1); a >= 0) {
+                    io::ToolSpec& t = scene.tools[static_cast<std::size_t>(active.load())];
+                    t.action = a == 0 ? io::ToolAction::push : a == 1 ? io::ToolAction::cut : io::ToolAction::wet;
+                }
+                if (toggle_cut_mode.exchange(false)) {
+                    io::ToolSpec& t = scene.tools[static_cast<std::size_t>(active.load())];
+                    t.cut_mode = t.cut_mode == io::CutMode::remove ? io::CutMode::separate : io::CutMode::remove;
+                }
                 if (paused.load() && !step_once.exchange(false)) {
                     std::this_thread::sleep_for(std::chrono::milliseconds(5));
                     next = clock_type::now();
@@ -148,27 +256,40 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                     pose = p.pose;
                 }
                 if (driven >= 0) tools.drive(static_cast<std::size_t>(driven), pose.position, pose.orientation);
-                const ToolFrameStats t = tools.frame(sim, g, static_cast<double>(frame + 1) * dt, dt);
-                if (!t.hold_object) sim.solver().step();
+                const ToolFrameStats t = tools.frame(*sim, *g, static_cast<double>(frame + 1) * dt, dt);
+                if (!t.hold_object) sim->solver().step();
                 contact::SurfacePoints& out = snapshots.write_slot();
                 const double margin = scene.tools[static_cast<std::size_t>(std::max(driven, 0))].push_margin_mm;
-                cut::sample_surface(sim.surface(), sim.solver().positions(), pose.world_bounds(margin + 5.0), out);
+                cut::sample_surface(sim->surface(), sim->solver().positions(), pose.world_bounds(margin + 5.0), out);
                 out.t_s = now_s();
                 snapshots.publish();
-                if (save_surface.exchange(false)) {
-                    const std::filesystem::path path = std::filesystem::path(options.out_dir) / "view_surface.obj";
-                    const surface::SurfaceMesh m = sim.surface().mesh(sim.solver().positions());
-                    io::write_mesh(path.string(), m.positions, m.triangles, m.labels);
-                    log::info("saved the surface to {} ({} triangles)", path.string(), m.triangles.size());
+                if (save_object.exchange(false)) {
+                    const std::filesystem::path dir(options.out_dir);
+                    const surface::SurfaceMesh m = sim->surface().mesh(sim->solver().positions());
+                    io::write_mesh((dir / "view_surface.obj").string(), m.positions, m.triangles, m.labels);
+                    const grid::FineVoxels& voxels = g->voxels();
+                    grid::LabelGrid kept(voxels.index_to_world());
+                    for (std::uint32_t v = 0; v < voxels.slots(); ++v)
+                        if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
+                    kept.save(dir / "view_object.vdb");
+                    log::info("saved the deformed surface to {} ({} triangles) and the object's {} voxels to {}", (dir / "view_surface.obj").string(),
+                              m.triangles.size(), voxels.alive_count(), (dir / "view_object.vdb").string());
                 }
                 if (picture_taken.exchange(false)) { // the window has the last one: make the next
                     RenderState& r = pictures.write_slot();
                     r.meshes.clear();
-                    r.meshes.push_back(surface_picture(sim, options.smooth));
+                    r.meshes.push_back(surface_picture(*sim, show_voxels.load() ? 0 : options.smooth));
                     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, r.meshes);
-                    if (show_cage.load()) r.meshes.push_back(element_cage(sim));
+                    if (show_cage.load()) r.meshes.push_back(element_cage(*sim));
                     r.t_s = static_cast<double>(frame + 1) * dt;
-                    r.elements = sim.model().elements().size();
+                    r.elements = sim->model().elements().size();
+                    r.level = simulated;
+                    const io::ToolSpec& tool = scene.tools[static_cast<std::size_t>(active.load())];
+                    r.tool = tool.name + " (" +
+                             (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")
+                              : tool.action == io::ToolAction::wet ? std::string("wet")
+                                                                   : std::string("push")) +
+                             ")";
                     pictures.publish();
                 }
                 ++frame;
@@ -226,8 +347,16 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         case GLFW_KEY_N: step_once = true; break;
         case GLFW_KEY_TAB: active = (active.load() + 1) % static_cast<int>(scene.tools.size()); break;
         case GLFW_KEY_C: show_cage = !show_cage.load(); break;
+        case GLFW_KEY_V: show_voxels = !show_voxels.load(); break;
         case GLFW_KEY_L: use_lod = !use_lod; break;
-        case GLFW_KEY_S: save_surface = true; break;
+        case GLFW_KEY_S: save_object = true; break;
+        case GLFW_KEY_U: undo = true; break;
+        case GLFW_KEY_M: toggle_cut_mode = true; break;
+        case GLFW_KEY_1: set_action = 0; break;
+        case GLFW_KEY_2: set_action = 1; break;
+        case GLFW_KEY_3: set_action = 2; break;
+        case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: level_change = 1; break;    // coarser: faster
+        case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: level_change = -1; break; // finer: more accurate
         case GLFW_KEY_P: screenshot = true; break;
         case GLFW_KEY_R: orbit = home; break;
         case GLFW_KEY_H: case GLFW_KEY_SLASH: show_help = !show_help; break;
@@ -251,7 +380,9 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         }
     };
     input.button = [&](int button, bool down, int) {
-        if (button == GLFW_MOUSE_BUTTON_LEFT && down) pointer.point_at(pointer_at(mouse_x, mouse_y));
+        if (button != GLFW_MOUSE_BUTTON_LEFT || !down) return;
+        stroke_started = true; // a stroke begins: what U undoes
+        pointer.point_at(pointer_at(mouse_x, mouse_y));
     };
     input.scroll = [&](double dy, int mods) {
         if (mods & GLFW_MOD_SHIFT) {
@@ -266,10 +397,10 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     render::Renderer renderer;
     render::TextOverlay text;
     loop.start();
-    log::info("viewer: {} ({} elements at level {}), tools: {}; press H for the keys", scene_path, sim.model().elements().size(), level,
-              scene.tools.size());
+
 
     std::unique_ptr<render::DisplayLod> lod;
+    std::size_t lod_source_triangles = 0;
     std::vector<render::DrawMesh> drawn;
     double rate_time = now_s(), sim_rate = 0, haptic_rate = 0, draw_rate = 0;
     std::uint64_t last_frames = 0, last_ticks = 0, draws = 0;
@@ -288,6 +419,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         if (fresh) { // a new picture: take it (and its lighter copy) once
             const RenderState& state = pictures.read_slot();
             drawn = state.meshes;
+            lod_source_triangles = drawn.empty() ? 0 : drawn.front().indices.size() / 3;
             if (use_lod && !drawn.empty() && drawn.front().indices.size() / 3 > options.display_triangles) {
                 if (!lod || !lod->fits(drawn.front()))
                     lod = std::make_unique<render::DisplayLod>(drawn.front(), render::lod_cell_mm(drawn.front(), options.display_triangles));
@@ -309,17 +441,16 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             draws = 0;
             rate_time = t;
         }
-        const io::ToolSpec& tool = scene.tools[static_cast<std::size_t>(active.load())];
+        const RenderState* shown = have_picture ? &pictures.read_slot() : nullptr;
         char status[512];
         std::snprintf(status, sizeof status,
-                      "simulation %.0f Hz%s   haptics %.0f Hz   drawing %.0f Hz\n%zu elements, level %d   surface %zu triangles%s\ntool %s (%s)%s   "
+                      "simulation %.0f Hz%s   haptics %.0f Hz   drawing %.0f Hz\n%zu elements, level %d   surface %zu triangles%s\ntool %s%s   "
                       "H: keys",
-                      sim_rate, paused.load() ? " (paused)" : "", haptic_rate, draw_rate, have_picture ? pictures.read_slot().elements : 0, level,
-                      drawn.empty() ? 0 : drawn.front().indices.size() / 3, use_lod && lod ? " (display level of detail)" : "", tool.name.c_str(),
-                      tool.action == io::ToolAction::cut ? "cut" : tool.action == io::ToolAction::wet ? "wet" : "push",
-                      show_cage.load() ? "   cage shown" : "");
+                      sim_rate, paused.load() ? " (paused)" : "", haptic_rate, draw_rate, shown ? shown->elements : 0, shown ? shown->level : level,
+                      drawn.empty() ? 0 : drawn.front().indices.size() / 3, use_lod && lod && drawn.front().indices.size() / 3 < lod_source_triangles ? " (display level of detail)" : "",
+                      shown ? shown->tool.c_str() : "", show_cage.load() ? "   cage shown" : "");
         text.draw(status, 14, 14, width, height);
-        if (show_help) text.draw(key_map, 14, height - 110, width, height);
+        if (show_help) text.draw(key_map, 14, height - 8 * 22 - 14, width, height);
         const bool last = options.exit_after_s > 0.0 && t >= options.exit_after_s;
         if (screenshot || (last && !options.screenshot.empty())) {
             const std::filesystem::path path = last && !options.screenshot.empty()

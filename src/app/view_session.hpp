@@ -21,6 +21,9 @@ struct ViewOptions {
     double exit_after_s = 0.0;            ///< > 0: close by itself after this long (tests, recordings)
     std::string screenshot;               ///< with exit_after_s: the last picture, PNG
     std::string out_dir = ".";            ///< where screenshots and saved surfaces go
+    /// "auto": a 6-DoF controller when one can be opened, else the mouse; "mouse"; "hid" (a
+    /// controller, or an error saying why there is none).
+    std::string device = "auto";
 };
 
 /// Runs the viewer on `scene_path` until the window closes. Throws InputError for a bad scene or

@@ -1,6 +1,7 @@
 // SpaceMouse-class HID reports: both report layouts, buttons, unknown reports, and the axis
 // mapping (dead zone, sign, clamping).
 
+#include "haptics/spacemouse_device.hpp"
 #include "haptics/spacemouse_report.hpp"
 
 #include <gtest/gtest.h>
@@ -64,4 +65,24 @@ TEST(SpaceMouseReport, MappingAppliesTableDeadZoneAndClamp)
     EXPECT_DOUBLE_EQ(out[1], 0.0);                    // raw x = 10: inside the dead zone
     EXPECT_DOUBLE_EQ(out[2], -1.0);                   // 1000 clamps to 1, sign flipped
     EXPECT_DOUBLE_EQ(out[5], (183.0 - 16) / (366 - 16)); // continuous past the dead zone
+}
+
+TEST(SpaceMouseRateControl, FullDeflectionMovesAndTurnsAtTheSetRates)
+{
+    // Half a second at full +x deflection: 30 mm at 60 mm/s; a second at full rz: 90 degrees
+    // about z at 90 degrees/s, in ten steps as the loop would take them.
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+    for (int i = 0; i < 10; ++i) vox::haptics::integrate_six_dof({1, 0, 0, 0, 0, 0}, 0.05, {}, p, q);
+    EXPECT_NEAR(p.x(), 30.0, 1e-9);
+    EXPECT_NEAR(p.tail<2>().norm(), 0.0, 1e-12);
+    for (int i = 0; i < 10; ++i) vox::haptics::integrate_six_dof({0, 0, 0, 0, 0, 1}, 0.1, {}, p, q);
+    EXPECT_NEAR(q.angularDistance(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()))), 0.0, 1e-9);
+    EXPECT_NEAR(p.x(), 30.0, 1e-9); // turning does not move it
+    // A cap at rest inside the dead zone does nothing.
+    vox::haptics::SixAxisState raw;
+    raw.axes = {10, -12, 5, 0, 3, -15};
+    const Eigen::Vector3d before = p;
+    vox::haptics::integrate_six_dof(vox::haptics::map_axes(raw, {}), 1.0, {}, p, q);
+    EXPECT_EQ(p, before);
 }
