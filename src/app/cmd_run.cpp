@@ -115,6 +115,7 @@ void add_run_command(CLI::App& app)
         std::unique_ptr<ScenePictures> pictures;
         if (args->render_every > 0) {
             pictures = std::make_unique<ScenePictures>(picture_options);
+            pictures->remember_uncut(sim);
             log::info("pictures every {} frames ({} x {}, {})", args->render_every, picture_options.width, picture_options.height,
                       pictures->context_description());
         }

@@ -71,20 +71,29 @@ void ScenePictures::write(const std::filesystem::path& path, const std::vector<r
 
 void ScenePictures::write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene)
 {
-    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth)};
+    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth, m_uncut.empty() ? nullptr : &m_uncut)};
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
     write(path, meshes);
 }
 
-render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth)
+std::unordered_set<std::uint64_t> surface_keys(const SceneSimulation& sim)
+{
+    std::unordered_set<std::uint64_t> keys;
+    for (const surface::SurfaceVertex& v : sim.surface().embedded().vertices())
+        if (v.users) keys.insert(v.key);
+    return keys;
+}
+
+render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut)
 {
     render::DrawMesh d = surface_drawing(sim.surface().mesh(sim.solver().positions()), smooth);
     // Wet material shows darker and cooler, by its element's water content (what a sculptor sees
-    // on soaked clay).
+    // on soaked clay); cut surfaces lighter, as freshly cut tissue or clay looks.
     const cut::ModelSurface& surface = sim.surface();
     const auto& slots = surface.embedded().vertices();
     for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < d.colors.size(); ++slot) {
         if (!slots[slot].users) continue; // the mesh lists the slots in use, in order
+        if (uncut && !uncut->contains(slots[slot].key)) d.colors[v] = 0.5f * d.colors[v] + 0.5f * Eigen::Vector3f(0.95f, 0.70f, 0.62f); // cut surface
         const std::uint32_t e = surface.vertex_element(slot);
         const auto w = e < sim.model().elements().size() ? static_cast<float>(sim.solver().water(e)) : 0.0f;
         if (w > 0.0f) d.colors[v] = (1.0f - 0.5f * w) * d.colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <unordered_set>
 
 namespace vox::app {
 
@@ -32,8 +33,11 @@ struct PictureOptions {
 /// The surface mesh (world mm, labels per vertex) as a drawable mesh, smoothed for display by
 /// `smooth` Taubin iterations.
 [[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth);
-/// The simulation's deformed surface as drawn: label colours, wet material darker.
-[[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth);
+/// The identities of the surface's vertices now: those a later cut creates are not among them.
+[[nodiscard]] std::unordered_set<std::uint64_t> surface_keys(const SceneSimulation& sim);
+/// The simulation's deformed surface as drawn: label colours, wet material darker, and, with
+/// `uncut` (surface_keys() before any cut), the surface cuts have made in a lighter, pinker tone.
+[[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut = nullptr);
 /// The simulated level's elements as a wire cage (their corner nodes where they are now).
 [[nodiscard]] render::DrawMesh element_cage(const SceneSimulation& sim);
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
@@ -49,6 +53,8 @@ public:
     void write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes);
     /// The simulation's surface and placed tools.
     void write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene);
+    /// Remembers the surface as it is (before any cut), so that cut surfaces show in their own tone.
+    void remember_uncut(const SceneSimulation& sim) { m_uncut = surface_keys(sim); }
 
     [[nodiscard]] const std::string& context_description() const { return m_context.description(); }
 
@@ -57,6 +63,7 @@ private:
     render::OffscreenContext m_context;
     render::Renderer m_renderer;
     std::optional<render::Camera> m_camera;
+    std::unordered_set<std::uint64_t> m_uncut;
 };
 
 } // namespace vox::app

@@ -182,6 +182,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             int driven = -1, simulated = level;
             contact::PlacedShape pose{&tools.shape(0), start, Eigen::Quaterniond::Identity()};
             std::vector<Checkpoint> checkpoints;
+            const std::unordered_set<std::uint64_t> uncut = surface_keys(*sim); // cut surfaces show in their own tone
             // The object as it was after the first `cuts` cuts, at level `at`, from rest.
             auto rebuild = [&](int at, std::size_t cuts) {
                 sim.reset();
@@ -278,7 +279,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 if (picture_taken.exchange(false)) { // the window has the last one: make the next
                     RenderState& r = pictures.write_slot();
                     r.meshes.clear();
-                    r.meshes.push_back(surface_picture(*sim, show_voxels.load() ? 0 : options.smooth));
+                    r.meshes.push_back(surface_picture(*sim, show_voxels.load() ? 0 : options.smooth, &uncut));
                     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, r.meshes);
                     if (show_cage.load()) r.meshes.push_back(element_cage(*sim));
                     r.t_s = static_cast<double>(frame + 1) * dt;
