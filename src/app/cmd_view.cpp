@@ -23,7 +23,7 @@ void add_view_command(CLI::App& app)
     cmd->add_option("--smooth", args->options.smooth, "Display smoothing of the surface, Taubin iterations (default 4)")->check(CLI::Range(0, 200));
     cmd->add_option("--display-triangles", args->options.display_triangles,
                     "Draw a clustered copy of surfaces with more triangles than this (default 150000; 0: always the full surface)");
-    cmd->add_option("--exit-after", args->options.exit_after_s, "Close by itself after this many seconds (0: when you close it)")
+    cmd->add_option("--exit-after", args->options.exit_after_s, "Close by itself this many seconds after the first picture (0: when you close it)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--screenshot", args->options.screenshot, "With --exit-after: write the last picture to this PNG file");
     cmd->add_option("--device", args->options.device,

@@ -40,6 +40,7 @@ struct RenderState {
     std::size_t elements = 0;
     int level = 0;
     std::string tool;                     ///< the active tool and what it does
+    int smooth = 0;                       ///< display smoothing the window is to give the surface
 };
 
 /// The state before a stroke, to undo it: how many cuts had been made, and the solver's state on
@@ -51,10 +52,12 @@ struct Checkpoint {
     std::vector<Eigen::Matrix3d> plastic;
 };
 
-/// The tool the haptic thread moved, and where.
+/// The tool the haptic thread moved, where, and where the device is heading (the surface
+/// snapshot must reach that far).
 struct ProxyPose {
     int tool = 0;
     contact::PlacedShape pose;
+    Eigen::Vector3d heading = Eigen::Vector3d::Zero();
 };
 
 /// An orbiting camera: yaw and pitch about `up` around a target, at a distance.
@@ -94,6 +97,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     scene.script.clear();
     render::CameraSpec spec = render::parse_camera(options.camera);
     spec.up = scene_up(scene);
+    spec.orthographic = false; // the viewer orbits in perspective
     const grid::LabelGrid labels = io::load_scene_object(scene);
     const int level = std::max(scene.object.levels, 1);
     // The grid has two levels above the scene's, for the coarser-level key.
@@ -163,7 +167,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             age = now_s() - surface.t_s;
             const int k = active.load(std::memory_order_relaxed);
             const Eigen::Vector3d f = coupled[static_cast<std::size_t>(k)]->update(s, surface, 1e-3);
-            proxies.write_slot() = {k, coupled[static_cast<std::size_t>(k)]->proxy()};
+            proxies.write_slot() = {k, coupled[static_cast<std::size_t>(k)]->proxy(), controller ? s.position_mm : pointer.target()};
             proxies.publish();
             ticks.fetch_add(1, std::memory_order_relaxed);
             return f;
@@ -181,6 +185,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             const double dt = scene.solver.dt_s;
             int driven = -1, simulated = level;
             contact::PlacedShape pose{&tools.shape(0), start, Eigen::Quaterniond::Identity()};
+            Eigen::Vector3d heading = start;
             std::vector<Checkpoint> checkpoints;
             const std::unordered_set<std::uint64_t> uncut = surface_keys(*sim); // cut surfaces show in their own tone
             // The object as it was after the first `cuts` cuts, at level `at`, from rest.
@@ -205,18 +210,6 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                         checkpoints.clear(); // the deformation restarts from rest at the new level
                         log::info("level {}: {} elements (the cuts kept, the deformation from rest)", at, sim->model().elements().size());
                     }
-                }
-                if (stroke_started.exchange(false)) {
-                    Checkpoint c;
-                    c.cuts = cut_log.size();
-                    c.positions = sim->solver().positions();
-                    c.velocities = sim->solver().velocities();
-                    for (std::uint32_t e = 0; e < sim->model().elements().size(); ++e) {
-                        c.water.push_back(sim->solver().water(e));
-                        c.plastic.push_back(sim->solver().plastic_strain(e));
-                    }
-                    checkpoints.push_back(std::move(c));
-                    if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
                 }
                 if (undo.exchange(false)) {
                     if (checkpoints.empty()) {
@@ -255,16 +248,33 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                     if (p.tool != driven && driven >= 0) tools.release(static_cast<std::size_t>(driven));
                     driven = p.tool;
                     pose = p.pose;
+                    heading = p.heading;
+                }
+                // A stroke's checkpoint before any of its cuts: the window flags the stroke before it
+                // moves the pointer, so a pose read above that belongs to the stroke sees the flag.
+                if (stroke_started.exchange(false)) {
+                    Checkpoint c;
+                    c.cuts = cut_log.size();
+                    c.positions = sim->solver().positions();
+                    c.velocities = sim->solver().velocities();
+                    for (std::uint32_t e = 0; e < sim->model().elements().size(); ++e) {
+                        c.water.push_back(sim->solver().water(e));
+                        c.plastic.push_back(sim->solver().plastic_strain(e));
+                    }
+                    checkpoints.push_back(std::move(c));
+                    if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
                 }
                 if (driven >= 0) tools.drive(static_cast<std::size_t>(driven), pose.position, pose.orientation);
                 const ToolFrameStats t = tools.frame(*sim, *g, static_cast<double>(frame + 1) * dt, dt);
                 if (!t.hold_object) sim->solver().step();
                 contact::SurfacePoints& out = snapshots.write_slot();
                 const double margin = scene.tools[static_cast<std::size_t>(std::max(driven, 0))].push_margin_mm;
-                cut::sample_surface(sim->surface(), sim->solver().positions(), pose.world_bounds(margin + 5.0), out);
+                Eigen::AlignedBox3d near = pose.world_bounds(margin + 5.0);
+                near.extend(contact::PlacedShape{pose.shape, heading, pose.orientation}.world_bounds(margin + 5.0));
+                cut::sample_surface(sim->surface(), sim->solver().positions(), near, out);
                 out.t_s = now_s();
                 snapshots.publish();
-                if (save_object.exchange(false)) {
+                if (save_object.exchange(false)) try {
                     const std::filesystem::path dir(options.out_dir);
                     const surface::SurfaceMesh m = sim->surface().mesh(sim->solver().positions());
                     io::write_mesh((dir / "view_surface.obj").string(), m.positions, m.triangles, m.labels);
@@ -275,11 +285,14 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                     kept.save(dir / "view_object.vdb");
                     log::info("saved the deformed surface to {} ({} triangles) and the object's {} voxels to {}", (dir / "view_surface.obj").string(),
                               m.triangles.size(), voxels.alive_count(), (dir / "view_object.vdb").string());
+                } catch (const std::exception& e) {
+                    log::warn("not saved: {}", e.what()); // the session goes on
                 }
                 if (picture_taken.exchange(false)) { // the window has the last one: make the next
                     RenderState& r = pictures.write_slot();
                     r.meshes.clear();
-                    r.meshes.push_back(surface_picture(*sim, show_voxels.load() ? 0 : options.smooth, &uncut));
+                    r.meshes.push_back(surface_picture(*sim, 0, &uncut)); // smoothed by the window's thread
+                    r.smooth = show_voxels.load() ? 0 : options.smooth;
                     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, r.meshes);
                     if (show_cage.load()) r.meshes.push_back(element_cage(*sim));
                     r.t_s = static_cast<double>(frame + 1) * dt;
@@ -331,16 +344,19 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     bool show_help = false, use_lod = options.display_triangles > 0, screenshot = false;
     int width = options.width, height = options.height, shots = 0;
     // The tool's point under the cursor, at the depth of where the tool now is.
+    render::Window* window_ptr = nullptr;
     auto pointer_at = [&](double x, double y) {
         const render::Camera c = orbit.camera();
-        const Eigen::Vector3d forward = (c.target - c.eye).normalized(), right = forward.cross(c.up).normalized(), up = right.cross(forward);
-        const double tan_v = std::tan(0.5 * c.fov_y_deg * M_PI / 180.0), tan_h = tan_v * width / height;
-        const Eigen::Vector3d ray = (forward + (2.0 * x / width - 1.0) * tan_h * right + (1.0 - 2.0 * y / height) * tan_v * up).normalized();
+        Eigen::Vector3d right, up, forward;
+        c.basis(right, up, forward);
+        int w = 1, h = 1; // the cursor is in window units (not framebuffer pixels on a scaled display)
+        window_ptr->window_size(w, h);
+        const double tan_v = std::tan(0.5 * c.fov_y_deg * M_PI / 180.0), tan_h = tan_v * w / h;
+        const Eigen::Vector3d ray = (forward + (2.0 * x / w - 1.0) * tan_h * right + (1.0 - 2.0 * y / h) * tan_v * up).normalized();
         const double depth = (pointer.pointed() - c.eye).dot(forward);
         return Eigen::Vector3d(c.eye + ray * (depth / ray.dot(forward)));
     };
     render::InputHandlers input;
-    render::Window* window_ptr = nullptr;
     input.key = [&](int key, int) {
         switch (key) {
         case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: window_ptr->close(); break;
@@ -375,8 +391,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             orbit.spec.pitch_deg = std::clamp(orbit.spec.pitch_deg + 0.3 * dy, -89.0, 89.0);
         }
         if (window_ptr->button_down(GLFW_MOUSE_BUTTON_MIDDLE)) {
-            const render::Camera c = orbit.camera();
-            const Eigen::Vector3d forward = (c.target - c.eye).normalized(), right = forward.cross(c.up).normalized(), up = right.cross(forward);
+            Eigen::Vector3d right, up, forward;
+            orbit.camera().basis(right, up, forward);
             orbit.target -= (dx * right - dy * up) * orbit.distance * 0.0015;
         }
     };
@@ -406,6 +422,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     double rate_time = now_s(), sim_rate = 0, haptic_rate = 0, draw_rate = 0;
     std::uint64_t last_frames = 0, last_ticks = 0, draws = 0;
     bool have_picture = false;
+    double first_shown = -1.0; // when the first picture was drawn (--exit-after counts from there)
     while (!window.should_close() && !stop.load()) {
         const bool fresh = pictures.update();
         if (fresh) {
@@ -420,6 +437,10 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         if (fresh) { // a new picture: take it (and its lighter copy) once
             const RenderState& state = pictures.read_slot();
             drawn = state.meshes;
+            if (!drawn.empty() && state.smooth > 0) { // off the simulation thread
+                render::smooth_for_display(drawn.front(), state.smooth);
+                render::compute_normals(drawn.front());
+            }
             lod_source_triangles = drawn.empty() ? 0 : drawn.front().indices.size() / 3;
             if (use_lod && !drawn.empty() && drawn.front().indices.size() / 3 > options.display_triangles) {
                 if (!lod || !lod->fits(drawn.front()))
@@ -452,13 +473,19 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                       shown ? shown->tool.c_str() : "", show_cage.load() ? "   cage shown" : "");
         text.draw(status, 14, 14, width, height);
         if (show_help) text.draw(key_map, 14, height - 8 * 22 - 14, width, height);
-        const bool last = options.exit_after_s > 0.0 && t >= options.exit_after_s;
+        if (have_picture && first_shown < 0.0) first_shown = t;
+        const bool last = options.exit_after_s > 0.0 && first_shown >= 0.0 && t >= first_shown + options.exit_after_s;
         if (screenshot || (last && !options.screenshot.empty())) {
             const std::filesystem::path path = last && !options.screenshot.empty()
                                                    ? std::filesystem::path(options.screenshot)
                                                    : std::filesystem::path(options.out_dir) / ("view_" + std::to_string(++shots) + ".png");
-            render::write_png(path, render::read_pixels(width, height));
-            log::info("screenshot: {}", path.string());
+            try {
+                render::write_png(path, render::read_pixels(width, height));
+                log::info("screenshot: {}", path.string());
+            } catch (const InputError& e) {
+                if (last) throw; // the screenshot asked for on the command line
+                log::warn("no screenshot: {}", e.what());
+            }
             screenshot = false;
         }
         window.present();

@@ -18,7 +18,7 @@ struct ViewOptions {
     int width = 1280, height = 800;
     int smooth = 4;                       ///< display smoothing (Taubin iterations)
     std::size_t display_triangles = 150000; ///< draw a clustered copy above this many triangles (0: always the full surface)
-    double exit_after_s = 0.0;            ///< > 0: close by itself after this long (tests, recordings)
+    double exit_after_s = 0.0;            ///< > 0: close by itself this long after the first picture (tests, recordings)
     std::string screenshot;               ///< with exit_after_s: the last picture, PNG
     std::string out_dir = ".";            ///< where screenshots and saved surfaces go
     /// "auto": a 6-DoF controller when one can be opened, else the mouse; "mouse"; "hid" (a

@@ -36,9 +36,15 @@ SpaceMouseDevice::~SpaceMouseDevice()
 bool SpaceMouseDevice::read(double t_s, DeviceState& state) noexcept
 {
     // Drain what has arrived since the last tick (reports come at about 60-120 Hz), never waiting.
+    // A failed read (the controller unplugged) stops the tool where it is: the last deflection must
+    // not keep moving it, and hidapi is not asked again (its error path allocates).
     std::uint8_t report[64];
-    for (int n = 0; n < 16; ++n) {
+    for (int n = 0; n < 16 && !m_failed; ++n) {
         const int got = hid_read_timeout(static_cast<hid_device*>(m_handle), report, sizeof report, 0);
+        if (got < 0) {
+            m_failed = true;
+            m_raw = {};
+        }
         if (got <= 0) break;
         parse_spacemouse_report(std::span<const std::uint8_t>(report, static_cast<std::size_t>(got)), m_raw);
     }

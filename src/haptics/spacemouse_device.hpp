@@ -46,6 +46,7 @@ private:
     Eigen::Vector3d m_position;
     Eigen::Quaterniond m_orientation;
     double m_last_t = -1.0;
+    bool m_failed = false; ///< a read failed: the device is gone
 };
 
 } // namespace vox::haptics

@@ -42,11 +42,17 @@ CameraSpec parse_camera(const std::string& spec)
                      "(pitch within +-90), optionally followed by \",ortho\"");
 }
 
+void Camera::basis(Eigen::Vector3d& right, Eigen::Vector3d& screen_up, Eigen::Vector3d& forward) const
+{
+    forward = (target - eye).normalized();
+    right = forward.cross(up).normalized();
+    screen_up = right.cross(forward);
+}
+
 Eigen::Matrix4f Camera::view() const
 {
-    const Eigen::Vector3d f = (target - eye).normalized();
-    const Eigen::Vector3d s = f.cross(up).normalized();
-    const Eigen::Vector3d u = s.cross(f);
+    Eigen::Vector3d s, u, f;
+    basis(s, u, f);
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     m.block<1, 3>(0, 0) = s.transpose();
     m.block<1, 3>(1, 0) = u.transpose();

@@ -29,6 +29,8 @@ struct Camera {
     double near_mm = 1.0, far_mm = 1000.0;
 
     [[nodiscard]] Eigen::Matrix4f view() const;
+    /// The view's unit axes in the world: right, up (on screen) and forward (into the screen).
+    void basis(Eigen::Vector3d& right, Eigen::Vector3d& screen_up, Eigen::Vector3d& forward) const;
     [[nodiscard]] Eigen::Matrix4f projection(double aspect) const;
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 // A lighter copy of a big surface for drawing on a slow (software) renderer: vertices clustered
-// on a grid of cells, each cluster drawn as one vertex at its members' mean, triangles whose
-// corners fall in fewer than three clusters dropped. The clustering is made once for a mesh's
+// by grid cell and facing (a cut's two walls face apart and stay apart), each cluster drawn as one
+// vertex at its members' mean, triangles whose corners fall in fewer than three clusters dropped. The clustering is made once for a mesh's
 // connectivity (again after a cut changes it); each frame only the means are taken.
 
 #include "render/draw_mesh.hpp"

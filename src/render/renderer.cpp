@@ -1,5 +1,7 @@
 #include "render/renderer.hpp"
 
+#include "render/gl_program.hpp"
+
 #include "core/error.hpp"
 
 #define GL_GLEXT_PROTOTYPES
@@ -59,36 +61,6 @@ uniform float alpha;
 out vec4 frag;
 void main() { frag = vec4(v_color, alpha); })";
 
-unsigned compile(GLenum type, const char* source)
-{
-    const GLuint shader = glCreateShader(type);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-        throw std::runtime_error(std::string("render: shader does not compile: ") + log);
-    }
-    return shader;
-}
-
-unsigned link(const char* vertex, const char* fragment)
-{
-    const GLuint program = glCreateProgram();
-    const GLuint vs = compile(GL_VERTEX_SHADER, vertex), fs = compile(GL_FRAGMENT_SHADER, fragment);
-    glAttachShader(program, vs);
-    glAttachShader(program, fs);
-    glLinkProgram(program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) throw std::runtime_error("render: shader program does not link");
-    return program;
-}
-
 /// One mesh's buffers, alive for one draw.
 struct Uploaded {
     GLuint vao = 0, buffers[4] = {0, 0, 0, 0};
@@ -122,8 +94,8 @@ struct Uploaded {
 
 Renderer::Renderer()
 {
-    m_program = link(mesh_vertex, mesh_fragment);
-    m_line_program = link(line_vertex, line_fragment);
+    m_program = link_program(mesh_vertex, mesh_fragment);
+    m_line_program = link_program(line_vertex, line_fragment);
 }
 
 Renderer::~Renderer()

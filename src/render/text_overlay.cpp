@@ -1,5 +1,7 @@
 #include "render/text_overlay.hpp"
 
+#include "render/gl_program.hpp"
+
 #define GL_GLEXT_PROTOTYPES
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -22,28 +24,11 @@ uniform vec4 color;
 out vec4 frag;
 void main() { frag = color; })";
 
-unsigned shader(GLenum type, const char* source)
-{
-    const GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) throw std::runtime_error("render: text shader does not compile");
-    return s;
-}
-
 } // namespace
 
 TextOverlay::TextOverlay()
 {
-    m_program = glCreateProgram();
-    const GLuint vs = shader(GL_VERTEX_SHADER, vertex_source), fs = shader(GL_FRAGMENT_SHADER, fragment_source);
-    glAttachShader(m_program, vs);
-    glAttachShader(m_program, fs);
-    glLinkProgram(m_program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
+    m_program = link_program(vertex_source, fragment_source);
     glGenVertexArrays(1, &m_vao);
     glGenBuffers(1, &m_buffer);
 }
@@ -75,6 +60,7 @@ void TextOverlay::draw(const std::string& text, int x, int y, int width, int hei
         quad(static_cast<float>(x) + scale * v[0], static_cast<float>(y) + scale * v[1], static_cast<float>(x) + scale * v[8],
              static_cast<float>(y) + scale * v[9]);
     }
+    const GLboolean depth = glIsEnabled(GL_DEPTH_TEST);
     glDisable(GL_DEPTH_TEST);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -90,7 +76,7 @@ void TextOverlay::draw(const std::string& text, int x, int y, int width, int hei
     glUniform4f(glGetUniformLocation(m_program, "color"), 0.1f, 0.1f, 0.12f, 1.0f);
     glDrawArrays(GL_TRIANGLES, 6, static_cast<GLsizei>(triangles.size() / 2 - 6));
     glDisable(GL_BLEND);
-    glEnable(GL_DEPTH_TEST);
+    if (depth) glEnable(GL_DEPTH_TEST);
 }
 
 } // namespace vox::render

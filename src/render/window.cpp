@@ -63,6 +63,7 @@ void Window::present()
 }
 
 void Window::size(int& width, int& height) const { glfwGetFramebufferSize(m_window, &width, &height); }
+void Window::window_size(int& width, int& height) const { glfwGetWindowSize(m_window, &width, &height); }
 bool Window::button_down(int button) const { return glfwGetMouseButton(m_window, button) == GLFW_PRESS; }
 
 } // namespace vox::render

@@ -34,7 +34,9 @@ public:
     void present();
     /// Framebuffer size in pixels.
     void size(int& width, int& height) const;
-    /// Modifier keys now held (GLFW_MOD_* bits), and whether a mouse button is down.
+    /// Window size in screen units (the cursor's), which a scaled display makes smaller than the framebuffer.
+    void window_size(int& width, int& height) const;
+    /// Whether a mouse button is down.
     [[nodiscard]] bool button_down(int button) const;
 
 private:

@@ -20,7 +20,7 @@ TEST(View, AWindowOnAVirtualDisplayShowsTheObjectAndTheRates)
     const std::string program = VOX_VOXSCULPT_EXE;
     const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/wet_push.json");
     const std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " + quote(program) + " view " + scene +
-                                " --size 640x480 --exit-after 3 --screenshot " + quote(dir.path("view.png")) + " > " + quote(dir.path("log.txt")) + " 2>&1";
+                                " --device mouse --size 640x480 --exit-after 3 --screenshot " + quote(dir.path("view.png")) + " > " + quote(dir.path("log.txt")) + " 2>&1";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     int w = 0, h = 0, channels = 0;
     std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load(dir.path("view.png").c_str(), &w, &h, &channels, 3), stbi_image_free);
