@@ -102,6 +102,46 @@ render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const s
     return d;
 }
 
+render::DrawMesh voxel_boxes(const SceneSimulation& sim)
+{
+    render::DrawMesh d;
+    const cut::ModelSurface& surface = sim.surface();
+    const grid::FineVoxels& voxels = surface.grid().voxels();
+    const auto& x = sim.solver().positions();
+    const double half = sim.model().level() == 0 ? 0.5 : 0.5 / static_cast<double>(1 << sim.model().level()); // a voxel in local units
+    for (std::uint32_t v = 0; v < voxels.slots(); ++v) {
+        if (!voxels.alive(v)) continue;
+        const grid::Coord c = voxels.coord(v);
+        Eigen::Vector3d local;
+        const std::uint32_t e = surface.voxel_element(v, local);
+        // A checkerboard of two shades, so that each voxel shows.
+        const Eigen::Vector3f color = ((c.x() + c.y() + c.z()) % 2 == 0 ? 0.92f : 0.78f) * render::label_color(voxels.label(v));
+        for (int axis = 0; axis < 3; ++axis)
+            for (const int side : {-1, 1}) {
+                const std::uint32_t n = voxels.find(c + side * grid::Coord::Unit(axis));
+                const bool joined = n != grid::FineVoxels::missing && voxels.alive(n) && !voxels.face_disconnected(side < 0 ? n : v, axis);
+                if (joined) continue;
+                // The face's corners: offsets of +-1/2 voxel across the two other axes.
+                const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+                const auto first = static_cast<std::uint32_t>(d.positions.size());
+                for (const auto& [s1, s2] : {std::pair{-1, -1}, std::pair{1, -1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+                    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+                    offset[axis] = 0.5 * side;
+                    offset[a1] = 0.5 * s1;
+                    offset[a2] = 0.5 * s2;
+                    const Eigen::Vector3d rest = voxels.world_mm(c.cast<double>() + offset);
+                    d.positions.push_back(surface.deformed_mm(e, local + 2.0 * half * offset, rest, x).cast<float>());
+                    d.colors.push_back(color);
+                }
+                // Counter-clockwise seen from outside: the corner order above turns about +axis.
+                if (side > 0) d.indices.insert(d.indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
+                else d.indices.insert(d.indices.end(), {first, first + 2, first + 1, first, first + 3, first + 2});
+            }
+    }
+    render::compute_normals(d);
+    return d;
+}
+
 render::DrawMesh element_cage(const SceneSimulation& sim)
 {
     render::DrawMesh d;

@@ -38,6 +38,10 @@ struct PictureOptions {
 /// The simulation's deformed surface as drawn: label colours, wet material darker, and, with
 /// `uncut` (surface_keys() before any cut), the surface cuts have made in a lighter, pinker tone.
 [[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut = nullptr);
+/// The fine voxels as boxes where the model has moved them: every face of a voxel not joined to a
+/// neighbour (the object's outside, removed neighbours, faces a cut opened), each corner carried
+/// by its element's trilinear map; coloured by label.
+[[nodiscard]] render::DrawMesh voxel_boxes(const SceneSimulation& sim);
 /// The simulated level's elements as a wire cage (their corner nodes where they are now).
 [[nodiscard]] render::DrawMesh element_cage(const SceneSimulation& sim);
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by

@@ -83,7 +83,7 @@ const char* const key_map = "mouse left: move the tool (a stroke)   wheel: neare
                             "M: cut mode (remove / separate)   U: undo the last stroke\n"
                             "SPACE: pause / run   N: one step while paused\n"
                             "+ / -: coarser / finer level (deformation restarts)\n"
-                            "C: element cage   V: voxel steps   L: level of detail\n"
+                            "C: element cage   V: the fine voxels   L: level of detail\n"
                             "S: save (.obj, .vdb)   P: screenshot   H, ?: help   Q, ESC: quit";
 
 } // namespace
@@ -277,13 +277,14 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 if (save_object.exchange(false)) try {
                     const std::filesystem::path dir(options.out_dir);
                     const surface::SurfaceMesh m = sim->surface().mesh(sim->solver().positions());
-                    io::write_mesh((dir / "view_surface.obj").string(), m.positions, m.triangles, m.labels);
+                    for (const char* name : {"view_surface.obj", "view_surface.ply", "view_surface.stl"})
+                        io::write_mesh((dir / name).string(), m.positions, m.triangles, m.labels);
                     const grid::FineVoxels& voxels = g->voxels();
                     grid::LabelGrid kept(voxels.index_to_world());
                     for (std::uint32_t v = 0; v < voxels.slots(); ++v)
                         if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
                     kept.save(dir / "view_object.vdb");
-                    log::info("saved the deformed surface to {} ({} triangles) and the object's {} voxels to {}", (dir / "view_surface.obj").string(),
+                    log::info("saved the deformed surface to {}.obj, .ply and .stl ({} triangles) and the object's {} voxels to {}", (dir / "view_surface").string(),
                               m.triangles.size(), voxels.alive_count(), (dir / "view_object.vdb").string());
                 } catch (const std::exception& e) {
                     log::warn("not saved: {}", e.what()); // the session goes on
@@ -291,8 +292,13 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 if (picture_taken.exchange(false)) { // the window has the last one: make the next
                     RenderState& r = pictures.write_slot();
                     r.meshes.clear();
-                    r.meshes.push_back(surface_picture(*sim, 0, &uncut)); // smoothed by the window's thread
-                    r.smooth = show_voxels.load() ? 0 : options.smooth;
+                    if (show_voxels.load()) {
+                        r.meshes.push_back(voxel_boxes(*sim));
+                        r.smooth = 0;
+                    } else {
+                        r.meshes.push_back(surface_picture(*sim, 0, &uncut)); // smoothed by the window's thread
+                        r.smooth = options.smooth;
+                    }
                     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, r.meshes);
                     if (show_cage.load()) r.meshes.push_back(element_cage(*sim));
                     r.t_s = static_cast<double>(frame + 1) * dt;
