@@ -26,6 +26,15 @@ target_include_directories(vox_nifti2 SYSTEM INTERFACE ${NIFTI2_INCLUDE_DIR})
 target_link_libraries(vox_nifti2 INTERFACE ${NIFTI2_LIBRARY} ${ZNZ_LIBRARY} ZLIB::ZLIB m)
 add_library(vox::nifti2 ALIAS vox_nifti2)
 
+# CHOLMOD (SuiteSparse) for the supernodal Cholesky preconditioner; Debian ships no CMake package
+# for SuiteSparse 5, so find it by hand. BLAS comes with it (OpenBLAS, serial, when installed).
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+add_library(vox_cholmod INTERFACE)
+target_include_directories(vox_cholmod SYSTEM INTERFACE ${CHOLMOD_INCLUDE_DIR})
+target_link_libraries(vox_cholmod INTERFACE ${CHOLMOD_LIBRARY})
+add_library(vox::cholmod ALIAS vox_cholmod)
+
 if(VOX_BUILD_TESTS)
   find_package(GTest CONFIG REQUIRED)
 endif()

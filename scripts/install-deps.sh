@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libnifti2-dev libspdlog-dev zlib1g-dev libstb-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev xvfb xauth
+  libsuitesparse-dev libopenblas0-serial
 )
 
 missing=()

@@ -12,12 +12,10 @@ void RestCholesky::update(const SystemMatrix& a, const std::vector<unsigned char
 {
     if (m_stale || m_fixed != fixed || m_factored_rotation.size() != node_rotation.size()) {
         const Eigen::SparseMatrix<double> column_major(a);
-        if (m_factorizations == 0 || m_fixed != fixed) m_factor.analyzePattern(column_major);
-        m_factor.factorize(column_major);
+        // A singular K (nothing holds the object) may still factor, with pivots at round-off level:
+        // that is a failure too.
+        m_failed = !m_factor.factor(column_major, m_factorizations == 0 || m_fixed != fixed);
         ++m_factorizations;
-        // A singular K (nothing holds the object) may still factor, with pivots at round-off level.
-        m_failed = m_factor.info() != Eigen::Success ||
-                   !(m_factor.vectorD().minCoeff() > 1e-10 * m_factor.vectorD().cwiseAbs().maxCoeff());
         m_factored_rotation = node_rotation;
         m_fixed = fixed;
         m_stale = false;
@@ -37,7 +35,7 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
     }
     for (Eigen::Index i = 0; i < r.size(); ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) m_scratch[i] = 0.0;
-    m_scratch = m_factor.solve(m_scratch);
+    m_factor.solve(m_scratch);
     z.resize(r.size());
     for (std::size_t n = 0; n < m_warp.size(); ++n) {
         const auto i = static_cast<Eigen::Index>(3 * n);

@@ -1,5 +1,6 @@
 #pragma once
-// The warped-stiffness preconditioner: a sparse Cholesky factor of the system matrix taken once
+// The warped-stiffness preconditioner: a sparse Cholesky factor of the system matrix (supernodal,
+// applied in single precision: fem/supernodal_factor.hpp) taken once
 // (at rest, or whenever it has gone stale), applied to the current residual in each node's rotated
 // frame: P = W A_0^-1 W^T, W the block-diagonal rotation of every node from the factored state to
 // the current one. A corotational matrix differs from the factored one mostly by those rotations,
@@ -9,7 +10,7 @@
 
 #include "fem/preconditioner.hpp"
 
-#include <Eigen/SparseCholesky>
+#include "fem/supernodal_factor.hpp"
 
 namespace vox::fem {
 
@@ -34,7 +35,7 @@ private:
     int m_refactor_iterations;
     bool m_stale = true, m_failed = false;
     int m_factorizations = 0;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_factor;
+    SupernodalFactor m_factor;
     std::vector<Eigen::Quaterniond> m_factored_rotation;
     std::vector<Eigen::Matrix3d> m_warp; ///< per node: world rotation from the factored state to now
     std::vector<unsigned char> m_fixed;
