@@ -1,6 +1,7 @@
 #include "contact/penalty_contact.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 namespace vox::contact {
@@ -9,6 +10,7 @@ namespace {
 /// One surface point against the pushing shape: its penalty force (N, on the point), its
 /// stiffness (N/mm per mm of depth) and depth; false when it is outside the pushing shape.
 struct PointPenalty {
+    bool measured = false; ///< the point was in reach: `distance` holds its signed distance
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< the direction the point is pushed
     double stiffness = 0.0, depth = 0.0, distance = 0.0;
@@ -20,7 +22,8 @@ struct PointPenalty {
 bool point_penalty(const PlacedShape& tool, const PlacedShape* from, const ContactParameters& parameters, const Eigen::AlignedBox3d& reach,
                    const Eigen::Vector3d& p, double area, const Eigen::Vector3d& outward, PointPenalty& out) noexcept
 {
-    if (!reach.contains(p)) return false;
+    out.measured = reach.contains(p);
+    if (!out.measured) return false;
     out.distance = tool.signed_distance(p, &out.normal);
     out.depth = parameters.margin_mm - out.distance;
     double inside = out.depth > 0.0 ? 1.0 : 0.0;
@@ -92,14 +95,17 @@ ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& 
 }
 
 ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
-                             bool with_pressure) noexcept
+                             bool with_pressure, std::span<double> distance) noexcept
 {
     ContactTotals out;
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    const bool keep = distance.size() >= points.count;
     PointPenalty pp;
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!point_penalty(tool, nullptr, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp)) continue;
+        const bool inside = point_penalty(tool, nullptr, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp);
+        if (keep) distance[i] = pp.measured ? pp.distance : std::numeric_limits<double>::infinity();
+        if (!inside) continue;
         out.force_on_tool_n -= pp.force;
         out.torque_on_tool_n_mm -= (p - tool.position).cross(pp.force);
         out.stiffness_n_per_mm += pp.stiffness * pp.normal * pp.normal.transpose();

@@ -75,8 +75,11 @@ struct ContactTotals {
 /// The same model as penalty_contact over the first `points.count` points; never allocates,
 /// locks or throws (the haptic loop calls it). The pressure (and load area) take a second pass
 /// over the points and are computed only `with_pressure` (the force and stiffness do not need it).
+/// `distance`, when given (at least points.count long), receives each point's signed distance to
+/// the tool's inner shape where it was measured (points within the pushing shape's box), else
+/// +infinity: the continuous check of the same tick reuses them.
 [[nodiscard]] ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
-                                           bool with_pressure = true) noexcept;
+                                           bool with_pressure = true, std::span<double> distance = {}) noexcept;
 
 /// Contact of `tool` (its inner shape, placed in the world) with surface points (world mm), each
 /// carrying `areas[i]` mm^2 of surface with outward unit normal `normals[i]` (a zero normal: the

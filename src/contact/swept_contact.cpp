@@ -7,8 +7,9 @@
 namespace vox::contact {
 
 double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm, const SurfacePoints& points,
-                            std::span<double> clearance) noexcept
+                            std::span<double> clearance, std::span<const double> from_distance) noexcept
 {
+    const bool known = from_distance.size() >= points.count;
     constexpr double far = std::numeric_limits<double>::infinity();
     const bool keep = clearance.size() >= points.count;
     if (keep) std::fill_n(clearance.begin(), points.count, far);
@@ -38,7 +39,8 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
         const Eigen::Vector3d& p = points.positions_mm[i];
         if (!swept.contains(p)) continue;
         // The end pose's distance only for points the motion can reach at all (few, for a tick).
-        const double d0 = from.signed_distance(p) - margin_mm + grip;
+        const double measured = known ? from_distance[i] : far;
+        const double d0 = (measured < far ? measured : from.signed_distance(p)) - margin_mm + grip;
         if (keep) clearance[i] = d0 - grip <= 0.0 ? -far : d0 - grip;
         if (d0 <= 0.0 || d0 > speed) continue;   // in the contact at the start, or out of reach
         const double d1 = to.signed_distance(p) - margin_mm;

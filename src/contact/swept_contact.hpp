@@ -22,7 +22,10 @@ namespace vox::contact {
 /// `clearance`, when given (at least points.count long), receives for each point its distance
 /// outside the pushing shape at `from`, mm, or -infinity when the point is in the contact there;
 /// points outside the box the move sweeps are left at +infinity, unmeasured.
+/// `from_distance`, when given, holds the points' signed distances at `from` already measured
+/// (+infinity where not), which are then not measured again.
 [[nodiscard]] double first_missed_contact(const PlacedShape& from, const PlacedShape& to, double margin_mm,
-                                          const SurfacePoints& points, std::span<double> clearance = {}) noexcept;
+                                          const SurfacePoints& points, std::span<double> clearance = {},
+                                          std::span<const double> from_distance = {}) noexcept;
 
 } // namespace vox::contact

@@ -52,11 +52,12 @@ bool ToolSweep::reachable(const Eigen::Vector3i& triangle, const PlacedShape& fr
     return nearest != -far && nearest + m_margin <= speed + size;
 }
 
-double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, const SurfacePoints& points) noexcept
+double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, const SurfacePoints& points,
+                             std::span<const double> from_distance) noexcept
 {
     m_swept_mesh = m_stopped_by_mesh = false;
     const std::size_t n = std::min(points.count, m_clearance.size());
-    double first = first_missed_contact(from, to, m_margin, points, std::span<double>(m_clearance.data(), n));
+    double first = first_missed_contact(from, to, m_margin, points, std::span<double>(m_clearance.data(), n), from_distance);
     if (points.triangles.empty() || n < points.count) return first;
     double speed = 0.0; // largest distance a tool vertex moves over the tick, mm
     for (std::size_t v = 0; v < m_local.positions.size(); ++v) {

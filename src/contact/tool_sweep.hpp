@@ -36,7 +36,10 @@ public:
     /// The earliest time t in [0, 1] of the move from `from` to `to` (same shape as given at
     /// construction) that the tool must stop at; 1 when it can go all the way. Tool vertices are
     /// taken to move linearly over the tick (a tick turns the tool by a small fraction of a degree).
-    [[nodiscard]] double first_stop(const PlacedShape& from, const PlacedShape& to, const SurfacePoints& points) noexcept;
+    /// `from_distance`: the points' signed distances at `from` already measured this tick
+    /// (penalty_totals), +infinity where not.
+    [[nodiscard]] double first_stop(const PlacedShape& from, const PlacedShape& to, const SurfacePoints& points,
+                                    std::span<const double> from_distance = {}) noexcept;
 
     /// Whether the last first_stop() ran the mesh test (a move longer than the margin), and
     /// whether the mesh test decided it (a feature between points).

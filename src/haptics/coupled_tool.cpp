@@ -6,7 +6,7 @@ namespace vox::haptics {
 
 CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling,
                          std::size_t snapshot_capacity)
-    : m_parameters(contact), m_coupling(coupling), m_sweep(shape, contact.margin_mm, snapshot_capacity)
+    : m_parameters(contact), m_coupling(coupling), m_sweep(shape, contact.margin_mm, snapshot_capacity), m_distance(snapshot_capacity)
 {
     m_proxy.shape = &shape;
 }
@@ -22,7 +22,10 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     // One Newton step a tick on k_c (x_d - x) + F(x) = 0, F linearised at the proxy: warm started
     // from the last tick, the proxy converges within a few ticks of any change (a millisecond
     // moves the device a few micrometres).
-    m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false);
+    // The points' distances at the proxy, measured once: the contact and the continuous check
+    // below both need them.
+    const std::span<double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
+    m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false, distance);
     const Eigen::Matrix3d a = kc * Eigen::Matrix3d::Identity() + m_contact.stiffness_n_per_mm;
     const Eigen::Vector3d residual = kc * (device.position_mm - m_proxy.position) + m_contact.force_on_tool_n;
     Eigen::Vector3d step = a.ldlt().solve(residual);
@@ -36,7 +39,7 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
         // fast), stops where it first touches.
         contact::PlacedShape moved = m_proxy;
         moved.position += step;
-        const double t = m_sweep.first_stop(m_proxy, moved, surface);
+        const double t = m_sweep.first_stop(m_proxy, moved, surface, distance);
         m_proxy.position += t * step;
     }
     const double dt = dt_s > 0.0 ? dt_s : 1e-3;

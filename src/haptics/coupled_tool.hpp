@@ -16,6 +16,8 @@
 #include "contact/tool_sweep.hpp"
 #include "haptics/device.hpp"
 
+#include <vector>
+
 namespace vox::haptics {
 
 struct CouplingSettings {
@@ -46,6 +48,7 @@ private:
     contact::PlacedShape m_proxy;
     contact::ContactTotals m_contact;
     contact::ToolSweep m_sweep;
+    std::vector<double> m_distance; ///< per snapshot point, this tick's distance at the proxy
     Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_proxy = Eigen::Vector3d::Zero();
     bool m_started = false;
 };
