@@ -57,7 +57,7 @@ void add_render_command(CLI::App& app)
             const int level = std::max(scene.object.levels, 1);
             grid::BranchedGrid g = build_scene_grid(scene, labels, level);
             const SceneSimulation sim(scene, g, level);
-            meshes.push_back(surface_drawing(sim.surface().mesh(sim.solver().positions()), options.smooth));
+            meshes.push_back(surface_picture(sim, options.smooth)); // the same picture as a run's (wet regions tinted)
             const ToolSession tools(scene);
             for (std::size_t k = 0; k < scene.tools.size(); ++k) {
                 const io::ToolPose pose = io::tool_pose(scene, k, 0.0);
