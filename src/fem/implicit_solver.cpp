@@ -51,10 +51,8 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
     m_element_force.assign(model.elements().size(), Vector24d::Zero());
     m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
-    if (m_options.matrix_free) {
-        m_element_product.assign(model.elements().size(), Vector24d::Zero());
-        return; // no matrix
-    }
+    m_element_product.assign(model.elements().size(), Vector24d::Zero());
+    if (m_options.matrix_free) return; // no matrix
 
     // The matrix pattern: a 3 x 3 block for every pair of nodes sharing an element. Built from
     // each node's sorted neighbour list (never from triplets: on the liver at level 1 those
@@ -132,6 +130,7 @@ void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
 {
     for (int a = 0; a < 3; ++a)
         if (axes & (1u << a)) m_fixed[3 * node + static_cast<std::size_t>(a)] = 1;
+    if (m_preconditioner) m_preconditioner->invalidate(); // built with other rows held
 }
 
 void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
@@ -184,7 +183,7 @@ double ImplicitSolver::plastic_correction(std::size_t e, const Vector24d& u, Vec
     return el.volume_m3 * (-(strain.cwiseProduct(sigma_p)).sum() + 0.5 * plastic.cwiseProduct(sigma_p).sum());
 }
 
-double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
+double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
 {
     const Eigen::Matrix3d& frame = m_model.frame();
     const auto& elements = m_model.elements();
@@ -223,16 +222,17 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, bool matrix)
     const bool lumped = m_options.lumped_mass;
     m_m_scale = m_scale;
     m_k_scale = k_scale;
-    if (matrix) m_diagonal.resize(static_cast<Eigen::Index>(3 * m_x.size()));
+    m_matrix_current = output == Output::matrix;
+    if (output != Output::forces) m_diagonal.resize(static_cast<Eigen::Index>(3 * m_x.size()));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t n = range.begin(); n != range.end(); ++n) {
             Eigen::Vector3d force = Eigen::Vector3d::Zero();
             for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k)
                 force += m_element_force[m_incidence[k] / 8].segment<3>(3 * (m_incidence[k] % 8));
             m_internal.segment<3>(static_cast<Eigen::Index>(3 * n)) = force;
-            if (!matrix) continue;
+            if (output == Output::forces) continue;
             const double diagonal_mass = lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n];
-            if (m_options.matrix_free) { // only the diagonal, for the Jacobi preconditioner
+            if (output == Output::diagonal) { // for the Jacobi preconditioner and the scaled residual
                 Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * diagonal_mass);
                 for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
                     const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
@@ -302,7 +302,13 @@ void ImplicitSolver::mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::Ve
     });
 }
 
-double ImplicitSolver::elastic_energy() { return assemble(0.0, 0.0, false); }
+double ImplicitSolver::elastic_energy() { return assemble(0.0, 0.0, Output::forces); }
+
+ImplicitSolver::Output ImplicitSolver::system_output() const
+{
+    if (m_options.matrix_free) return Output::diagonal;
+    return m_preconditioner && !m_preconditioner->needs_matrix() ? Output::diagonal : Output::matrix;
+}
 
 Eigen::VectorXd ImplicitSolver::external_force() const
 {
@@ -320,7 +326,7 @@ Eigen::VectorXd ImplicitSolver::external_force() const
 void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 {
     // Held degrees of freedom: identity rows and columns, zero right-hand side.
-    if (!m_options.matrix_free)
+    if (m_matrix_current)
         for (Eigen::Index row = 0; row < m_matrix.outerSize(); ++row)
             for (SystemMatrix::InnerIterator it(m_matrix, row); it; ++it)
                 if (m_fixed[static_cast<std::size_t>(row)] || m_fixed[static_cast<std::size_t>(it.col())])
@@ -334,7 +340,7 @@ void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 
 void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
-    if (m_options.matrix_free) {
+    if (!m_matrix_current) {
         multiply_element_wise(p, out);
         return;
     }
@@ -424,7 +430,7 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
     }
     if (m_preconditioner) {
         update_node_rotations();
-        m_preconditioner->update(m_matrix, m_fixed, m_node_rotation);
+        m_preconditioner->update(m_matrix_current ? &m_matrix : nullptr, m_fixed, m_node_rotation);
         if (m_preconditioner->failed()) { // e.g. a factor of a singular K: nothing holds the object
             m_fallback_note = std::string(m_preconditioner->name()) +
                               " preconditioner failed (singular matrix: is the object held?); using Jacobi";
@@ -495,7 +501,7 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     m_contact_scale = dt * dt;
     auto t = std::chrono::steady_clock::now();
     energy_before = kinetic_energy() +
-                    assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt, true);
+                    assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt, system_output());
     Eigen::VectorXd rhs;
     mass_times(m_v, rhs);
     rhs += dt * (f_ext - m_internal);
@@ -577,7 +583,7 @@ StepStats ImplicitSolver::step()
         s.converged = false;
         for (int it = 0; it < m_options.newton_max_iterations; ++it) {
             auto t = std::chrono::steady_clock::now();
-            assemble(0.0, 1.0, true);
+            assemble(0.0, 1.0, system_output());
             if (!m_contact.empty()) f_ext = external_force(); // contact forces follow the nodes
             Eigen::VectorXd rhs = f_ext - m_internal;
             apply_constraints(rhs);

@@ -29,8 +29,9 @@ struct SolverOptions {
     /// diagonal M, and a much better conditioned implicit system (consistent hexahedral mass alone
     /// spreads its eigenvalues 27-fold).
     bool lumped_mass = true;
-    /// Apply the system matrix element by element instead of assembling it: cheaper when CG takes
-    /// few iterations (SOFA's way); needs the Jacobi preconditioner.
+    /// Never assemble the system matrix: apply it element by element (SOFA's way), with the Jacobi
+    /// preconditioner. (With the warped factor the solver already multiplies element by element
+    /// and assembles only when the factor is taken again.)
     bool matrix_free = false;
     int newton_max_iterations = 20;   ///< quasi-static mode
     /// Throws InputError naming the offending option.
@@ -132,9 +133,14 @@ public:
     double elastic_energy();
 
 private:
-    /// Element rotations, elastic forces (m_internal) and energy at the current positions; with
-    /// `matrix`, also m_matrix = m_scale M + k_scale K(x).
-    double assemble(double m_scale, double k_scale, bool matrix);
+    /// What an assembly produces beyond the element rotations, elastic forces and energy.
+    enum class Output { forces, diagonal, matrix };
+    /// Element rotations, elastic forces (m_internal) and energy at the current positions; then
+    /// the diagonal of the system matrix m_scale M + k_scale K(x), or the whole matrix (m_matrix).
+    double assemble(double m_scale, double k_scale, Output output);
+    /// What a system solve needs assembled: the matrix only when there is no matrix-free product
+    /// to use or the preconditioner will read it.
+    [[nodiscard]] Output system_output() const;
     /// Adds the plastic forces of element e to `force` (local frame), letting its plastic strain
     /// creep first when a step starts; returns the energy correction, J.
     double plastic_correction(std::size_t e, const Vector24d& u, Vector24d& force);
@@ -170,6 +176,7 @@ private:
     std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
     std::vector<Vector24d> m_element_force;           ///< per element, rotated elastic forces, N
     mutable std::vector<Vector24d> m_element_product; ///< matrix-free products, per element
+    bool m_matrix_current = false;                    ///< m_matrix holds the system being solved
     Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
     double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K
     std::vector<Eigen::Quaterniond> m_rotation;       ///< per element, index-aligned frame (warm start)

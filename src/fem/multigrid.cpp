@@ -4,6 +4,7 @@
 #include "grid/hex8.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace vox::fem {
 namespace {
@@ -88,11 +89,12 @@ Multigrid::Multigrid(const grid::BranchedGrid& grid, const HexModel& model, int 
     }
 }
 
-void Multigrid::update(const Matrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>&)
+void Multigrid::update(const Matrix* a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>&)
 {
+    if (!a) throw std::logic_error("Multigrid::update: needs the assembled matrix");
     m_matrix.resize(level_count());
     m_inverse_diagonal.resize(level_count());
-    m_matrix[0] = a;
+    m_matrix[0] = *a;
     for (std::size_t k = 0; k + 1 < level_count(); ++k) {
         Eigen::SparseMatrix<double, Eigen::RowMajor> p = m_prolongation[k];
         if (k == 0) // held fine dofs take no coarse correction

@@ -27,8 +27,8 @@ public:
     [[nodiscard]] std::size_t level_count() const { return m_prolongation.size() + 1; }
 
     /// Rebuilds the coarse matrices for the fine matrix `a` (held dofs: identity rows and columns,
-    /// flagged in `fixed`) by Galerkin products. Call after every assembly.
-    void update(const Matrix& a, const std::vector<unsigned char>& fixed,
+    /// flagged in `fixed`) by Galerkin products. Call after every assembly (never null).
+    void update(const Matrix* a, const std::vector<unsigned char>& fixed,
                 const std::vector<Eigen::Quaterniond>& node_rotation) override;
 
     /// z = (one V-cycle) r.

@@ -1,12 +1,17 @@
 #pragma once
 // The warped-stiffness preconditioner: a sparse Cholesky factor of the system matrix (supernodal,
-// applied in single precision: fem/supernodal_factor.hpp) taken once
-// (at rest, or whenever it has gone stale), applied to the current residual in each node's rotated
-// frame: P = W A_0^-1 W^T, W the block-diagonal rotation of every node from the factored state to
-// the current one. A corotational matrix differs from the factored one mostly by those rotations,
-// so CG converges in a few iterations without a factorisation per step (the idea of Hecht, Lee,
-// Shewchuk and O'Brien 2012, without their partial updates: we refactor whole when the iteration
-// count says the factor is stale).
+// applied in single precision: fem/supernodal_factor.hpp) taken once and again whenever it has
+// gone stale, applied to the current residual in each node's rotated frame: P = W A_0^-1 W^T, W the
+// block-diagonal rotation of every node from the factored state to the current one. A corotational
+// matrix differs from the factored one mostly by those rotations, so CG converges in a few
+// iterations without a factorisation per step (the idea of Hecht, Lee, Shewchuk and O'Brien 2012,
+// without their partial updates: the factor is taken whole).
+//
+// When to refactor is a rent-or-buy decision: each solve costs the iterations the factor needed
+// right after it was taken plus an excess that grows as the object turns away from the factored
+// state. The excess iterations are summed, and once they cost as much as a new factorisation
+// would, the factor is taken again. Over any run this spends at most twice what the best schedule
+// in hindsight would. A hard cap on the iterations of one solve refactors at once.
 
 #include "fem/preconditioner.hpp"
 
@@ -17,24 +22,33 @@ namespace vox::fem {
 class RestCholesky final : public Preconditioner {
 public:
     /// `frame`: the orthonormal index-to-world map (node rotations are in the index-aligned frame).
-    /// `refactor_iterations`: a solve needing more CG iterations than this marks the factor stale.
+    /// `refactor_iterations`: a solve needing more CG iterations than this marks the factor stale
+    /// whatever the running cost says.
     explicit RestCholesky(const Eigen::Matrix3d& frame, int refactor_iterations = 25);
 
-    void update(const SystemMatrix& a, const std::vector<unsigned char>& fixed,
+    [[nodiscard]] bool needs_matrix() const override { return m_stale; }
+    void update(const SystemMatrix* a, const std::vector<unsigned char>& fixed,
                 const std::vector<Eigen::Quaterniond>& node_rotation) override;
     void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
-    void report_iterations(int iterations) override { m_stale = m_stale || iterations > m_refactor_iterations; }
+    void report_iterations(int iterations) override;
     void invalidate() override { m_stale = true; }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
     /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
     [[nodiscard]] bool failed() const override { return m_failed; }
+    /// Factorisations taken so far.
+    [[nodiscard]] int factorizations() const { return m_factorizations; }
+    /// What a factorisation costs, in CG iterations (see the .cpp for the model).
+    [[nodiscard]] double refactor_cost_iterations() const { return m_refactor_cost; }
 
 private:
     Eigen::Matrix3d m_frame;
     int m_refactor_iterations;
     bool m_stale = true, m_failed = false;
     int m_factorizations = 0;
+    double m_refactor_cost = 0.0; ///< CG iterations
+    int m_baseline = -1;          ///< fewest iterations of a solve since the factorisation
+    double m_excess = 0.0;        ///< iterations beyond the baseline since the factorisation
     SupernodalFactor m_factor;
     std::vector<Eigen::Quaterniond> m_factored_rotation;
     std::vector<Eigen::Matrix3d> m_warp; ///< per node: world rotation from the factored state to now

@@ -50,6 +50,7 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
         if (m_cholmod->factor) cholmod_free_factor(&m_cholmod->factor, &c);
         m_cholmod->factor = cholmod_analyze(&view, &c);
         if (!m_cholmod->factor) throw std::runtime_error("SupernodalFactor: CHOLMOD could not analyse the matrix");
+        m_factor_flops = c.fl;
     }
     cholmod_factorize(&view, m_cholmod->factor, &c);
     const cholmod_factor* l = m_cholmod->factor;

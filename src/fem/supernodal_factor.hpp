@@ -27,12 +27,15 @@ public:
     void solve(Eigen::VectorXd& x) const;
     /// Entries of the factor (its supernodes' dense blocks).
     [[nodiscard]] std::size_t entries() const { return m_values.size(); }
+    /// Floating-point operations of one numerical factorisation (CHOLMOD's count from the analysis).
+    [[nodiscard]] double factor_flops() const { return m_factor_flops; }
 
 private:
     struct Cholmod;
     std::unique_ptr<Cholmod> m_cholmod;
     std::vector<float> m_values;                      ///< supernodes' blocks, column-major
     std::vector<int> m_super, m_pi, m_px, m_s, m_perm; ///< CHOLMOD's supernodal layout
+    double m_factor_flops = 0.0;
     mutable std::vector<float> m_b, m_tmp;
 };
 

@@ -213,8 +213,9 @@ public:
     {
         if (m_data.size() - m_pos < t.size) return std::nullopt;
         std::array<unsigned char, 8> b{};
-        std::memcpy(b.data(), m_data.data() + m_pos, t.size);
-        if (m_swap) std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(t.size));
+        const std::size_t size = std::min(t.size, b.size()); // PLY scalars have at most 8 bytes
+        std::memcpy(b.data(), m_data.data() + m_pos, size);
+        if (m_swap) std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(size));
         m_pos += t.size;
         switch (t.type) {
         case PlyType::i8: return as<std::int8_t>(b);
