@@ -1,0 +1,94 @@
+#include "isxfem/xfem_tetrahedron.hpp"
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace vox::isxfem {
+namespace {
+
+/// The 3 x 3 block of the isotropic stiffness integrand between basis functions with gradients
+/// ga and gb: lambda ga gb^T + mu (gb ga^T + (ga . gb) I).
+Eigen::Matrix3d elastic_block(const Eigen::Vector3d& ga, const Eigen::Vector3d& gb, const grid::Lame& lame)
+{
+    return lame.lambda * ga * gb.transpose() + lame.mu * (gb * ga.transpose() + ga.dot(gb) * Eigen::Matrix3d::Identity());
+}
+
+} // namespace
+
+TetGeometry tet_geometry(const std::array<Eigen::Vector3d, 4>& x)
+{
+    Eigen::Matrix3d j;
+    for (int k = 0; k < 3; ++k) j.col(k) = x[static_cast<std::size_t>(k + 1)] - x[0];
+    const double det = j.determinant();
+    if (!(std::abs(det) > 0.0)) throw std::invalid_argument("tet_geometry: a degenerate tetrahedron");
+    // Rows 1..3 of the gradient are the rows of J^-1 (N_k = xi_k); row 0 is minus their sum.
+    const Eigen::Matrix3d inverse = j.inverse();
+    TetGeometry g;
+    g.gradient.bottomRows<3>() = inverse;
+    g.gradient.row(0) = -inverse.colwise().sum();
+    g.volume = std::abs(det) / 6.0;
+    return g;
+}
+
+Matrix12d tet_stiffness(const TetGeometry& g, const grid::Lame& lame)
+{
+    Matrix12d k;
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+            k.block<3, 3>(3 * a, 3 * b) = g.volume * elastic_block(g.gradient.row(a).transpose(), g.gradient.row(b).transpose(), lame);
+    return k;
+}
+
+Matrix12d tet_mass(const TetGeometry& g, double density)
+{
+    Matrix12d m = Matrix12d::Zero();
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) m.block<3, 3>(3 * a, 3 * b).diagonal().setConstant(density * g.volume * (a == b ? 2.0 : 1.0) / 20.0);
+    return m;
+}
+
+CutTet cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::array<double, 4>& phi, double k, const grid::Lame& lame,
+               double density, const MomentFitting& fitting)
+{
+    if (!(k >= 0.0 && k <= 1.0)) throw std::invalid_argument("cut_tet: k must be in [0, 1]");
+    const TetGeometry g = tet_geometry(x);
+    const SideWeights w = side_weights(fitting, phi);
+    CutTet out;
+    out.side_volume = {6.0 * g.volume * w.negative_volume, 6.0 * g.volume * w.positive_volume};
+    for (int i = 0; i < 4; ++i) out.node_side[static_cast<std::size_t>(i)] = phi[static_cast<std::size_t>(i)] >= 0.0 ? 1 : 0;
+    Eigen::Vector3d grad_gamma = Eigen::Vector3d::Zero();
+    for (int m = 0; m < 4; ++m)
+        if (out.node_side[static_cast<std::size_t>(m)]) grad_gamma += g.gradient.row(m).transpose();
+    for (int side = 0; side < 2; ++side) {
+        const Eigen::VectorXd& weights = side == 0 ? w.negative : w.positive;
+        const double h = side;
+        for (std::size_t q = 0; q < fitting.points().size(); ++q) {
+            const double weight = 6.0 * g.volume * weights[static_cast<Eigen::Index>(q)];
+            const Eigen::Vector3d& xi = fitting.points()[q];
+            const std::array<double, 4> n{1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
+            double gamma = 0.0;
+            for (int m = 0; m < 4; ++m) gamma += out.node_side[static_cast<std::size_t>(m)] * n[static_cast<std::size_t>(m)];
+            std::array<double, 8> value{};
+            std::array<Eigen::Vector3d, 8> grad;
+            for (int i = 0; i < 4; ++i) {
+                const double psi = h - (k * gamma + (1.0 - k) * out.node_side[static_cast<std::size_t>(i)]);
+                value[static_cast<std::size_t>(i)] = n[static_cast<std::size_t>(i)];
+                grad[static_cast<std::size_t>(i)] = g.gradient.row(i).transpose();
+                value[static_cast<std::size_t>(4 + i)] = psi * n[static_cast<std::size_t>(i)];
+                grad[static_cast<std::size_t>(4 + i)] = psi * g.gradient.row(i).transpose() - k * n[static_cast<std::size_t>(i)] * grad_gamma;
+            }
+            for (int a = 0; a < 8; ++a)
+                for (int b = 0; b < 8; ++b) {
+                    out.stiffness.block<3, 3>(3 * a, 3 * b) +=
+                        weight * elastic_block(grad[static_cast<std::size_t>(a)], grad[static_cast<std::size_t>(b)], lame);
+                    out.mass.block<3, 3>(3 * a, 3 * b).diagonal().array() +=
+                        weight * density * value[static_cast<std::size_t>(a)] * value[static_cast<std::size_t>(b)];
+                }
+        }
+    }
+    return out;
+}
+
+} // namespace vox::isxfem
