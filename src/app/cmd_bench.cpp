@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "app/bench_conditioning.hpp"
 #include "app/bench_cutting.hpp"
 #include "app/bench_haptics.hpp"
 #include "app/bench_stability.hpp"
@@ -246,6 +247,12 @@ void add_bench_command(CLI::App& app)
     CLI::App* cutting = bench->add_subcommand("cutting", "Cutting-frame time on the liver at level 4 during a 5 cm incision");
     cutting->add_option("--runs", *cutting_runs, "How many times to replay the incision (default 5)")->check(CLI::Range(1, 100));
     cutting->callback([cutting_runs] { run_cutting_bench(*cutting_runs); });
+
+    auto conditioning_out = std::make_shared<std::string>("docs");
+    CLI::App* conditioning = bench->add_subcommand(
+        "conditioning", "Condition numbers of XFEM and Is-XFEM systems as a cut nears a node plane, with and without preconditioning");
+    conditioning->add_option("--out", *conditioning_out, "Folder for conditioning.md (default docs)");
+    conditioning->callback([conditioning_out] { write_conditioning(*conditioning_out, run_conditioning()); });
 
     auto stability_out = std::make_shared<std::string>("docs");
     auto quick = std::make_shared<bool>(false);

@@ -66,10 +66,15 @@ PlaneCutSystem assemble_plane_cut(const TetMesh& mesh, const PlaneCut& cut, doub
     out.mass.resize(static_cast<Eigen::Index>(dofs), static_cast<Eigen::Index>(dofs));
     out.mass.setFromTriplets(m_entries.begin(), m_entries.end());
     out.volume_ratio.assign(dofs, 1.0);
+    out.weighted_ratio.assign(dofs, 1.0);
+    const Eigen::VectorXd mass_diagonal = out.mass.diagonal();
     for (std::size_t node = 0; node < n; ++node)
         if (out.enriched[node] >= 0)
-            for (int i = 0; i < 3; ++i)
-                out.volume_ratio[3 * (n + static_cast<std::size_t>(out.enriched[node])) + static_cast<std::size_t>(i)] = across[node] / support[node];
+            for (std::size_t i = 0; i < 3; ++i) {
+                const std::size_t d = 3 * (n + static_cast<std::size_t>(out.enriched[node])) + i;
+                out.volume_ratio[d] = across[node] / support[node];
+                out.weighted_ratio[d] = mass_diagonal[static_cast<Eigen::Index>(d)] / mass_diagonal[static_cast<Eigen::Index>(3 * node + i)];
+            }
     return out;
 }
 

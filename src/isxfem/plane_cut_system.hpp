@@ -28,6 +28,11 @@ struct PlaneCutSystem {
     Eigen::SparseMatrix<double> stiffness, mass; ///< N/m and kg; 3 (nodes + enriched nodes) square
     std::vector<std::int32_t> enriched;          ///< per node: its place among the enriched nodes, or -1
     std::vector<double> volume_ratio;            ///< per dof: enriched ones their node's ratio, standard ones 1
+    /// Per dof: for enriched ones int (psi_i N_i)^2 / int N_i^2 over the node's support (the
+    /// ratio of their consistent-mass diagonals), a volume ratio weighted by what the enriched
+    /// function actually is: for k = 0 it is small where the plain ratio is, for k > 0 it stays
+    /// near k^2 on the node's own side; standard dofs 1.
+    std::vector<double> weighted_ratio;
     std::size_t cut_tets = 0;
     [[nodiscard]] std::size_t dofs() const { return volume_ratio.size(); }
 };
