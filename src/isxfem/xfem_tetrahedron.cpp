@@ -81,13 +81,14 @@ CutTet cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::array<double,
             }
             for (int a = 0; a < 8; ++a)
                 for (int b = 0; b < 8; ++b) {
-                    out.stiffness.block<3, 3>(3 * a, 3 * b) +=
+                    out.side_stiffness[static_cast<std::size_t>(side)].block<3, 3>(3 * a, 3 * b) +=
                         weight * elastic_block(grad[static_cast<std::size_t>(a)], grad[static_cast<std::size_t>(b)], lame);
                     out.mass.block<3, 3>(3 * a, 3 * b).diagonal().array() +=
                         weight * density * value[static_cast<std::size_t>(a)] * value[static_cast<std::size_t>(b)];
                 }
         }
     }
+    out.stiffness = out.side_stiffness[0] + out.side_stiffness[1];
     return out;
 }
 

@@ -45,6 +45,7 @@ Matrix12d tet_mass(const TetGeometry& g, double density);
 /// dofs each).
 struct CutTet {
     Matrix24d stiffness = Matrix24d::Zero(), mass = Matrix24d::Zero();
+    std::array<Matrix24d, 2> side_stiffness{Matrix24d::Zero(), Matrix24d::Zero()}; ///< their sum is `stiffness`
     std::array<double, 2> side_volume{};    ///< m^3: phi < 0, phi >= 0
     std::array<unsigned char, 4> node_side{}; ///< H_i
 };

@@ -1,0 +1,80 @@
+#include "isxfem/xfem_model.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace vox::isxfem {
+
+XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vector<std::uint32_t> material, double k)
+    : m_mesh(std::move(mesh)), m_materials(std::move(materials)), m_k(k)
+{
+    if (!(k >= 0.0 && k <= 1.0)) throw std::invalid_argument("XfemModel: k must be in [0, 1], got " + std::to_string(k));
+    if (material.size() != m_mesh.tets.size()) throw std::invalid_argument("XfemModel: one material per tetrahedron");
+    m_elements.resize(m_mesh.tets.size());
+    for (std::size_t t = 0; t < m_mesh.tets.size(); ++t) {
+        XfemElement& e = m_elements[t];
+        e.node = m_mesh.tets[t];
+        if (material[t] >= m_materials.size()) throw std::invalid_argument("XfemModel: material index out of range");
+        e.material = material[t];
+        e.geometry = tet_geometry(m_mesh.corners(t));
+        const TetMaterial& m = m_materials[e.material];
+        e.stiffness = tet_stiffness(e.geometry, m.lame);
+        e.mass.topLeftCorner<12, 12>() = tet_mass(e.geometry, m.density);
+    }
+}
+
+CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside)
+{
+    CutReport report;
+    const int id = m_cuts;
+    std::vector<std::int64_t> block_of_node(m_mesh.nodes.size(), -1);
+    for (XfemElement& e : m_elements) {
+        std::array<double, 4> phi{};
+        bool negative = false, positive = false;
+        for (std::size_t c = 0; c < 4; ++c) {
+            phi[c] = plane.at(m_mesh.nodes[e.node[c]]);
+            (phi[c] < 0.0 ? negative : positive) = true;
+        }
+        if (!negative || !positive) continue;
+        if (e.cut >= 0) {
+            ++report.already_cut;
+            continue;
+        }
+        // A closed boundary: every edge the plane crosses is crossed inside the region.
+        bool whole = true;
+        for (std::size_t a = 0; a < 4 && whole && inside; ++a)
+            for (std::size_t b = a + 1; b < 4 && whole; ++b)
+                if ((phi[a] < 0.0) != (phi[b] < 0.0)) {
+                    const double t = phi[a] / (phi[a] - phi[b]);
+                    whole = inside(m_mesh.nodes[e.node[a]] + t * (m_mesh.nodes[e.node[b]] - m_mesh.nodes[e.node[a]]));
+                }
+        if (!whole) {
+            ++report.partial_tets;
+            continue;
+        }
+        const TetMaterial& m = m_materials[e.material];
+        std::array<Eigen::Vector3d, 4> x{};
+        for (std::size_t c = 0; c < 4; ++c) x[c] = m_mesh.nodes[e.node[c]];
+        const CutTet c = cut_tet(x, phi, m_k, m.lame, m.density, m_fitting);
+        e.cut = id;
+        e.phi = phi;
+        e.node_side = c.node_side;
+        e.side_volume = c.side_volume;
+        e.side_stiffness = c.side_stiffness;
+        e.mass = c.mass;
+        for (std::size_t i = 0; i < 4; ++i) {
+            std::int64_t& block = block_of_node[e.node[i]];
+            if (block < 0) {
+                block = static_cast<std::int64_t>(block_count());
+                m_enriched_node.push_back(e.node[i]);
+                ++report.new_blocks;
+            }
+            e.enriched[i] = static_cast<std::uint32_t>(block);
+        }
+        ++report.cut_tets;
+    }
+    if (report.cut_tets > 0) ++m_cuts;
+    return report;
+}
+
+} // namespace vox::isxfem
