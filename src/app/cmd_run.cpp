@@ -13,6 +13,7 @@
 #include "app/scene_pictures.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/device_run.hpp"
+#include "app/isxfem_run.hpp"
 #include "app/tool_session.hpp"
 #include "cut/pieces.hpp"
 #include "io/mesh_writer.hpp"
@@ -82,8 +83,12 @@ void add_run_command(CLI::App& app)
         picture_options.camera = render::parse_camera(args->camera);
         picture_options.camera.up = scene_up(scene);
         std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
-        if (scene.solver.type != io::SolverType::dbg)
-            throw scene.error("solver.type", "\"isxfem\" runs are not available yet; use \"dbg\"");
+        if (scene.solver.type == io::SolverType::isxfem) {
+            if (!args->device.empty() || !args->replay.empty() || args->render_every > 0)
+                throw InputError("--device, --replay and --render-every work with \"type\": \"dbg\" scenes only so far");
+            run_isxfem(scene, args->scene, args->frames, args->out.empty() ? scene.output.dir : std::filesystem::path(args->out));
+            return;
+        }
         const grid::LabelGrid labels = io::load_scene_object(scene);
         // Coarser levels than the simulated one serve only the multigrid preconditioner (built
         // when the solver will use it: every level costs memory and time at each cut); "auto"

@@ -69,6 +69,34 @@ grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGri
                               max_level);
 }
 
+std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
+                                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
+{
+    std::vector<unsigned char> kept(model.node_count(), 0);
+    const Eigen::Vector3d half = 0.5e3 * grid.voxels().voxel_size_m();
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        bool touches = true;
+        if (level >= 1) {
+            const grid::Level& lv = grid.level(level);
+            const grid::Element& ge = lv.elements[model.elements()[e].grid_element];
+            if (lv.cell_elements(ge.code).size() > 1) { // superimposed: only where its material reaches
+                touches = false;
+                for (std::uint32_t v : ge.voxels)
+                    if (in_box(grid.voxels().world_mm(grid.voxels().coord(v).cast<double>()), lo - half, hi + half)) {
+                        touches = true;
+                        break;
+                    }
+            }
+        }
+        if (touches)
+            for (std::uint32_t n : model.elements()[e].dof_node) kept[n] = 1;
+    }
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t n = 0; n < model.node_count(); ++n)
+        if (kept[n] && in_box(model.rest_positions()[n] * 1e3, lo, hi)) out.push_back(n);
+    return out;
+}
+
 SceneSimulation::SceneSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
     : m_scene(scene), m_grid(&grid), m_level(level)
 {
@@ -165,37 +193,7 @@ void SceneSimulation::build(bool first, const fem::HexModel* previous, const gri
     }
 
     solver.set_gravity(scene.gravity_m_s2);
-    // Superimposed elements share their cell's corner positions: a box catches a node of one
-    // only when that element's own material reaches into the box, so holding one arm of a U-tube
-    // does not hold the other arm's element in the same cell.
-    std::vector<unsigned char> superimposed(model.elements().size(), 0); // cells holding several elements
-    if (level >= 1) {
-        const grid::Level& lv = grid.level(level);
-        for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
-            const grid::Element& ge = lv.elements[model.elements()[e].grid_element];
-            superimposed[e] = lv.cell_elements(ge.code).size() > 1;
-        }
-    }
-    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-        std::vector<unsigned char> kept(model.node_count(), 0);
-        const Eigen::Vector3d half = 0.5e3 * grid.voxels().voxel_size_m();
-        for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
-            bool touches = !superimposed[e];
-            if (!touches)
-                for (std::uint32_t v : grid.level(level).elements[model.elements()[e].grid_element].voxels) {
-                    if (in_box(grid.voxels().world_mm(grid.voxels().coord(v).cast<double>()), lo - half, hi + half)) {
-                        touches = true;
-                        break;
-                    }
-                }
-            if (touches)
-                for (std::uint32_t n : model.elements()[e].dof_node) kept[n] = 1;
-        }
-        std::vector<std::uint32_t> out;
-        for (std::uint32_t n = 0; n < model.node_count(); ++n)
-            if (kept[n] && in_box(model.rest_positions()[n] * 1e3, lo, hi)) out.push_back(n);
-        return out;
-    };
+    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return nodes_in_box(grid, model, level, lo, hi); };
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);

@@ -30,6 +30,13 @@ namespace vox::app {
 /// the loads or the time step are beyond what this object and level can follow.
 [[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
 
+/// The nodes of `model` (at `level` of `grid`) inside the box [lo, hi] (world mm) that a scene's
+/// constraint or load box holds. Superimposed elements share their cell's corner positions: a box
+/// catches a node of one only when that element's own material reaches into the box, so holding
+/// one arm of a U-tube does not hold the other arm's element in the same cell.
+[[nodiscard]] std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
+                                                      const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
 /// Milliseconds spent applying one cut.
 struct CutTimings {
     double grid_update_ms = 0.0; ///< BranchedGrid::update

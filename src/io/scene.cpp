@@ -363,6 +363,7 @@ SolverSettings read_solver(JsonReader r)
     if (const std::optional<JsonNode> node = r.optional_node("mass")) {
         s.lumped_mass = choose_enum(*node, mass_kinds);
     }
+    s.isxfem_k = r.optional("k", s.isxfem_k, closed_range(0.0, 1.0));
     r.finish();
     return s;
 }

@@ -129,6 +129,9 @@ struct SolverSettings {
     PreconditionerChoice preconditioner = PreconditionerChoice::automatic;
     /// Key "mass": "lumped" (default: row sums, diagonal) or "consistent".
     bool lumped_mass = true;
+    /// isxfem: the enrichment parameter k in [0, 1] of Is-XFEM (0: standard XFEM); default 0.1,
+    /// the sculpting paper's.
+    double isxfem_k = 0.1;
 };
 
 enum class ConstraintType {

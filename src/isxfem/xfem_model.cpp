@@ -23,11 +23,13 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
     }
 }
 
-CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside)
+CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside, int extend)
 {
+    if (extend >= m_cuts) throw std::invalid_argument("XfemModel::cut: no cut " + std::to_string(extend) + " to extend");
     CutReport report;
-    const int id = m_cuts;
-    std::vector<std::int64_t> block_of_node(m_mesh.nodes.size(), -1);
+    const int id = extend >= 0 ? extend : m_cuts;
+    std::unordered_map<std::uint32_t, std::uint32_t> fresh;
+    std::unordered_map<std::uint32_t, std::uint32_t>& block_of_node = extend >= 0 ? m_cut_blocks[static_cast<std::size_t>(extend)] : fresh;
     for (XfemElement& e : m_elements) {
         std::array<double, 4> phi{};
         bool negative = false, positive = false;
@@ -63,17 +65,23 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         e.side_stiffness = c.side_stiffness;
         e.mass = c.mass;
         for (std::size_t i = 0; i < 4; ++i) {
-            std::int64_t& block = block_of_node[e.node[i]];
-            if (block < 0) {
-                block = static_cast<std::int64_t>(block_count());
+            const auto [it, added] = block_of_node.try_emplace(e.node[i], static_cast<std::uint32_t>(block_count()));
+            if (added) {
                 m_enriched_node.push_back(e.node[i]);
                 ++report.new_blocks;
             }
-            e.enriched[i] = static_cast<std::uint32_t>(block);
+            e.enriched[i] = it->second;
         }
         ++report.cut_tets;
     }
-    if (report.cut_tets > 0) ++m_cuts;
+    if (report.cut_tets > 0) {
+        report.cut = id;
+        if (extend < 0) {
+            m_cut_blocks.push_back(std::move(fresh));
+            m_cut_planes.push_back(plane);
+            ++m_cuts;
+        }
+    }
     return report;
 }
 

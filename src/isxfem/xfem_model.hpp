@@ -15,6 +15,7 @@
 #include "isxfem/xfem_tetrahedron.hpp"
 
 #include <functional>
+#include <unordered_map>
 #include <vector>
 
 namespace vox::isxfem {
@@ -43,6 +44,7 @@ struct XfemElement {
 };
 
 struct CutReport {
+    int cut = -1;                   ///< the cut's id (-1: nothing was cut)
     std::size_t cut_tets = 0;       ///< newly cut
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole: left uncut
@@ -56,8 +58,10 @@ public:
     XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vector<std::uint32_t> material, double k);
 
     /// Cuts by the plane where it crosses a tetrahedron whole within the region `inside` (a
-    /// point of the plane, world m; all of the plane when null).
-    CutReport cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside = {});
+    /// point of the plane, world m; all of the plane when null). `extend`: the id of an earlier
+    /// cut by the same plane that this one continues (a blade going on through its stroke), whose
+    /// nodes keep their enriched blocks, so the crack stays one surface; -1: a new cut.
+    CutReport cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside = {}, int extend = -1);
 
     [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
     [[nodiscard]] const std::vector<XfemElement>& elements() const { return m_elements; }
@@ -68,6 +72,8 @@ public:
     /// The node an enriched block belongs to (block >= node_count()).
     [[nodiscard]] std::uint32_t enriched_node(std::uint32_t block) const { return m_enriched_node[block - node_count()]; }
     [[nodiscard]] int cut_count() const { return m_cuts; }
+    /// The plane of cut `id`.
+    [[nodiscard]] const PlaneCut& cut_plane(int id) const { return m_cut_planes.at(static_cast<std::size_t>(id)); }
 
 private:
     TetMesh m_mesh;
@@ -76,6 +82,8 @@ private:
     MomentFitting m_fitting;
     std::vector<XfemElement> m_elements;
     std::vector<std::uint32_t> m_enriched_node; ///< per enriched block
+    std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> m_cut_blocks; ///< per cut: node -> enriched block
+    std::vector<PlaneCut> m_cut_planes;
     int m_cuts = 0;
 };
 

@@ -107,3 +107,17 @@ TEST(XfemSolver, ACutAtRestMovesNothingAndPartialCutsAreLeft)
     const CutReport again = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0441});
     EXPECT_EQ(again.already_cut, r.cut_tets);
 }
+
+TEST(XfemSolver, ACutContinuedLaterIsOneCrack)
+{
+    XfemModel once = bar_model(0.1), twice = bar_model(0.1);
+    const PlaneCut plane{Eigen::Vector3d::UnitX(), 0.0437};
+    const CutReport whole = once.cut(plane);
+    const CutReport first = twice.cut(plane, [](const Eigen::Vector3d& p) { return p.y() < 0.012; });
+    const CutReport rest = twice.cut(plane, {}, first.cut);
+    EXPECT_EQ(rest.cut, first.cut);
+    EXPECT_EQ(twice.cut_count(), 1);
+    EXPECT_EQ(first.cut_tets + rest.cut_tets, whole.cut_tets);
+    EXPECT_EQ(twice.block_count(), once.block_count()); // shared nodes kept their blocks
+    EXPECT_THROW(twice.cut(plane, {}, 5), std::invalid_argument);
+}

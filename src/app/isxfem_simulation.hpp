@@ -1,0 +1,53 @@
+#pragma once
+// A scene simulated with the Is-XFEM solver (`"solver": {"type": "isxfem"}`): the tetrahedra of the
+// scene's object at the chosen level (isxfem/grid_tets.hpp: the branched elements split in six,
+// so the supports and loads catch the same nodes as the branched-grid solver's), the scene's
+// gravity, constraints, loads and solver settings, blade cuts, and the object's surface embedded
+// in the tetrahedra by barycentric coordinates (each vertex on its side of any cut through its
+// tetrahedron).
+
+#include "io/scene.hpp"
+#include "isxfem/grid_tets.hpp"
+#include "isxfem/xfem_solver.hpp"
+#include "surface/embedded_surface.hpp"
+
+#include <memory>
+
+namespace vox::app {
+
+class IsxfemSimulation {
+public:
+    /// Throws the scene's InputError when a constraint or load box catches no node.
+    IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+
+    [[nodiscard]] const isxfem::XfemModel& model() const { return *m_model; }
+    [[nodiscard]] isxfem::XfemSolver& solver() { return *m_solver; }
+    [[nodiscard]] const isxfem::XfemSolver& solver() const { return *m_solver; }
+    [[nodiscard]] std::size_t tet_count() const { return m_model->elements().size(); }
+
+    /// Cuts with the plane through `point_m` with unit `normal`, within the region `inside`;
+    /// `extend`: the id of the cut this continues (-1: a new one).
+    isxfem::CutReport cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                          const std::function<bool(const Eigen::Vector3d&)>& inside, int extend);
+
+    /// The deformed surface, world mm. Triangles that straddle a cut through one of their
+    /// vertices' tetrahedra are left out (the cut opens a gap in the surface; the faces that
+    /// would close it are not made yet).
+    [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
+    /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.
+    [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements() const;
+
+private:
+    const grid::BranchedGrid& m_grid;
+    std::unique_ptr<isxfem::XfemModel> m_model;
+    std::unique_ptr<isxfem::XfemSolver> m_solver;
+    std::unique_ptr<surface::EmbeddedSurface> m_surface;
+    struct Embedded {
+        std::size_t tet = 0;
+        std::array<double, 4> bary{};
+        Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
+    };
+    std::vector<Embedded> m_vertices; ///< per used surface vertex, in mesh order
+};
+
+} // namespace vox::app

@@ -1,0 +1,112 @@
+#include "isxfem/grid_tets.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace vox::isxfem {
+namespace {
+
+constexpr double k_fill_floor = 1e-3;
+
+/// The Kuhn tetrahedron (0 .. 5, in the order of std::next_permutation over the axes) of the unit
+/// cube holding local point t: the one whose axis order sorts t's coordinates descending.
+int kuhn_index(const Eigen::Vector3d& t)
+{
+    std::array<int, 3> order{0, 1, 2};
+    int index = 0;
+    do {
+        if (t[order[0]] >= t[order[1]] && t[order[1]] >= t[order[2]]) return index;
+        ++index;
+    } while (std::next_permutation(order.begin(), order.end()));
+    return 0;
+}
+
+} // namespace
+
+GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& model)
+{
+    GridTets out;
+    out.mesh.nodes = model.rest_positions();
+    const int level = model.level();
+    const auto& grid_materials = grid.materials();
+    for (const fem::HexElement& el : model.elements()) {
+        // Material per tetrahedron: counts of fine voxel centres, per material.
+        std::array<std::vector<double>, 6> count;
+        for (auto& c : count) c.assign(grid_materials.size(), 0.0);
+        double capacity = 1.0 / 6.0; // voxels a tetrahedron of the cell holds
+        if (level == 0) {
+            for (auto& c : count) c[static_cast<std::size_t>(el.material)] = capacity;
+        } else {
+            const grid::Element& ge = grid.level(level).elements[el.grid_element];
+            const double size = static_cast<double>(1 << level);
+            capacity = size * size * size / 6.0;
+            const Eigen::Vector3d corner0 = grid::BranchedGrid::cell_corner_index(ge.cell, level, 0);
+            for (std::uint32_t v : ge.voxels) {
+                const Eigen::Vector3d t = (grid.voxels().coord(v).cast<double>() - corner0) / size;
+                count[static_cast<std::size_t>(kuhn_index(t))][static_cast<std::size_t>(grid.voxels().material(v))] += 1.0;
+            }
+        }
+        std::array<int, 3> order{0, 1, 2};
+        int p = 0;
+        do {
+            // The path corner 0 -> +order[0] -> +order[1] -> corner 7 (corner bits: +x 1, +y 2, +z 4).
+            std::array<std::uint32_t, 4> t{};
+            int corner = 0;
+            t[0] = el.dof_node[0];
+            for (int s = 0; s < 3; ++s) {
+                corner |= 1 << order[static_cast<std::size_t>(s)];
+                t[static_cast<std::size_t>(s + 1)] = el.dof_node[static_cast<std::size_t>(corner)];
+            }
+            if (signed_volume({out.mesh.nodes[t[0]], out.mesh.nodes[t[1]], out.mesh.nodes[t[2]], out.mesh.nodes[t[3]]}) < 0.0)
+                std::swap(t[2], t[3]); // a mirroring scan transform
+            out.mesh.tets.push_back(t);
+            const std::vector<double>& c = count[static_cast<std::size_t>(p)];
+            const double held = std::accumulate(c.begin(), c.end(), 0.0);
+            const double fill = std::clamp(held / capacity, k_fill_floor, 1.0);
+            TetMaterial m{{0.0, 0.0}, 0.0};
+            const std::size_t dominant = static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
+            for (std::size_t k = 0; k < c.size(); ++k) {
+                // Shares of the held material (all of it the dominant one when empty).
+                const double share = held > 0.0 ? c[k] / held : (k == dominant ? 1.0 : 0.0);
+                m.lame.lambda += fill * share * grid_materials[k].lame.lambda;
+                m.lame.mu += fill * share * grid_materials[k].lame.mu;
+                m.density += fill * share * grid_materials[k].density_kg_m3;
+            }
+            out.material.push_back(static_cast<std::uint32_t>(out.materials.size()));
+            out.materials.push_back(m);
+            out.fill.push_back(fill);
+            ++p;
+        } while (std::next_permutation(order.begin(), order.end()));
+    }
+    return out;
+}
+
+std::pair<std::size_t, std::array<double, 4>> locate(const TetMesh& mesh, std::size_t element, const Eigen::Vector3d& x)
+{
+    std::size_t best = GridTets::first_tet(element);
+    std::array<double, 4> best_l{0.25, 0.25, 0.25, 0.25};
+    double best_min = -INFINITY;
+    for (std::size_t t = GridTets::first_tet(element); t < GridTets::first_tet(element) + 6; ++t) {
+        const auto c = mesh.corners(t);
+        Eigen::Matrix3d j;
+        for (int k = 0; k < 3; ++k) j.col(k) = c[static_cast<std::size_t>(k + 1)] - c[0];
+        const Eigen::Vector3d l = j.inverse() * (x - c[0]);
+        const std::array<double, 4> bary{1.0 - l.sum(), l.x(), l.y(), l.z()};
+        const double lowest = *std::min_element(bary.begin(), bary.end());
+        if (lowest > best_min) {
+            best_min = lowest;
+            best = t;
+            best_l = bary;
+        }
+    }
+    // Clamp: a point on the cell's boundary may sit a rounding error outside.
+    double sum = 0.0;
+    for (double& b : best_l) sum += (b = std::max(b, 0.0));
+    for (double& b : best_l) b /= sum;
+    return {best, best_l};
+}
+
+} // namespace vox::isxfem
