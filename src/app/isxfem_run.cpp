@@ -124,7 +124,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
               level, sim.tet_count(), sim.solver().dof_count(), frames, dt);
     nlohmann::json stats{{"scene", scene_path}, {"solver", "isxfem"}, {"k", scene.solver.isxfem_k}, {"level", level},
                          {"tetrahedra", sim.tet_count()}, {"dofs", sim.solver().dof_count()}, {"dt_s", dt},
-                         {"linear_solver", "CG, Jacobi preconditioner"}, {"frames", nlohmann::json::array()}};
+                         {"linear_solver", std::string("CG, ") + sim.solver().preconditioner_name() + " preconditioner"}, {"frames", nlohmann::json::array()}};
     double total_ms = 0.0, max_ms = 0.0, cut_total_ms = 0.0;
     int converged = 0;
     std::size_t cut_tets = 0, partial = 0;

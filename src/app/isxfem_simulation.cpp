@@ -3,6 +3,7 @@
 #include "app/scene_simulation.hpp"
 #include "cut/model_surface.hpp"
 #include "fem/hex_model.hpp"
+#include "fem/rest_cholesky.hpp"
 
 namespace vox::app {
 
@@ -27,6 +28,14 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     o.rayleigh_mass_per_s = scene.solver.rayleigh_mass_per_s;
     o.rayleigh_stiffness_s = scene.solver.rayleigh_stiffness_s;
     m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, o);
+    switch (scene.solver.preconditioner) {
+    case io::PreconditionerChoice::multigrid:
+        throw scene.error("solver.preconditioner", "\"isxfem\" has no multigrid; use \"auto\", \"cholesky\" or \"jacobi\"");
+    case io::PreconditionerChoice::jacobi:
+        break;
+    default: // the warped factor, taken again after each cut and when the object has turned away from it
+        m_solver->set_preconditioner(std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity()));
+    }
     m_solver->set_gravity(scene.gravity_m_s2);
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];

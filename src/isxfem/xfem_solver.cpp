@@ -46,6 +46,29 @@ void XfemSolver::fix(std::uint32_t node, unsigned axes)
 {
     for (unsigned a = 0; a < 3; ++a)
         if (axes & (1u << a)) m_fixed.at(3 * std::size_t{node} + a) = 1;
+    if (m_preconditioner) m_preconditioner->invalidate();
+}
+
+void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p) { m_preconditioner = std::move(p); }
+
+void XfemSolver::update_block_rotations()
+{
+    // The mean of the quaternions, each taken with the sign nearer the running sum.
+    std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
+    const auto& elements = m_model.elements();
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+        const XfemElement& el = elements[e];
+        for (std::size_t side = 0; side < (el.cut >= 0 ? 2u : 1u); ++side) {
+            const Eigen::Vector4d q = m_rotation[e][side].coeffs();
+            for (std::size_t a = 0; a < el.block_count(); ++a) {
+                Eigen::Vector4d& s = sum[el.block(a)];
+                s += s.dot(q) < 0.0 ? -q : q;
+            }
+        }
+    }
+    m_block_rotation.resize(m_x.size(), Eigen::Quaterniond::Identity());
+    for (std::size_t b = 0; b < m_x.size(); ++b)
+        if (sum[b].squaredNorm() > 0.0) m_block_rotation[b].coeffs() = sum[b].normalized();
 }
 
 void XfemSolver::model_changed()
@@ -56,6 +79,7 @@ void XfemSolver::model_changed()
     m_fixed.resize(3 * blocks, 0);
     m_rotation.resize(m_model.elements().size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
     build_pattern();
+    if (m_preconditioner) m_preconditioner->invalidate(); // a grown system: factor it anew
 }
 
 void XfemSolver::build_pattern()
@@ -181,7 +205,7 @@ void XfemSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
     out.noalias() = m_matrix * p;
 }
 
-int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual) const
+int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
     // Conjugate gradients with Jacobi preconditioning, stopping on the Jacobi-scaled residual
     // relative to the scaled right-hand side (as the branched-grid solver does).
@@ -193,10 +217,22 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
         residual = 0.0;
         return 0;
     }
-    Eigen::VectorXd r(rhs.size()), q(rhs.size());
+    if (m_preconditioner) {
+        update_block_rotations();
+        m_preconditioner->update(&m_matrix, m_fixed, m_block_rotation);
+        if (m_preconditioner->failed()) m_preconditioner.reset(); // a singular system: Jacobi carries on
+    }
+    auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {
+        if (m_preconditioner)
+            m_preconditioner->apply(res, out);
+        else
+            out = res.cwiseProduct(inv_d);
+    };
+    Eigen::VectorXd r(rhs.size()), q(rhs.size()), z(rhs.size());
     multiply(x, q);
     r = rhs - q;
-    Eigen::VectorXd z = r.cwiseProduct(inv_d), p = z;
+    precondition(r, z);
+    Eigen::VectorXd p = z;
     double rz = r.dot(z);
     int it = 0;
     residual = r.cwiseProduct(inv_sqrt_d).norm() / b_norm;
@@ -207,13 +243,15 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
         const double alpha = rz / pq;
         x += alpha * p;
         r -= alpha * q;
-        z = r.cwiseProduct(inv_d);
+        precondition(r, z);
         const double rz_next = r.dot(z);
-        p = z + (rz_next / rz) * p;
-        rz = rz_next;
         residual = r.cwiseProduct(inv_sqrt_d).norm() / b_norm;
         ++it;
+        if (!(rz_next > 0.0)) break;
+        p = z + (rz_next / rz) * p;
+        rz = rz_next;
     }
+    if (m_preconditioner) m_preconditioner->report_iterations(it);
     return it;
 }
 

@@ -3,7 +3,9 @@
 // (fem/implicit_solver.hpp): one linearised implicit Euler step per frame,
 //   (M + dt C + dt^2 K) v' = M v + dt (f_ext - f_int(x)),   x' = x + dt v',
 // Rayleigh damping C = alpha M + beta K, consistent mass, conjugate gradients warm started from v
-// with Jacobi preconditioning (the scaling that keeps cut systems conditioned: docs/isxfem.md).
+// with Jacobi preconditioning (the scaling that keeps cut systems conditioned: docs/isxfem.md) or
+// a given preconditioner (the warped factor of fem/rest_cholesky.hpp: each dof block turned by the
+// mean rotation of its tetrahedra; a cut makes it factor the grown system anew).
 //
 // State per dof block: a node's position (world m) or an enriched block's displacement (m).
 // Rotations: a whole tetrahedron takes the rotational part of its deformation gradient; a cut one
@@ -12,10 +14,13 @@
 
 #include "isxfem/xfem_model.hpp"
 
+#include "fem/preconditioner.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace vox::isxfem {
@@ -42,6 +47,10 @@ class XfemSolver {
 public:
     XfemSolver(const XfemModel& model, const XfemOptions& options);
 
+    /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
+    void set_preconditioner(std::unique_ptr<fem::Preconditioner> p);
+    [[nodiscard]] const char* preconditioner_name() const { return m_preconditioner ? m_preconditioner->name() : "Jacobi"; }
+
     /// Holds node `node` along the axes whose bits are set in `axes` (1 x, 2 y, 4 z).
     void fix(std::uint32_t node, unsigned axes);
     void set_gravity(const Eigen::Vector3d& g) { m_gravity = g; }
@@ -67,7 +76,9 @@ private:
     /// Rotations, elastic forces (m_internal) and the system matrix scale_m M + scale_k K(x).
     void assemble(double scale_m, double scale_k);
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
-    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual) const;
+    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
+    /// The mean rotation of each dof block's tetrahedra (both sides of cut ones), for the warp.
+    void update_block_rotations();
 
     const XfemModel& m_model;
     XfemOptions m_options;
@@ -80,6 +91,8 @@ private:
     std::vector<std::uint32_t> m_rank;                     ///< per element, 64 block pairs: column block's rank in its row
     std::vector<std::uint32_t> m_rank_start;               ///< per element, into m_rank
     Eigen::VectorXd m_internal;
+    std::unique_ptr<fem::Preconditioner> m_preconditioner;
+    std::vector<Eigen::Quaterniond> m_block_rotation;
 };
 
 } // namespace vox::isxfem
