@@ -7,6 +7,7 @@
 #include "app/commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
+#include "app/bench_compare.hpp"
 #include "app/bench_conditioning.hpp"
 #include "app/bench_cutting.hpp"
 #include "app/bench_haptics.hpp"
@@ -23,6 +24,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace vox::app {
@@ -253,6 +255,19 @@ void add_bench_command(CLI::App& app)
         "conditioning", "Condition numbers of XFEM and Is-XFEM systems as a cut nears a node plane, with and without preconditioning");
     conditioning->add_option("--out", *conditioning_out, "Folder for conditioning.md (default docs)");
     conditioning->callback([conditioning_out] { write_conditioning(*conditioning_out, run_conditioning()); });
+
+    struct CompareArgs {
+        std::string scene, out = "docs";
+        std::optional<int> frames;
+    };
+    auto compare_args = std::make_shared<CompareArgs>();
+    CLI::App* compare = bench->add_subcommand(
+        "compare", "The same scene and tool script by the branched grid and by Is-XFEM (k = 0.1 and k = 0), side by side");
+    compare->add_option("scene", compare_args->scene, "Scene file (.json)")->required();
+    compare->add_option("--frames", compare_args->frames, "Number of frames (default: the script's duration / dt_s, else 100)")
+        ->check(CLI::PositiveNumber);
+    compare->add_option("--out", compare_args->out, "Folder for compare-SCENE.md (default docs)");
+    compare->callback([compare_args] { run_compare(compare_args->scene, compare_args->frames, compare_args->out); });
 
     auto stability_out = std::make_shared<std::string>("docs");
     auto quick = std::make_shared<bool>(false);

@@ -53,6 +53,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         if (m_surface->vertices()[v].users == 0) continue;
         Embedded e;
         e.rest_m = embedding.vertex_rest_mm(v) * 1e-3;
+        e.key = m_surface->vertices()[v].key;
         std::tie(e.tet, e.bary) = isxfem::locate(m_model->mesh(), embedding.vertex_element(v), e.rest_m);
         m_vertices.push_back(e);
     }
@@ -78,6 +79,14 @@ std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
         u.push_back(m_solver->position(v.tet, v.bary, side) - v.rest_m);
     }
     return u;
+}
+
+std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
+{
+    std::vector<std::uint64_t> keys;
+    keys.reserve(m_vertices.size());
+    for (const Embedded& v : m_vertices) keys.push_back(v.key);
+    return keys;
 }
 
 surface::SurfaceMesh IsxfemSimulation::surface_mesh() const

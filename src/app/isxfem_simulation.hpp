@@ -36,6 +36,9 @@ public:
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
     /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements() const;
+    /// The identity (surface::SurfaceVertex::key) of each of those vertices, the same as in a
+    /// branched-grid simulation of the same scene and level.
+    [[nodiscard]] std::vector<std::uint64_t> surface_keys() const;
 
 private:
     const grid::BranchedGrid& m_grid;
@@ -46,6 +49,7 @@ private:
         std::size_t tet = 0;
         std::array<double, 4> bary{};
         Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
+        std::uint64_t key = 0;
     };
     std::vector<Embedded> m_vertices; ///< per used surface vertex, in mesh order
 };

@@ -54,3 +54,16 @@ TEST(IsxfemRun, WhatItCannotDoYetIsRefusedByName)
     EXPECT_NE(r.err.find("isxfem"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(d / "out" / "stats.json"));
 }
+
+TEST(IsxfemRun, CompareRunsBothMethodsOnTheSameScene)
+{
+    const fs::path out = fresh_dir("isxfem_compare");
+    const auto r = run_voxsculpt("bench compare " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/bar_cut_isxfem.json") +
+                                 " --frames 12 --out " + quote(out.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(out / "compare-bar_cut_isxfem.md");
+    std::stringstream md;
+    md << in.rdbuf();
+    for (const char* method : {"| dbg |", "| Is-XFEM (k = 0.1) |", "| XFEM (k = 0) |"}) EXPECT_NE(md.str().find(method), std::string::npos) << method;
+    EXPECT_NE(md.str().find("12 of 12"), std::string::npos); // every frame converged
+}

@@ -1,0 +1,91 @@
+#include "app/blade_stroke.hpp"
+
+#include "contact/tool_shape.hpp"
+
+#include <cmath>
+
+namespace vox::app {
+
+BladeStroke::BladeStroke(const io::ToolSpec& tool)
+    : m_profile((tool.shape == io::ToolShape::scalpel ? contact::ToolShape::scalpel(tool.size_mm) : contact::ToolShape::box(tool.size_mm))
+                    .profile())
+{
+}
+
+isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to)
+{
+    const Eigen::Matrix3d r = to.orientation.toRotationMatrix();
+    const Eigen::Vector3d normal = r.col(1);
+    const bool same_plane = m_cut >= 0 && (normal - m_rotation.col(1)).norm() < 1e-9 &&
+                            std::abs((to.position_mm - m_origin_mm).dot(normal)) < 1e-6;
+    if (!same_plane) {
+        m_cut = -1;
+        m_rotation = r;
+        m_origin_mm = to.position_mm;
+        m_segments.clear();
+    }
+    // The motion in the plane, in the stroke's x-z coordinates (motion across it is ignored).
+    auto in_plane = [&](const Eigen::Vector3d& p_mm) {
+        const Eigen::Vector3d local = m_rotation.transpose() * (p_mm - m_origin_mm);
+        return Eigen::Vector2d(local.x(), local.z());
+    };
+    m_segments.push_back({in_plane(from.placed ? from.position_mm : to.position_mm), in_plane(to.position_mm)});
+    const auto inside = [this, &in_plane](const Eigen::Vector3d& p_m) { return covered(in_plane(p_m * 1e3)); };
+    const isxfem::CutReport report = sim.cut(m_origin_mm * 1e-3, m_rotation.col(1), inside, m_cut);
+    if (report.cut >= 0) m_cut = report.cut;
+    return report;
+}
+
+bool BladeStroke::covered(const Eigen::Vector2d& q) const
+{
+    // Some t in [0, 1] with q - a - t (b - a) inside every edge's half-plane of the convex,
+    // counter-clockwise profile: an interval of t per edge.
+    for (const auto& [a, b] : m_segments) {
+        double lo = 0.0, hi = 1.0;
+        const Eigen::Vector2d d = b - a, p = q - a;
+        for (std::size_t k = 0; k < m_profile.size() && lo <= hi; ++k) {
+            const Eigen::Vector2d& e0 = m_profile[k];
+            const Eigen::Vector2d& e1 = m_profile[(k + 1) % m_profile.size()];
+            const Eigen::Vector2d outward(e1.y() - e0.y(), e0.x() - e1.x()); // right of a counter-clockwise edge
+            // outward . (p - t d - e0) <= 0  <=>  t (outward . d) >= outward . (p - e0)
+            const double c = outward.dot(p - e0), s = outward.dot(d);
+            if (std::abs(s) < 1e-300) {
+                if (c > 0.0) hi = -1.0;
+            } else if (s > 0.0) {
+                lo = std::max(lo, c / s);
+            } else {
+                hi = std::min(hi, c / s);
+            }
+        }
+        if (lo <= hi) return true;
+    }
+    return false;
+}
+
+isxfem::CutReport cut_frame(const io::Scene& scene, IsxfemSimulation& sim, std::vector<BladeStroke>& strokes, int frame, double dt)
+{
+    isxfem::CutReport total;
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+        const io::ToolPose from = io::tool_pose(scene, k, (frame - 1) * dt), to = io::tool_pose(scene, k, frame * dt);
+        if (!to.placed) continue;
+        const isxfem::CutReport r = strokes[k].advance(sim, from, to);
+        total.cut_tets += r.cut_tets;
+        total.new_blocks += r.new_blocks;
+        total.partial_tets += r.partial_tets;
+        total.already_cut += r.already_cut;
+    }
+    return total;
+}
+
+void check_isxfem_tools(const io::Scene& scene)
+{
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+        const io::ToolSpec& t = scene.tools[k];
+        if (t.action != io::ToolAction::cut || (t.shape != io::ToolShape::blade && t.shape != io::ToolShape::scalpel))
+            throw scene.error("tools[" + std::to_string(k) + "]",
+                              "\"" + t.name + "\": \"isxfem\" scenes cut with blades and scalpels only so far; pushing and wetting tools need \"type\": \"dbg\"");
+        if (t.two_phase) throw scene.error("tools[" + std::to_string(k) + "].two_phase", "\"isxfem\" has no two-phase cutting yet");
+    }
+}
+
+} // namespace vox::app
