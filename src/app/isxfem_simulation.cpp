@@ -4,6 +4,13 @@
 #include "cut/model_surface.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
+#include "isxfem/polygon_triangulation.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <map>
+#include <set>
 
 namespace vox::app {
 
@@ -89,26 +96,152 @@ std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
     return keys;
 }
 
+/// A surface vertex while the cut faces are made: where it is embedded and on which side.
+struct IsxfemSimulation::CapVertex {
+    std::size_t tet = 0;
+    std::array<double, 4> bary{};
+    int side = 0;
+    Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
+    std::int32_t label = 0;
+};
+
+namespace {
+
+/// Barycentric coordinates of x in tetrahedron t, and the smallest of them.
+std::pair<std::array<double, 4>, double> barycentric(const isxfem::TetMesh& mesh, std::size_t t, const Eigen::Vector3d& x)
+{
+    const auto c = mesh.corners(t);
+    Eigen::Matrix3d j;
+    for (int k = 0; k < 3; ++k) j.col(k) = c[static_cast<std::size_t>(k + 1)] - c[0];
+    const Eigen::Vector3d l = j.inverse() * (x - c[0]);
+    const std::array<double, 4> b{1.0 - l.sum(), l.x(), l.y(), l.z()};
+    return {b, *std::min_element(b.begin(), b.end())};
+}
+
+} // namespace
+
 surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
 {
-    surface::SurfaceMesh out = m_surface->mesh(m_grid); // rest, world mm, the used vertices in slot order
-    const std::vector<Eigen::Vector3d> u = surface_displacements();
-    // A triangle straddles cut j when one of its vertices lies in a tetrahedron cut by j and its
-    // vertices' rest positions lie on both sides of j's plane.
-    auto straddles = [&](const Eigen::Vector3i& t) {
-        for (int a = 0; a < 3; ++a) {
-            const int cut = m_model->elements()[m_vertices[static_cast<std::size_t>(t[a])].tet].cut;
-            if (cut < 0) continue;
-            const isxfem::PlaneCut& plane = m_model->cut_plane(cut);
-            bool negative = false, positive = false;
-            for (int b = 0; b < 3; ++b) (plane.at(m_vertices[static_cast<std::size_t>(t[b])].rest_m) < 0.0 ? negative : positive) = true;
-            if (negative && positive) return true;
-        }
-        return false;
-    };
-    std::erase_if(out.triangles, straddles);
-    for (std::size_t k = 0; k < out.positions.size(); ++k) out.positions[k] += 1e3 * u[k];
+    const surface::SurfaceMesh rest = m_surface->mesh(m_grid); // rest, world mm, the used vertices in slot order
+    std::vector<CapVertex> vertices;
+    vertices.reserve(m_vertices.size());
+    for (std::size_t k = 0; k < m_vertices.size(); ++k) {
+        const Embedded& e = m_vertices[k];
+        const isxfem::XfemElement& el = m_model->elements()[e.tet];
+        double phi = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) phi += e.bary[c] * el.phi[c];
+        vertices.push_back({e.tet, e.bary, el.cut >= 0 && phi >= 0.0 ? 1 : 0, e.rest_m, rest.labels[k]});
+    }
+    std::vector<Eigen::Vector3i> triangles = rest.triangles;
+    for (int cut = 0; cut < m_model->cut_count(); ++cut) close_cut(cut, vertices, triangles);
+    surface::SurfaceMesh out;
+    out.triangles = std::move(triangles);
+    for (const CapVertex& v : vertices) {
+        out.positions.push_back(1e3 * m_solver->position(v.tet, v.bary, v.side));
+        out.labels.push_back(v.label);
+    }
     return out;
+}
+
+void IsxfemSimulation::close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
+{
+    // Triangles the cut's plane crosses where it cut a tetrahedron of theirs are split along the
+    // plane, each piece keeping the side it lies on (new vertices on the plane, one copy per side);
+    // the closed loops the split edges make are filled on both sides.
+    const isxfem::PlaneCut& plane = m_model->cut_plane(cut);
+    std::map<std::pair<int, int>, std::array<int, 2>> crossing; // edge -> its point on the plane, per side
+    auto point_on = [&](int a, int b) {
+        const auto key = std::minmax(a, b);
+        if (const auto it = crossing.find(key); it != crossing.end()) return it->second;
+        const CapVertex& va = vertices[static_cast<std::size_t>(key.first)];
+        const CapVertex& vb = vertices[static_cast<std::size_t>(key.second)];
+        const double fa = plane.at(va.rest_m), fb = plane.at(vb.rest_m);
+        const Eigen::Vector3d x = va.rest_m + fa / (fa - fb) * (vb.rest_m - va.rest_m);
+        // In whichever of its ends' tetrahedra holds it better (the edge is shorter than a cell).
+        const auto from_a = barycentric(m_model->mesh(), va.tet, x), from_b = barycentric(m_model->mesh(), vb.tet, x);
+        const bool use_b = from_b.second > from_a.second;
+        std::array<double, 4> bary = use_b ? from_b.first : from_a.first;
+        const std::size_t tet = use_b ? vb.tet : va.tet;
+        double sum = 0.0;
+        for (double& l : bary) sum += (l = std::max(l, 0.0));
+        for (double& l : bary) l /= sum;
+        std::array<int, 2> copies{};
+        for (int side = 0; side < 2; ++side) {
+            copies[static_cast<std::size_t>(side)] = static_cast<int>(vertices.size());
+            vertices.push_back({tet, bary, side, x, va.label});
+        }
+        crossing.emplace(key, copies);
+        return copies;
+    };
+    std::vector<Eigen::Vector3i> kept;
+    std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> links; // crossing edge -> the crossing edges it joins
+    for (const Eigen::Vector3i& t : triangles) {
+        std::array<bool, 3> positive{};
+        bool in_cut = false;
+        for (int a = 0; a < 3; ++a) {
+            const CapVertex& v = vertices[static_cast<std::size_t>(t[a])];
+            positive[static_cast<std::size_t>(a)] = plane.at(v.rest_m) >= 0.0;
+            in_cut = in_cut || m_model->elements()[v.tet].cut == cut;
+        }
+        if (!in_cut || (positive[0] == positive[1] && positive[1] == positive[2])) {
+            kept.push_back(t);
+            continue;
+        }
+        // Each side's piece: its corners and the edge crossings, in the triangle's order.
+        std::array<std::pair<int, int>, 2> ends{};
+        int found = 0;
+        for (int side = 0; side < 2; ++side) {
+            std::vector<int> piece;
+            for (int a = 0; a < 3; ++a) {
+                const int b = (a + 1) % 3;
+                if (positive[static_cast<std::size_t>(a)] == (side == 1)) piece.push_back(t[a]);
+                if (positive[static_cast<std::size_t>(a)] != positive[static_cast<std::size_t>(b)]) {
+                    piece.push_back(point_on(t[a], t[b])[static_cast<std::size_t>(side)]);
+                    if (side == 0) ends[static_cast<std::size_t>(found++)] = std::minmax(t[a], t[b]);
+                }
+            }
+            for (std::size_t k = 1; k + 1 < piece.size(); ++k) kept.emplace_back(piece[0], piece[k], piece[k + 1]);
+        }
+        links[ends[0]].push_back(ends[1]);
+        links[ends[1]].push_back(ends[0]);
+    }
+    triangles = std::move(kept);
+    // Closed loops of crossing points; open chains (a cut that does not go through) are left open.
+    const Eigen::Vector3d n = plane.normal.normalized();
+    const Eigen::Vector3d u = n.unitOrthogonal(), w = n.cross(u);
+    std::set<std::pair<int, int>> visited;
+    for (const auto& [start, next] : links) {
+        if (visited.count(start) || next.size() != 2) continue;
+        std::vector<std::pair<int, int>> loop{start};
+        visited.insert(start);
+        std::pair<int, int> previous = start, current = next[0];
+        bool closed = false;
+        while (true) {
+            if (current == start) {
+                closed = true;
+                break;
+            }
+            const auto it = links.find(current);
+            if (it == links.end() || it->second.size() != 2 || visited.count(current)) break;
+            visited.insert(current);
+            loop.push_back(current);
+            const std::pair<int, int> after = it->second[0] == previous ? it->second[1] : it->second[0];
+            previous = current;
+            current = after;
+        }
+        if (!closed || loop.size() < 3) continue;
+        std::vector<Eigen::Vector2d> flat;
+        for (const auto& edge : loop) {
+            const Eigen::Vector3d& x = vertices[static_cast<std::size_t>(crossing.at(edge)[0])].rest_m;
+            flat.emplace_back(u.dot(x), w.dot(x));
+        }
+        // Counter-clockwise in (u, w) faces +n, out of the negative side.
+        for (const std::array<int, 3>& f : isxfem::triangulate_polygon(flat)) {
+            auto copy = [&](int i, int side) { return crossing.at(loop[static_cast<std::size_t>(i)])[static_cast<std::size_t>(side)]; };
+            triangles.emplace_back(copy(f[0], 0), copy(f[1], 0), copy(f[2], 0));
+            triangles.emplace_back(copy(f[0], 1), copy(f[2], 1), copy(f[1], 1));
+        }
+    }
 }
 
 } // namespace vox::app

@@ -30,9 +30,10 @@ public:
     isxfem::CutReport cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
                           const std::function<bool(const Eigen::Vector3d&)>& inside, int extend);
 
-    /// The deformed surface, world mm. Triangles that straddle a cut through one of their
-    /// vertices' tetrahedra are left out (the cut opens a gap in the surface; the faces that
-    /// would close it are not made yet).
+    /// The deformed surface, world mm, closed along the cuts: triangles a cut's plane crosses
+    /// where it cut one of their tetrahedra are split along the plane (each piece moving with its
+    /// side), and each closed loop of split edges is filled on both sides. A cut that does not go
+    /// through the surface (a slit) leaves its opening as it is.
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
     /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements() const;
@@ -41,6 +42,9 @@ public:
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const;
 
 private:
+    struct CapVertex;
+    void close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
+
     const grid::BranchedGrid& m_grid;
     std::unique_ptr<isxfem::XfemModel> m_model;
     std::unique_ptr<isxfem::XfemSolver> m_solver;

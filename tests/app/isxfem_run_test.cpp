@@ -1,5 +1,6 @@
 // `voxsculpt run` with the Is-XFEM solver, end to end: the bundled bar is cut through by its blade
-// over several frames into one crack, and its far half falls away while the held half stays; a
+// over several frames into one crack, its far half falls away while the held half stays, and the
+// surface comes out closed along the cut (two closed pieces, the bar's volume between them); a
 // scene asking Is-XFEM for what it does not do yet is refused with one message naming the key.
 
 #include "app/run_command.hpp"
@@ -34,7 +35,12 @@ TEST(IsxfemRun, TheBarIsCutThroughAndItsFarHalfFalls)
     EXPECT_GT(cutting_frames, 1); // the blade goes down through it over several frames
     // By 0.3 s the far half has fallen tens of centimetres (free fall from the last cut: 0.5 g t^2).
     EXPECT_GT(stats["frames"].back()["max_displacement_mm"].get<double>(), 150.0);
-    EXPECT_TRUE(fs::exists(out / "final.obj"));
+    // Closed along the cut: two closed pieces holding the bar's 100 x 10 x 10 mm between them.
+    const nlohmann::json mesh = vox::test::info_json(out / "final.obj");
+    EXPECT_EQ(mesh["closed"], true);
+    EXPECT_EQ(mesh["components"], 2);
+    EXPECT_EQ(mesh["consistently_oriented"], true);
+    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 50.0);
 }
 
 TEST(IsxfemRun, WhatItCannotDoYetIsRefusedByName)
