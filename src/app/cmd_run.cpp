@@ -14,6 +14,7 @@
 #include "app/scene_simulation.hpp"
 #include "app/device_run.hpp"
 #include "app/isxfem_run.hpp"
+#include "app/run_output.hpp"
 #include "app/tool_session.hpp"
 #include "cut/pieces.hpp"
 #include "io/mesh_writer.hpp"
@@ -222,40 +223,29 @@ void add_run_command(CLI::App& app)
                                        {"elements", sim.model().elements().size()},
                                        {"object_held", tf.hold_object},
                                        {"tools", tool_frames}});
-            if (pictures && f % args->render_every == 0) {
-                char name[32];
-                std::snprintf(name, sizeof name, "frame_%05d.png", f);
-                pictures->write(out / name, sim, tools, scene);
-            }
-            if (f % scene.output.mesh_every_n_frames == 0) {
-                char name[32];
-                std::snprintf(name, sizeof name, "frame_%05d.obj", f);
-                write_surface(out / name, sim);
-            }
+            if (pictures && f % args->render_every == 0) pictures->write(out / frame_file_name(f, "png"), sim, tools, scene);
+            if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
             progress.update(static_cast<std::uint64_t>(f));
         }
         progress.finish();
-        stats["summary"] = {{"frames", frames},
-                            {"total_step_ms", total_ms},
-                            {"mean_step_ms", frames ? total_ms / frames : 0.0},
-                            {"max_step_ms", max_ms},
-                            {"converged_frames", converged},
-                            {"removed_voxels", removed},
-                            {"separated_faces", separated},
-                            {"separated_voxels", tools.separated_voxels()},
-                            {"voxels", g.voxels().alive_count()},
-                            {"cutting_frames", cutting_ms.size()},
-                            {"cutting_ms_p95", quantile(cutting_ms, 0.95)},
-                            {"final_elements", sim.model().elements().size()},
-                            {"pieces", cut::piece_count(sim.model())},
-                            {"wet_elements", wet_elements(sim)},
-                            {"mass_kg", g.total_mass_kg()},
-                            {"final_max_displacement_mm", last.max_displacement_m * 1e3},
-                            {"final_elastic_energy_j", last.elastic_energy_j},
-                            {"final_kinetic_energy_j", last.kinetic_energy_j}};
+        stats["summary"] = step_summary(frames, total_ms, max_ms, converged);
+        stats["summary"].update(
+            {{"removed_voxels", removed},
+             {"separated_faces", separated},
+             {"separated_voxels", tools.separated_voxels()},
+             {"voxels", g.voxels().alive_count()},
+             {"cutting_frames", cutting_ms.size()},
+             {"cutting_ms_p95", quantile(cutting_ms, 0.95)},
+             {"final_elements", sim.model().elements().size()},
+             {"pieces", cut::piece_count(sim.model())},
+             {"wet_elements", wet_elements(sim)},
+             {"mass_kg", g.total_mass_kg()},
+             {"final_max_displacement_mm", last.max_displacement_m * 1e3},
+             {"final_elastic_energy_j", last.elastic_energy_j},
+             {"final_kinetic_energy_j", last.kinetic_energy_j}});
         if (!sim.solver().fallback_note().empty()) {
-            log::warn("{}", sim.solver().fallback_note());
-            stats["linear_solver"] = sim.solver().fallback_note();
+          log::warn("{}", sim.solver().fallback_note());
+          stats["linear_solver"] = sim.solver().fallback_note();
         }
         write_surface(out / "final.obj", sim);
         if (pictures) pictures->write(out / "final.png", sim, tools, scene);

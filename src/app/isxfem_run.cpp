@@ -2,6 +2,7 @@
 
 #include "app/blade_stroke.hpp"
 #include "app/isxfem_simulation.hpp"
+#include "app/run_output.hpp"
 #include "app/scene_simulation.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -82,29 +83,27 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"cut_tets", frame_cut.cut_tets},
                                    {"partly_crossed_tets", frame_cut.partial_tets},
                                    {"dofs", sim.solver().dof_count()}});
-        if (f % scene.output.mesh_every_n_frames == 0) {
-            char name[32];
-            std::snprintf(name, sizeof name, "frame_%05d.obj", f);
-            write_surface(out / name, sim);
-        }
+        if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
         progress.update(static_cast<std::uint64_t>(f));
     }
     progress.finish();
-    stats["summary"] = {{"frames", frames},
-                        {"total_step_ms", total_ms},
-                        {"mean_step_ms", frames ? total_ms / frames : 0.0},
-                        {"max_step_ms", max_ms},
-                        {"converged_frames", converged},
-                        {"cut_tets", cut_tets},
-                        {"cuts", sim.model().cut_count()},
-                        {"partly_crossed_tets_last_frame", partial},
-                        {"total_cut_ms", cut_total_ms},
-                        {"final_dofs", sim.solver().dof_count()},
-                        {"final_kinetic_energy_j", last.kinetic_energy_j}};
+    stats["summary"] = step_summary(frames, total_ms, max_ms, converged);
+    stats["summary"].update(
+        {{"cut_tets", cut_tets},
+         {"cuts", sim.model().cut_count()},
+         {"partly_crossed_tets_last_frame", partial},
+         {"total_cut_ms", cut_total_ms},
+         {"final_dofs", sim.solver().dof_count()},
+         {"final_kinetic_energy_j", last.kinetic_energy_j}});
     write_surface(out / "final.obj", sim);
-    write_atomically(out / "stats.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << stats.dump(1) << '\n'; });
-    log::info("wrote {}: stats.json, final.obj and {} frame meshes; mean step {:.2f} ms, {} tetrahedra cut in {} cuts", out.string(),
-              frames / scene.output.mesh_every_n_frames, total_ms / std::max(frames, 1), cut_tets, sim.model().cut_count());
+    write_atomically(out / "stats.json", [&](const std::filesystem::path &tmp) {
+      std::ofstream(tmp) << stats.dump(1) << '\n';
+    });
+    log::info("wrote {}: stats.json, final.obj and {} frame meshes; mean step "
+              "{:.2f} ms, {} tetrahedra cut in {} cuts",
+              out.string(), frames / scene.output.mesh_every_n_frames,
+              total_ms / std::max(frames, 1), cut_tets,
+              sim.model().cut_count());
 }
 
 } // namespace vox::app

@@ -30,4 +30,12 @@ inline void extract_rotation(const Eigen::Matrix3d& a, Eigen::Quaterniond& q, in
     }
 }
 
+/// Adds rotation q to a running sum of quaternions with the sign nearer the sum (q and -q are the
+/// same rotation); the normalised sum is the mean rotation.
+inline void accumulate_rotation(Eigen::Vector4d& sum, const Eigen::Quaterniond& q)
+{
+    const Eigen::Vector4d c = q.coeffs();
+    sum += sum.dot(c) < 0.0 ? -c : c;
+}
+
 } // namespace vox::fem

@@ -1,5 +1,7 @@
 #include "fem/implicit_solver.hpp"
 
+#include "fem/conjugate_gradient.hpp"
+
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
 
@@ -401,32 +403,19 @@ void ImplicitSolver::update_node_rotations()
     std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
     const auto& elements = m_model.elements();
     for (std::size_t e = 0; e < elements.size(); ++e)
-        for (std::uint32_t n : elements[e].dof_node) {
-            const Eigen::Vector4d q = m_rotation[e].coeffs();
-            sum[n] += sum[n].dot(q) < 0.0 ? -q : q;
-        }
+        for (std::uint32_t n : elements[e].dof_node) accumulate_rotation(sum[n], m_rotation[e]);
     for (std::size_t n = 0; n < m_x.size(); ++n)
         if (sum[n].squaredNorm() > 0.0) m_node_rotation[n].coeffs() = sum[n].normalized();
 }
 
 int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
-    // Conjugate gradients stopping when the Jacobi-scaled residual D^-1/2 r falls below the
-    // tolerance relative to the scaled right-hand side. Unscaled, nodes that carry almost no
-    // material (an element holding one voxel of 512) would barely count in the residual and could
-    // move wildly while the solve "converges".
     const Eigen::Index n = rhs.size();
     Eigen::VectorXd inv_d(n), inv_sqrt_d(n);
     for (Eigen::Index i = 0; i < n; ++i) {
         const double d = m_diagonal[i];
         inv_d[i] = d > 0.0 ? 1.0 / d : 1.0;
         inv_sqrt_d[i] = std::sqrt(inv_d[i]);
-    }
-    const double b_norm = rhs.cwiseProduct(inv_sqrt_d).norm();
-    if (b_norm == 0.0) {
-        x.setZero();
-        residual = 0.0;
-        return 0;
     }
     if (m_preconditioner) {
         update_node_rotations();
@@ -443,36 +432,11 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         else
             out = res.cwiseProduct(inv_d);
     };
-    auto scaled_norm = [&](const Eigen::VectorXd& res) { return res.cwiseProduct(inv_sqrt_d).norm() / b_norm; };
-    Eigen::VectorXd r(n), z(n), q(n);
-    multiply(x, q);
-    r = rhs - q;
-    precondition(r, z);
-    Eigen::VectorXd p = z;
-    double rz = r.dot(z);
-    int it = 0;
-    residual = scaled_norm(r);
-    while (residual > m_options.cg_tolerance && it < m_options.cg_max_iterations) {
-        multiply(p, q);
-        const double pq = p.dot(q);
-        if (!(pq > 0.0)) break; // not positive definite along p: stop rather than diverge
-        const double alpha = rz / pq;
-        x += alpha * p;
-        r -= alpha * q;
-        precondition(r, z);
-        const double rz_next = r.dot(z);
-        if (!(rz_next > 0.0)) { // a semidefinite preconditioner (or r = 0): nothing more to gain
-            residual = scaled_norm(r);
-            ++it;
-            break;
-        }
-        p = z + (rz_next / rz) * p;
-        rz = rz_next;
-        residual = scaled_norm(r);
-        ++it;
-    }
-    if (m_preconditioner) m_preconditioner->report_iterations(it);
-    return it;
+    const CgResult cg = conjugate_gradient([this](const Eigen::VectorXd& p, Eigen::VectorXd& out) { multiply(p, out); }, precondition, rhs,
+                                           inv_sqrt_d, m_options.cg_tolerance, m_options.cg_max_iterations, x);
+    residual = cg.residual;
+    if (m_preconditioner) m_preconditioner->report_iterations(cg.iterations);
+    return cg.iterations;
 }
 
 namespace {

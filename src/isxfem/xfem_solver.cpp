@@ -1,6 +1,7 @@
 #include "isxfem/xfem_solver.hpp"
 
 #include "core/error.hpp"
+#include "fem/conjugate_gradient.hpp"
 #include "fem/corotation.hpp"
 
 #include <algorithm>
@@ -53,18 +54,12 @@ void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p) { m_
 
 void XfemSolver::update_block_rotations()
 {
-    // The mean of the quaternions, each taken with the sign nearer the running sum.
     std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
     const auto& elements = m_model.elements();
     for (std::size_t e = 0; e < elements.size(); ++e) {
         const XfemElement& el = elements[e];
-        for (std::size_t side = 0; side < (el.cut >= 0 ? 2u : 1u); ++side) {
-            const Eigen::Vector4d q = m_rotation[e][side].coeffs();
-            for (std::size_t a = 0; a < el.block_count(); ++a) {
-                Eigen::Vector4d& s = sum[el.block(a)];
-                s += s.dot(q) < 0.0 ? -q : q;
-            }
-        }
+        for (std::size_t side = 0; side < (el.cut >= 0 ? 2u : 1u); ++side)
+            for (std::size_t a = 0; a < el.block_count(); ++a) fem::accumulate_rotation(sum[el.block(a)], m_rotation[e][side]);
     }
     m_block_rotation.resize(m_x.size(), Eigen::Quaterniond::Identity());
     for (std::size_t b = 0; b < m_x.size(); ++b)
@@ -207,16 +202,7 @@ void XfemSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 
 int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
-    // Conjugate gradients with Jacobi preconditioning, stopping on the Jacobi-scaled residual
-    // relative to the scaled right-hand side (as the branched-grid solver does).
     const Eigen::VectorXd inv_d = m_matrix.diagonal().cwiseInverse();
-    const Eigen::VectorXd inv_sqrt_d = inv_d.cwiseSqrt();
-    const double b_norm = rhs.cwiseProduct(inv_sqrt_d).norm();
-    if (b_norm == 0.0) {
-        x.setZero();
-        residual = 0.0;
-        return 0;
-    }
     if (m_preconditioner) {
         update_block_rotations();
         m_preconditioner->update(&m_matrix, m_fixed, m_block_rotation);
@@ -228,31 +214,12 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
         else
             out = res.cwiseProduct(inv_d);
     };
-    Eigen::VectorXd r(rhs.size()), q(rhs.size()), z(rhs.size());
-    multiply(x, q);
-    r = rhs - q;
-    precondition(r, z);
-    Eigen::VectorXd p = z;
-    double rz = r.dot(z);
-    int it = 0;
-    residual = r.cwiseProduct(inv_sqrt_d).norm() / b_norm;
-    while (residual > m_options.cg_tolerance && it < m_options.cg_max_iterations) {
-        multiply(p, q);
-        const double pq = p.dot(q);
-        if (!(pq > 0.0)) break;
-        const double alpha = rz / pq;
-        x += alpha * p;
-        r -= alpha * q;
-        precondition(r, z);
-        const double rz_next = r.dot(z);
-        residual = r.cwiseProduct(inv_sqrt_d).norm() / b_norm;
-        ++it;
-        if (!(rz_next > 0.0)) break;
-        p = z + (rz_next / rz) * p;
-        rz = rz_next;
-    }
-    if (m_preconditioner) m_preconditioner->report_iterations(it);
-    return it;
+    const fem::CgResult cg = fem::conjugate_gradient([this](const Eigen::VectorXd& p, Eigen::VectorXd& out) { multiply(p, out); },
+                                                     precondition, rhs, inv_d.cwiseSqrt(), m_options.cg_tolerance,
+                                                     m_options.cg_max_iterations, x);
+    residual = cg.residual;
+    if (m_preconditioner) m_preconditioner->report_iterations(cg.iterations);
+    return cg.iterations;
 }
 
 XfemStepStats XfemSolver::step()

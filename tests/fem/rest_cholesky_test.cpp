@@ -5,46 +5,22 @@
 
 #include "fem/rest_cholesky.hpp"
 
+#include "fem/grid_laplacian.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
-#include <tuple>
 #include <vector>
 
 using namespace vox::fem;
 
 namespace {
 
-/// A vector Laplacian on an n^3 grid of nodes, three dofs a node (isotropic, so any node rotation
-/// leaves it unchanged), plus `shift` times the identity: symmetric positive definite.
-SystemMatrix vector_laplacian(int n, double shift)
-{
-    std::vector<Eigen::Triplet<double>> t;
-    auto id = [n](int i, int j, int k) { return (i * n + j) * n + k; };
-    auto inside = [n](int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < n && j < n && k < n; };
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-            for (int k = 0; k < n; ++k) {
-                double degree = 0.0;
-                for (const auto& [di, dj, dk] : {std::tuple{1, 0, 0}, std::tuple{-1, 0, 0}, std::tuple{0, 1, 0}, std::tuple{0, -1, 0},
-                                                 std::tuple{0, 0, 1}, std::tuple{0, 0, -1}})
-                    if (inside(i + di, j + dj, k + dk)) {
-                        for (int a = 0; a < 3; ++a) t.emplace_back(3 * id(i, j, k) + a, 3 * id(i + di, j + dj, k + dk) + a, -1.0);
-                        degree += 1.0;
-                    }
-                for (int a = 0; a < 3; ++a) t.emplace_back(3 * id(i, j, k) + a, 3 * id(i, j, k) + a, degree + shift);
-            }
-    SystemMatrix m(3 * n * n * n, 3 * n * n * n);
-    m.setFromTriplets(t.begin(), t.end());
-    m.makeCompressed();
-    return m;
-}
-
 struct Fixture {
-    SystemMatrix a = vector_laplacian(5, 0.5);
+    SystemMatrix a = vox::test::grid_laplacian<Eigen::RowMajor>(5, 0.5, 3);
     std::vector<unsigned char> fixed = std::vector<unsigned char>(static_cast<std::size_t>(a.rows()), 0);
     std::vector<Eigen::Quaterniond> rest = std::vector<Eigen::Quaterniond>(static_cast<std::size_t>(a.rows() / 3), Eigen::Quaterniond::Identity());
 };

@@ -4,39 +4,14 @@
 
 #include "fem/supernodal_factor.hpp"
 
+#include "fem/grid_laplacian.hpp"
+
 #include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 
-#include <tuple>
 #include <vector>
 
-namespace {
-
-/// The 7-point Laplacian on an n^3 grid (Neumann boundaries) plus `shift` times the identity.
-Eigen::SparseMatrix<double> grid_laplacian(int n, double shift)
-{
-    std::vector<Eigen::Triplet<double>> t;
-    auto id = [n](int i, int j, int k) { return (i * n + j) * n + k; };
-    auto inside = [n](int i, int j, int k) { return i >= 0 && j >= 0 && k >= 0 && i < n && j < n && k < n; };
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-            for (int k = 0; k < n; ++k) {
-                double degree = 0.0;
-                for (const auto& [di, dj, dk] : {std::tuple{1, 0, 0}, std::tuple{-1, 0, 0}, std::tuple{0, 1, 0}, std::tuple{0, -1, 0},
-                                                 std::tuple{0, 0, 1}, std::tuple{0, 0, -1}})
-                    if (inside(i + di, j + dj, k + dk)) {
-                        t.emplace_back(id(i, j, k), id(i + di, j + dj, k + dk), -1.0);
-                        degree += 1.0;
-                    }
-                t.emplace_back(id(i, j, k), id(i, j, k), degree + shift);
-            }
-    Eigen::SparseMatrix<double> m(n * n * n, n * n * n);
-    m.setFromTriplets(t.begin(), t.end());
-    m.makeCompressed();
-    return m;
-}
-
-} // namespace
+using vox::test::grid_laplacian;
 
 TEST(SupernodalFactor, SolvesToSinglePrecisionAndRefactorsNewValues)
 {
