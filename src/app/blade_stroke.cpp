@@ -16,7 +16,9 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
 {
     const Eigen::Matrix3d r = to.orientation.toRotationMatrix();
     const Eigen::Vector3d normal = r.col(1);
-    const bool same_plane = m_cut >= 0 && (normal - m_rotation.col(1)).norm() < 1e-9 &&
+    // The stroke goes on while the plane stays put, whether or not it has cut anything yet: a
+    // blade shorter than a tetrahedron cuts it once its sweep has covered it.
+    const bool same_plane = !m_segments.empty() && (normal - m_rotation.col(1)).norm() < 1e-9 &&
                             std::abs((to.position_mm - m_origin_mm).dot(normal)) < 1e-6;
     if (!same_plane) {
         m_cut = -1;

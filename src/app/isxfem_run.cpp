@@ -95,6 +95,10 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
          {"total_cut_ms", cut_total_ms},
          {"final_dofs", sim.solver().dof_count()},
          {"final_kinetic_energy_j", last.kinetic_energy_j}});
+    if (!sim.solver().fallback_note().empty()) {
+        log::warn("{}", sim.solver().fallback_note());
+        stats["linear_solver"] = sim.solver().fallback_note();
+    }
     write_surface(out / "final.obj", sim);
     write_atomically(out / "stats.json", [&](const std::filesystem::path &tmp) {
       std::ofstream(tmp) << stats.dump(1) << '\n';

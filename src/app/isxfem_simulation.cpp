@@ -165,10 +165,11 @@ void IsxfemSimulation::close_cut(int cut, std::vector<CapVertex>& vertices, std:
         double sum = 0.0;
         for (double& l : bary) sum += (l = std::max(l, 0.0));
         for (double& l : bary) l /= sum;
+        const std::int32_t label = va.label; // va refers into `vertices`, which grows below
         std::array<int, 2> copies{};
         for (int side = 0; side < 2; ++side) {
             copies[static_cast<std::size_t>(side)] = static_cast<int>(vertices.size());
-            vertices.push_back({tet, bary, side, x, va.label});
+            vertices.push_back({tet, bary, side, x, label});
         }
         crossing.emplace(key, copies);
         return copies;

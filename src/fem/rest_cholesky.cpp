@@ -15,9 +15,12 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
     if (m_stale || m_fixed != fixed || m_factored_rotation.size() != node_rotation.size()) {
         if (!a) throw std::logic_error("RestCholesky::update: a new factor needs the assembled matrix");
         const Eigen::SparseMatrix<double> column_major(*a);
+        const bool new_pattern = m_factorizations == 0 || m_fixed != fixed || a->rows() != m_rows || a->nonZeros() != m_nonzeros;
+        m_rows = a->rows();
+        m_nonzeros = a->nonZeros();
         // A singular K (nothing holds the object) may still factor, with pivots at round-off level:
         // that is a failure too.
-        m_failed = !m_factor.factor(column_major, m_factorizations == 0 || m_fixed != fixed);
+        m_failed = !m_factor.factor(column_major, new_pattern);
         ++m_factorizations;
         m_factored_rotation = node_rotation;
         m_fixed = fixed;

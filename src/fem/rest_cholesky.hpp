@@ -10,8 +10,9 @@
 // When to refactor is a rent-or-buy decision: each solve costs the iterations the factor needed
 // right after it was taken plus an excess that grows as the object turns away from the factored
 // state. The excess iterations are summed, and once they cost as much as a new factorisation
-// would, the factor is taken again. Over any run this spends at most twice what the best schedule
-// in hindsight would. A hard cap on the iterations of one solve refactors at once.
+// would (an estimate from the flop counts), the factor is taken again: the classic ski-rental
+// rule, which for one stretch between factorisations spends at most twice what the best choice in
+// hindsight would. A hard cap on the iterations of one solve refactors at once.
 
 #include "fem/preconditioner.hpp"
 
@@ -53,6 +54,7 @@ private:
     std::vector<Eigen::Quaterniond> m_factored_rotation;
     std::vector<Eigen::Matrix3d> m_warp; ///< per node: world rotation from the factored state to now
     std::vector<unsigned char> m_fixed;
+    Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last analysed: a new pattern needs a new analysis
     mutable Eigen::VectorXd m_scratch;
 };
 

@@ -11,17 +11,22 @@ namespace {
 
 constexpr double k_fill_floor = 1e-3;
 
-/// The Kuhn tetrahedron (0 .. 5, in the order of std::next_permutation over the axes) of the unit
-/// cube holding local point t: the one whose axis order sorts t's coordinates descending.
-int kuhn_index(const Eigen::Vector3d& t)
+/// The Kuhn tetrahedra (0 .. 5, in the order of std::next_permutation over the axes) of the unit
+/// cube holding local point t: those whose axis order sorts t's coordinates descending. A point
+/// on the planes between them (equal coordinates, as many voxel centres are) belongs to each in
+/// equal shares, so a full cell gives each of its six tetrahedra the same material.
+void add_kuhn_shares(const Eigen::Vector3d& t, double amount, std::array<double, 6>& shares)
 {
     std::array<int, 3> order{0, 1, 2};
-    int index = 0;
+    std::array<bool, 6> holds{};
+    int count = 0, index = 0;
     do {
-        if (t[order[0]] >= t[order[1]] && t[order[1]] >= t[order[2]]) return index;
+        holds[static_cast<std::size_t>(index)] = t[order[0]] >= t[order[1]] && t[order[1]] >= t[order[2]];
+        count += holds[static_cast<std::size_t>(index)];
         ++index;
     } while (std::next_permutation(order.begin(), order.end()));
-    return 0;
+    for (std::size_t k = 0; k < 6; ++k)
+        if (holds[k]) shares[k] += amount / count;
 }
 
 } // namespace
@@ -33,7 +38,7 @@ GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& mo
     const int level = model.level();
     const auto& grid_materials = grid.materials();
     for (const fem::HexElement& el : model.elements()) {
-        // Material per tetrahedron: counts of fine voxel centres, per material.
+        // Material per tetrahedron: shares of fine voxel centres, per material.
         std::array<std::vector<double>, 6> count;
         for (auto& c : count) c.assign(grid_materials.size(), 0.0);
         double capacity = 1.0 / 6.0; // voxels a tetrahedron of the cell holds
@@ -45,8 +50,9 @@ GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& mo
             capacity = size * size * size / 6.0;
             const Eigen::Vector3d corner0 = grid::BranchedGrid::cell_corner_index(ge.cell, level, 0);
             for (std::uint32_t v : ge.voxels) {
-                const Eigen::Vector3d t = (grid.voxels().coord(v).cast<double>() - corner0) / size;
-                count[static_cast<std::size_t>(kuhn_index(t))][static_cast<std::size_t>(grid.voxels().material(v))] += 1.0;
+                std::array<double, 6> shares{};
+                add_kuhn_shares((grid.voxels().coord(v).cast<double>() - corner0) / size, 1.0, shares);
+                for (std::size_t k = 0; k < 6; ++k) count[k][static_cast<std::size_t>(grid.voxels().material(v))] += shares[k];
             }
         }
         std::array<int, 3> order{0, 1, 2};
@@ -67,9 +73,10 @@ GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& mo
             const double held = std::accumulate(c.begin(), c.end(), 0.0);
             const double fill = std::clamp(held / capacity, k_fill_floor, 1.0);
             TetMaterial m{{0.0, 0.0}, 0.0};
-            const std::size_t dominant = static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
+            const std::size_t dominant = held > 0.0 ? static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin())
+                                                    : static_cast<std::size_t>(el.material);
             for (std::size_t k = 0; k < c.size(); ++k) {
-                // Shares of the held material (all of it the dominant one when empty).
+                // Shares of the held material (an empty one: the element's own material).
                 const double share = held > 0.0 ? c[k] / held : (k == dominant ? 1.0 : 0.0);
                 m.lame.lambda += fill * share * grid_materials[k].lame.lambda;
                 m.lame.mu += fill * share * grid_materials[k].lame.mu;

@@ -47,7 +47,7 @@ struct CutReport {
     int cut = -1;                   ///< the cut's id (-1: nothing was cut)
     std::size_t cut_tets = 0;       ///< newly cut
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
-    std::size_t partial_tets = 0;   ///< crossed but not separated whole: left uncut
+    std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
     std::size_t already_cut = 0;    ///< crossed but cut before: left as they were
 };
 

@@ -72,9 +72,17 @@ void XfemSolver::model_changed()
     m_x.resize(blocks, Eigen::Vector3d::Zero());
     m_v.resize(blocks, Eigen::Vector3d::Zero());
     m_fixed.resize(3 * blocks, 0);
-    m_rotation.resize(m_model.elements().size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
+    const auto& elements = m_model.elements();
+    m_rotation.resize(elements.size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
+    m_was_cut.resize(elements.size(), 0);
+    for (std::size_t e = 0; e < elements.size(); ++e)
+        if (elements[e].cut >= 0 && !m_was_cut[e]) { // a newly cut element: both sides start from its rotation
+            m_rotation[e][1] = m_rotation[e][0];
+            m_was_cut[e] = 1;
+        }
     build_pattern();
     if (m_preconditioner) m_preconditioner->invalidate(); // a grown system: factor it anew
+    m_preconditioner_failed = false;
 }
 
 void XfemSolver::build_pattern()
@@ -202,14 +210,19 @@ void XfemSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 
 int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
 {
-    const Eigen::VectorXd inv_d = m_matrix.diagonal().cwiseInverse();
-    if (m_preconditioner) {
+    Eigen::VectorXd inv_d = m_matrix.diagonal();
+    for (Eigen::Index i = 0; i < inv_d.size(); ++i) inv_d[i] = inv_d[i] > 0.0 ? 1.0 / inv_d[i] : 1.0;
+    const bool factor = m_preconditioner && !m_preconditioner_failed;
+    if (factor) {
         update_block_rotations();
         m_preconditioner->update(&m_matrix, m_fixed, m_block_rotation);
-        if (m_preconditioner->failed()) m_preconditioner.reset(); // a singular system: Jacobi carries on
+        if (m_preconditioner->failed()) { // a (nearly) singular system: Jacobi carries on until the next cut
+            m_preconditioner_failed = true;
+            m_fallback_note = std::string(m_preconditioner->name()) + " preconditioner failed (a nearly singular system); Jacobi took over";
+        }
     }
     auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {
-        if (m_preconditioner)
+        if (m_preconditioner && !m_preconditioner_failed)
             m_preconditioner->apply(res, out);
         else
             out = res.cwiseProduct(inv_d);
@@ -218,7 +231,7 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
                                                      precondition, rhs, inv_d.cwiseSqrt(), m_options.cg_tolerance,
                                                      m_options.cg_max_iterations, x);
     residual = cg.residual;
-    if (m_preconditioner) m_preconditioner->report_iterations(cg.iterations);
+    if (m_preconditioner && !m_preconditioner_failed) m_preconditioner->report_iterations(cg.iterations);
     return cg.iterations;
 }
 

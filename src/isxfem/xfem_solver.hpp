@@ -21,6 +21,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace vox::isxfem {
@@ -50,12 +51,17 @@ public:
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     void set_preconditioner(std::unique_ptr<fem::Preconditioner> p);
     [[nodiscard]] const char* preconditioner_name() const { return m_preconditioner ? m_preconditioner->name() : "Jacobi"; }
+    /// Set when the preconditioner could not be built (a factor of a singular or nearly singular
+    /// system) and Jacobi took over until the next cut; empty otherwise.
+    [[nodiscard]] const std::string& fallback_note() const { return m_fallback_note; }
 
     /// Holds node `node` along the axes whose bits are set in `axes` (1 x, 2 y, 4 z).
     void fix(std::uint32_t node, unsigned axes);
     void set_gravity(const Eigen::Vector3d& g) { m_gravity = g; }
-    /// After the model was cut: new enriched blocks start with zero displacement and velocity (the
-    /// material does not move when it is cut), and the matrix pattern is rebuilt.
+    /// After the model was cut: new enriched blocks start with zero displacement and velocity (a
+    /// fresh cut moves nothing; a tetrahedron added to a crack whose nodes' blocks already moved
+    /// takes their jump at once), newly cut tetrahedra turn both sides as they turned whole, and
+    /// the matrix pattern is rebuilt.
     void model_changed();
 
     XfemStepStats step();
@@ -92,7 +98,10 @@ private:
     std::vector<std::uint32_t> m_rank_start;               ///< per element, into m_rank
     Eigen::VectorXd m_internal;
     std::unique_ptr<fem::Preconditioner> m_preconditioner;
+    bool m_preconditioner_failed = false;   ///< Jacobi until the next cut
+    std::string m_fallback_note;
     std::vector<Eigen::Quaterniond> m_block_rotation;
+    std::vector<unsigned char> m_was_cut;   ///< per element: cut when the rotations were last sized
 };
 
 } // namespace vox::isxfem
