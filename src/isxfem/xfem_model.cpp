@@ -59,7 +59,7 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         std::array<Eigen::Vector3d, 4> x{};
         for (std::size_t c = 0; c < 4; ++c) x[c] = m_mesh.nodes[e.node[c]];
         const CutTet c = cut_tet(x, phi, m_k, m.lame, m.density, m_fitting);
-        if (std::min(c.side_volume[0], c.side_volume[1]) <= 1e-12 * e.geometry.volume) {
+        if (std::min(c.side_volume[0], c.side_volume[1]) <= 0.0) {
             ++report.partial_tets; // the plane only touches it (through nodes): nothing to separate
             continue;
         }
