@@ -40,7 +40,7 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         }
         if (!negative || !positive) continue;
         if (e.cut >= 0) {
-            ++report.already_cut;
+            if (e.cut != id) ++report.already_cut; // another cut's: left as it was (one cut per tetrahedron)
             continue;
         }
         // A closed boundary: every edge the plane crosses is crossed inside the region.

@@ -48,7 +48,7 @@ struct CutReport {
     std::size_t cut_tets = 0;       ///< newly cut
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
-    std::size_t already_cut = 0;    ///< crossed but cut before: left as they were
+    std::size_t already_cut = 0;    ///< crossed but cut before by another cut: left as they were
 };
 
 class XfemModel {

@@ -116,6 +116,7 @@ TEST(XfemSolver, ACutContinuedLaterIsOneCrack)
     const CutReport first = twice.cut(plane, [](const Eigen::Vector3d& p) { return p.y() < 0.012; });
     const CutReport rest = twice.cut(plane, {}, first.cut);
     EXPECT_EQ(rest.cut, first.cut);
+    EXPECT_EQ(rest.already_cut, 0u); // its own tetrahedra are not "another cut's"
     EXPECT_EQ(twice.cut_count(), 1);
     EXPECT_EQ(first.cut_tets + rest.cut_tets, whole.cut_tets);
     EXPECT_EQ(twice.block_count(), once.block_count()); // shared nodes kept their blocks
