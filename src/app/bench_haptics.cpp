@@ -98,8 +98,7 @@ void run_haptics_bench(double seconds)
     haptics::HapticLoop loop(
         device,
         [&](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
-            snapshots.update();
-            const contact::SurfacePoints& surface = snapshots.read_slot();
+            const contact::SurfacePoints& surface = snapshots.latest();
             age = now_s() - surface.t_s;
             stale_ticks += age > stale_s;
             const Eigen::Vector3d f = coupled.update(s, surface, 1e-3);

@@ -162,8 +162,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     haptics::HapticLoop loop(
         device,
         [&](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
-            snapshots.update();
-            const contact::SurfacePoints& surface = snapshots.read_slot();
+            const contact::SurfacePoints& surface = snapshots.latest();
             age = now_s() - surface.t_s;
             const int k = active.load(std::memory_order_relaxed);
             const Eigen::Vector3d f = coupled[static_cast<std::size_t>(k)]->update(s, surface, 1e-3);

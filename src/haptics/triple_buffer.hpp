@@ -34,6 +34,12 @@ public:
     }
     /// The reader's current value.
     [[nodiscard]] const T& read_slot() const noexcept { return m_slots[m_read]; }
+    /// The newest value: update() then read_slot().
+    [[nodiscard]] const T& latest() noexcept
+    {
+        update();
+        return read_slot();
+    }
 
 private:
     static constexpr std::uint8_t k_index = 3, k_fresh = 4;
