@@ -53,7 +53,7 @@ void run(bool factor, int frames)
     for (int f = 1; f <= frames; ++f) {
         const auto start = std::chrono::steady_clock::now();
         const double depth = std::min(1.0, f / 20.0) * 1.1 * top; // the blade's edge goes down to below the block
-        if (f <= 22) {
+        if (f <= 22 && !std::getenv("VOX_NOCUT")) {
             const isxfem::CutReport r = model.cut(plane, [&](const Eigen::Vector3d& p) { return p.z() >= top - depth; }, cut);
             if (r.cut >= 0) cut = r.cut;
             if (r.cut_tets > 0) solver.model_changed();
@@ -61,6 +61,7 @@ void run(bool factor, int frames)
         const double c = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const isxfem::XfemStepStats s = solver.step();
         frame_ms.push_back(c + s.step_ms);
+        if (std::getenv("VOX_TRACE")) std::fprintf(stderr, "f%d cut %.2f asm %.2f solve %.2f its %d\n", f, c, s.assembly_ms, s.solve_ms, s.cg_iterations);
         cut_ms.push_back(c);
         its.push_back(s.cg_iterations);
     }

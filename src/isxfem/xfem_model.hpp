@@ -65,6 +65,7 @@ public:
 
     [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
     [[nodiscard]] const std::vector<XfemElement>& elements() const { return m_elements; }
+    [[nodiscard]] const std::vector<TetMaterial>& materials() const { return m_materials; }
     [[nodiscard]] double k() const { return m_k; }
     [[nodiscard]] std::size_t node_count() const { return m_mesh.nodes.size(); }
     /// Dof blocks (3 dofs each): the nodes', then the enriched ones.

@@ -13,6 +13,7 @@
 // (exact for k = 0, the linear part for k > 0), so the two pieces of a cut element can turn apart.
 
 #include "isxfem/xfem_model.hpp"
+#include "isxfem/xfem_operator.hpp"
 
 #include "fem/preconditioner.hpp"
 
@@ -78,10 +79,6 @@ public:
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }
 
 private:
-    void build_pattern();
-    /// Rotations, elastic forces (m_internal) and the system matrix scale_m M + scale_k K(x).
-    void assemble(double scale_m, double scale_k);
-    void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
     /// The mean rotation of each dof block's tetrahedra (both sides of cut ones), for the warp.
     void update_block_rotations();
@@ -91,17 +88,11 @@ private:
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3d> m_x, m_v;
     std::vector<unsigned char> m_fixed;                    ///< per dof
-    std::vector<std::array<Eigen::Quaterniond, 2>> m_rotation; ///< per element (and side)
-    using Matrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-    Matrix m_matrix, m_mass;                               ///< same pattern
-    std::vector<std::uint32_t> m_rank;                     ///< per element, 64 block pairs: column block's rank in its row
-    std::vector<std::uint32_t> m_rank_start;               ///< per element, into m_rank
-    Eigen::VectorXd m_internal;
+    XfemOperator m_operator;
     std::unique_ptr<fem::Preconditioner> m_preconditioner;
     bool m_preconditioner_failed = false;   ///< Jacobi until the next cut
     std::string m_fallback_note;
     std::vector<Eigen::Quaterniond> m_block_rotation;
-    std::vector<unsigned char> m_was_cut;   ///< per element: cut when the rotations were last sized
 };
 
 } // namespace vox::isxfem

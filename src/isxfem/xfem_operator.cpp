@@ -1,0 +1,254 @@
+#include "isxfem/xfem_operator.hpp"
+
+#include "fem/corotation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace vox::isxfem {
+namespace {
+
+/// V sigma(sym h): the isotropic linear stress of the displacement gradient h, times the volume
+/// (`lame_volume`: V lambda, V mu).
+Eigen::Matrix3d stress(const Eigen::Matrix3d& h, const std::array<double, 2>& lame_volume)
+{
+    const Eigen::Matrix3d strain = 0.5 * (h + h.transpose());
+    Eigen::Matrix3d s = 2.0 * lame_volume[1] * strain;
+    s.diagonal().array() += lame_volume[0] * strain.trace();
+    return s;
+}
+
+/// sum_c v_c g_c^T over the corners of a tetrahedron.
+Eigen::Matrix3d gradient_of(const std::array<Eigen::Vector3d, 4>& v, const TetGeometry& g)
+{
+    Eigen::Matrix3d out = v[0] * g.gradient.row(0);
+    for (int c = 1; c < 4; ++c) out.noalias() += v[static_cast<std::size_t>(c)] * g.gradient.row(c);
+    return out;
+}
+
+/// The linear field of side `side` of a cut element: nodal positions x_i + (h - H_i) a_i (exact for
+/// k = 0, the linear part for k > 0), whose gradient gives the side's rotation.
+std::array<Eigen::Vector3d, 4> side_field(const XfemElement& el, const std::vector<Eigen::Vector3d>& x, std::size_t side)
+{
+    std::array<Eigen::Vector3d, 4> p{};
+    for (std::size_t c = 0; c < 4; ++c) p[c] = x[el.node[c]] + (static_cast<double>(side) - el.node_side[c]) * x[el.enriched[c]];
+    return p;
+}
+
+template <class F> void parallel(std::size_t n, F&& f)
+{
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i < r.end(); ++i) f(i);
+    });
+}
+
+} // namespace
+
+XfemOperator::XfemOperator(const XfemModel& model) : m_model(model)
+{
+    const auto& elements = model.elements();
+    m_lame_volume.resize(elements.size());
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+        const grid::Lame& lame = model.materials()[elements[e].material].lame;
+        m_lame_volume[e] = {elements[e].geometry.volume * lame.lambda, elements[e].geometry.volume * lame.mu};
+    }
+    model_changed();
+}
+
+void XfemOperator::model_changed()
+{
+    const auto& elements = m_model.elements();
+    const std::size_t blocks = m_model.block_count();
+    m_rotation.resize(elements.size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
+    m_r.resize(elements.size(), {Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()});
+    m_was_cut.resize(elements.size(), 0);
+    m_slot_start.assign(elements.size() + 1, 0);
+    std::vector<std::uint32_t> count(blocks + 1, 0);
+    std::vector<Eigen::Triplet<double>> mass;
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+        const XfemElement& el = elements[e];
+        if (el.cut >= 0 && !m_was_cut[e]) { // newly cut: both sides start from its rotation
+            m_rotation[e][1] = m_rotation[e][0];
+            m_r[e][1] = m_r[e][0];
+            m_was_cut[e] = 1;
+        }
+        const std::size_t n = el.block_count();
+        m_slot_start[e + 1] = m_slot_start[e] + static_cast<std::uint32_t>(3 * n);
+        for (std::size_t a = 0; a < n; ++a) {
+            ++count[el.block(a) + 1];
+            for (std::size_t b = 0; b < n; ++b)
+                mass.emplace_back(static_cast<int>(el.block(a)), static_cast<int>(el.block(b)),
+                                  el.mass(static_cast<Eigen::Index>(3 * a), static_cast<Eigen::Index>(3 * b)));
+        }
+    }
+    // Every block keeps a diagonal entry, so the matrix has one even for a block no element touches.
+    for (std::size_t b = 0; b < blocks; ++b) mass.emplace_back(static_cast<int>(b), static_cast<int>(b), 0.0);
+    m_block_mass.resize(static_cast<Eigen::Index>(blocks), static_cast<Eigen::Index>(blocks));
+    m_block_mass.setFromTriplets(mass.begin(), mass.end());
+    for (std::size_t b = 0; b < blocks; ++b) count[b + 1] += count[b];
+    m_touch_start = count;
+    m_touch.resize(count[blocks]);
+    for (std::size_t e = 0; e < elements.size(); ++e)
+        for (std::size_t a = 0; a < elements[e].block_count(); ++a)
+            m_touch[count[elements[e].block(a)]++] = {static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(a)};
+    // Where each element's blocks sit in the rows of the blocks they touch.
+    const int* outer = m_block_mass.outerIndexPtr();
+    const int* inner = m_block_mass.innerIndexPtr();
+    m_rank_start.assign(m_touch.size() + 1, 0);
+    m_rank.clear();
+    for (std::size_t b = 0; b < blocks; ++b)
+        for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t) {
+            const XfemElement& el = elements[m_touch[t][0]];
+            for (std::size_t c = 0; c < el.block_count(); ++c)
+                m_rank.push_back(static_cast<std::uint32_t>(std::lower_bound(inner + outer[b], inner + outer[b + 1], static_cast<int>(el.block(c))) -
+                                                            (inner + outer[b])));
+            m_rank_start[t + 1] = static_cast<std::uint32_t>(m_rank.size());
+        }
+    build_pattern();
+    m_slots.resize(m_slot_start.back());
+    m_force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * blocks));
+}
+
+void XfemOperator::build_pattern()
+{
+    // Block row A holds, for each neighbour B in the order of the block mass's row, three columns;
+    // an entry of A's dof i and B's dof j sits at outer[3A + i] + 3 rank(A, B) + j.
+    const auto blocks = m_block_mass.rows();
+    const int* block_outer = m_block_mass.outerIndexPtr();
+    const int* block_inner = m_block_mass.innerIndexPtr();
+    m_matrix.resize(3 * blocks, 3 * blocks);
+    m_matrix.resizeNonZeros(9 * m_block_mass.nonZeros());
+    int* outer = m_matrix.outerIndexPtr();
+    int* inner = m_matrix.innerIndexPtr();
+    outer[0] = 0;
+    for (Eigen::Index b = 0; b < blocks; ++b)
+        for (int i = 0; i < 3; ++i) {
+            int position = outer[3 * b + i];
+            for (int k = block_outer[b]; k < block_outer[b + 1]; ++k)
+                for (int j = 0; j < 3; ++j) inner[position++] = 3 * block_inner[k] + j;
+            outer[3 * b + i + 1] = position;
+        }
+}
+
+void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vector<unsigned char>& fixed, double scale_m,
+                          double scale_k)
+{
+    const auto& elements = m_model.elements();
+    const auto& rest = m_model.mesh().nodes;
+    m_fixed = fixed;
+    parallel(elements.size(), [&](std::size_t e) {
+        const XfemElement& el = elements[e];
+        double* force = &m_slots[m_slot_start[e]];
+        if (el.cut < 0) {
+            // F = I + grad(x - X): from displacements, so an element at rest has exactly no strain.
+            std::array<Eigen::Vector3d, 4> displacement{};
+            for (std::size_t c = 0; c < 4; ++c) displacement[c] = x[el.node[c]] - rest[el.node[c]];
+            const Eigen::Matrix3d f = Eigen::Matrix3d::Identity() + gradient_of(displacement, el.geometry);
+            fem::extract_rotation(f, m_rotation[e][0]);
+            const Eigen::Matrix3d r = m_r[e][0] = m_rotation[e][0].toRotationMatrix();
+            const Eigen::Matrix3d s = r * stress(r.transpose() * f - Eigen::Matrix3d::Identity(), m_lame_volume[e]);
+            for (Eigen::Index c = 0; c < 4; ++c) Eigen::Map<Eigen::Vector3d>(force + 3 * c) = s * el.geometry.gradient.row(c).transpose();
+            return;
+        }
+        Eigen::Map<Eigen::Matrix<double, 24, 1>> f(force);
+        f.setZero();
+        for (std::size_t side = 0; side < 2; ++side) {
+            fem::extract_rotation(gradient_of(side_field(el, x, side), el.geometry), m_rotation[e][side]);
+            const Eigen::Matrix3d r = m_r[e][side] = m_rotation[e][side].toRotationMatrix();
+            Eigen::Matrix<double, 24, 1> u;
+            for (std::size_t c = 0; c < 4; ++c) {
+                const auto i = static_cast<Eigen::Index>(3 * c);
+                u.segment<3>(i) = r.transpose() * (x[el.node[c]] - x[el.node[0]]) - (rest[el.node[c]] - rest[el.node[0]]);
+                u.segment<3>(12 + i) = r.transpose() * x[el.enriched[c]];
+            }
+            const Eigen::Matrix<double, 24, 1> local = el.side_stiffness[side] * u;
+            for (Eigen::Index b = 0; b < 8; ++b) f.segment<3>(3 * b) += r * local.segment<3>(3 * b);
+        }
+    });
+    parallel(m_model.block_count(), [&](std::size_t b) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t)
+            sum += Eigen::Map<const Eigen::Vector3d>(&m_slots[m_slot_start[m_touch[t][0]] + 3 * m_touch[t][1]]);
+        m_force.segment<3>(3 * static_cast<Eigen::Index>(b)) = sum;
+        fill_row(b, scale_m, scale_k);
+    });
+}
+
+void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
+{
+    const auto& elements = m_model.elements();
+    const int* outer = m_matrix.outerIndexPtr();
+    double* row[3];
+    for (std::size_t i = 0; i < 3; ++i) row[i] = m_matrix.valuePtr() + outer[3 * block + i];
+    auto add = [&](std::uint32_t rank, const Eigen::Matrix3d& m) {
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) row[i][3 * rank + static_cast<std::uint32_t>(j)] += m(i, j);
+    };
+    const auto width = static_cast<std::size_t>(outer[3 * block + 1] - outer[3 * block]);
+    for (std::size_t i = 0; i < 3; ++i) std::fill(row[i], row[i] + width, 0.0);
+    std::uint32_t rank = 0;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m_block_mass, static_cast<Eigen::Index>(block)); it; ++it, ++rank)
+        for (std::size_t i = 0; i < 3; ++i) row[i][3 * rank + i] = scale_m * it.value();
+    for (std::uint32_t t = m_touch_start[block]; t < m_touch_start[block + 1]; ++t) {
+        const std::size_t e = m_touch[t][0];
+        const auto a = static_cast<Eigen::Index>(m_touch[t][1]);
+        const XfemElement& el = elements[e];
+        const std::uint32_t* ranks = &m_rank[m_rank_start[t]];
+        if (el.cut < 0) {
+            const double lambda = scale_k * m_lame_volume[e][0], mu = scale_k * m_lame_volume[e][1];
+            const Eigen::Matrix3d& r = m_r[e][0];
+            const Eigen::Vector3d ga = r * el.geometry.gradient.row(a).transpose();
+            for (Eigen::Index b = 0; b < 4; ++b) {
+                const Eigen::Vector3d gb = r * el.geometry.gradient.row(b).transpose();
+                Eigen::Matrix3d m = lambda * ga * gb.transpose() + mu * gb * ga.transpose();
+                m.diagonal().array() += mu * ga.dot(gb);
+                add(ranks[b], m);
+            }
+            continue;
+        }
+        for (std::size_t side = 0; side < 2; ++side) {
+            const Eigen::Matrix3d& r = m_r[e][side];
+            for (Eigen::Index b = 0; b < 8; ++b)
+                add(ranks[b], scale_k * r * el.side_stiffness[side].block<3, 3>(3 * a, 3 * b) * r.transpose());
+        }
+    }
+    // Held dofs: identity rows and columns.
+    const int* inner = m_matrix.innerIndexPtr();
+    for (std::size_t i = 0; i < 3; ++i) {
+        const std::size_t dof = 3 * block + i;
+        for (std::size_t k = 0; k < width; ++k) {
+            const auto column = static_cast<std::size_t>(inner[static_cast<std::size_t>(outer[dof]) + k]);
+            if (m_fixed[dof] || m_fixed[column]) row[i][k] = column == dof ? 1.0 : 0.0;
+        }
+    }
+}
+
+void XfemOperator::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    out.resize(p.size());
+    const int* outer = m_matrix.outerIndexPtr();
+    const int* inner = m_matrix.innerIndexPtr();
+    const double* values = m_matrix.valuePtr();
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p.size(), 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index i = r.begin(); i < r.end(); ++i) {
+            double sum = 0.0;
+            for (int k = outer[i]; k < outer[i + 1]; ++k) sum += values[k] * p[inner[k]];
+            out[i] = sum;
+        }
+    });
+}
+
+void XfemOperator::mass_multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    out.resize(p.size());
+    parallel(m_model.block_count(), [&](std::size_t b) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m_block_mass, static_cast<Eigen::Index>(b)); it; ++it)
+            sum += it.value() * p.segment<3>(3 * it.col());
+        out.segment<3>(3 * static_cast<Eigen::Index>(b)) = sum;
+    });
+}
+
+} // namespace vox::isxfem
