@@ -7,11 +7,22 @@
 #include <Eigen/Geometry>
 #include <Eigen/Sparse>
 
+#include <cstdint>
 #include <vector>
 
 namespace vox::fem {
 
 using SystemMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+/// A dof block that holds the jump between two fields turning apart: the enriched dofs a of a
+/// node cut by a crack (fields x - H a and x + (1 - H) a on the node's two sides, H its side).
+/// When the sides turn by R_0 and R_1 the jump turns as a -> (R_1 - R_0) x + R_other a, which a
+/// warping preconditioner can follow instead of turning a like an ordinary block.
+struct JumpBlock {
+    std::uint32_t block = 0; ///< the jump's dof block; its rotation is the other side's
+    std::uint32_t node = 0;  ///< the node's own dof block; its rotation is the node's side's
+    double sign = 1.0;       ///< +1 when the node is on side 0 (R_1 - R_0 = R_block - R_node), else -1
+};
 
 class Preconditioner {
 public:
@@ -31,6 +42,8 @@ public:
     /// The matrix has changed beyond what update() tracks (a new time step, newly held dofs):
     /// rebuild next time.
     virtual void invalidate() {}
+    /// The jump blocks of the system (see JumpBlock); ignored unless the preconditioner warps.
+    virtual void set_jump_blocks(std::vector<JumpBlock> /*jumps*/) {}
     [[nodiscard]] virtual const char* name() const = 0;
     /// True when the last update could not build the preconditioner (a singular matrix).
     [[nodiscard]] virtual bool failed() const { return false; }

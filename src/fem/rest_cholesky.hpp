@@ -13,6 +13,14 @@
 // would (an estimate from the flop counts), the factor is taken again: the classic ski-rental
 // rule, which for one stretch between factorisations spends at most twice what the best choice in
 // hindsight would. A hard cap on the iterations of one solve refactors at once.
+//
+// Two things serve cut (XFEM) systems. Jump blocks (preconditioner.hpp) are warped with the two
+// sides of their crack, W = [R_node 0; sign (R_block - R_node) R_block] on (node, jump), so two
+// pieces turning apart keep the factor fresh. And a system that grew (a cut added enriched dofs,
+// leaving the matrix of the old ones as it was) keeps its factor for the old dofs and takes the
+// inverse of each new block's 3 x 3 diagonal block for the new ones, until the rent-or-buy rule
+// says the extra iterations pay for a new factor: a cut made frame by frame does not refactor every
+// frame.
 
 #include "fem/preconditioner.hpp"
 
@@ -33,6 +41,7 @@ public:
     void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;
     void report_iterations(int iterations) override;
     void invalidate() override { m_stale = true; }
+    void set_jump_blocks(std::vector<JumpBlock> jumps) override { m_jumps = std::move(jumps); }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
     /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
@@ -52,9 +61,14 @@ private:
     double m_excess = 0.0;        ///< iterations beyond the baseline since the factorisation
     SupernodalFactor m_factor;
     std::vector<Eigen::Quaterniond> m_factored_rotation;
-    std::vector<Eigen::Matrix3d> m_warp; ///< per node: world rotation from the factored state to now
+    std::vector<Eigen::Matrix3d> m_warp; ///< per factored block: world rotation from the factored state to now
+    std::vector<JumpBlock> m_jumps;
+    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node), or zero when not factored
+    std::vector<Eigen::Matrix3d> m_grown_inverse; ///< per block added since the factorisation: its diagonal block's inverse
     std::vector<unsigned char> m_fixed;
-    Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last analysed: a new pattern needs a new analysis
+    Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last factored: a new pattern needs a new analysis
+    /// Whether `fixed` holds the factored dofs as factored and none of the dofs added since.
+    [[nodiscard]] bool same_holds(const std::vector<unsigned char>& fixed) const;
     mutable Eigen::VectorXd m_scratch;
 };
 

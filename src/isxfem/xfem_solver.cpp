@@ -43,16 +43,27 @@ void XfemSolver::fix(std::uint32_t node, unsigned axes)
     if (m_preconditioner) m_preconditioner->invalidate();
 }
 
-void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p) { m_preconditioner = std::move(p); }
+void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p)
+{
+    m_preconditioner = std::move(p);
+    if (m_preconditioner) m_preconditioner->set_jump_blocks(m_jumps);
+}
 
 void XfemSolver::update_block_rotations()
 {
+    // A node turns with what lies on its side: its whole tetrahedra and its own side of the cut
+    // ones; an enriched block (the jump across the crack) with the other side, so the jump warp
+    // of RestCholesky follows two pieces turning apart.
     std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
     const auto& elements = m_model.elements();
     for (std::size_t e = 0; e < elements.size(); ++e) {
         const XfemElement& el = elements[e];
-        for (std::size_t side = 0; side < (el.cut >= 0 ? 2u : 1u); ++side)
-            for (std::size_t a = 0; a < el.block_count(); ++a) fem::accumulate_rotation(sum[el.block(a)], m_operator.rotation(e)[side]);
+        const auto& rotation = m_operator.rotation(e);
+        for (std::size_t c = 0; c < 4; ++c) {
+            const std::size_t side = el.cut >= 0 ? el.node_side[c] : 0;
+            fem::accumulate_rotation(sum[el.node[c]], rotation[side]);
+            if (el.cut >= 0) fem::accumulate_rotation(sum[el.enriched[c]], rotation[1 - side]);
+        }
     }
     m_block_rotation.resize(m_x.size(), Eigen::Quaterniond::Identity());
     for (std::size_t b = 0; b < m_x.size(); ++b)
@@ -66,7 +77,21 @@ void XfemSolver::model_changed()
     m_v.resize(blocks, Eigen::Vector3d::Zero());
     m_fixed.resize(3 * blocks, 0);
     m_operator.model_changed();
-    if (m_preconditioner) m_preconditioner->invalidate(); // a grown system: factor it anew
+    m_jumps.clear();
+    std::vector<unsigned char> seen(blocks, 0);
+    for (const XfemElement& el : m_model.elements())
+        if (el.cut >= 0)
+            for (std::size_t c = 0; c < 4; ++c)
+                if (!seen[el.enriched[c]]) {
+                    seen[el.enriched[c]] = 1;
+                    m_jumps.push_back({el.enriched[c], el.node[c], el.node_side[c] ? -1.0 : 1.0});
+                }
+    if (m_preconditioner) {
+        m_preconditioner->set_jump_blocks(m_jumps);
+        // A grown system keeps the factor of its old dofs (the cut left their matrix as it was);
+        // one that had failed is factored anew.
+        if (m_preconditioner_failed) m_preconditioner->invalidate();
+    }
     m_preconditioner_failed = false;
 }
 

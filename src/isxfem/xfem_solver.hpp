@@ -4,8 +4,9 @@
 //   (M + dt C + dt^2 K) v' = M v + dt (f_ext - f_int(x)),   x' = x + dt v',
 // Rayleigh damping C = alpha M + beta K, consistent mass, conjugate gradients warm started from v
 // with Jacobi preconditioning (the scaling that keeps cut systems conditioned: docs/isxfem.md) or
-// a given preconditioner (the warped factor of fem/rest_cholesky.hpp: each dof block turned by the
-// mean rotation of its tetrahedra; a cut makes it factor the grown system anew).
+// a given preconditioner (the warped factor of fem/rest_cholesky.hpp: each node turned by the mean
+// rotation of what lies on its side, each enriched block as the jump between its node's two sides;
+// a cut keeps the factor of the old dofs until a new one pays).
 //
 // State per dof block: a node's position (world m) or an enriched block's displacement (m).
 // Rotations: a whole tetrahedron takes the rotational part of its deformation gradient; a cut one
@@ -93,6 +94,7 @@ private:
     bool m_preconditioner_failed = false;   ///< Jacobi until the next cut
     std::string m_fallback_note;
     std::vector<Eigen::Quaterniond> m_block_rotation;
+    std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
 };
 
 } // namespace vox::isxfem
