@@ -1,8 +1,5 @@
 #include "fem/rest_cholesky.hpp"
 
-#include <Eigen/LU>
-
-#include <algorithm>
 #include <stdexcept>
 
 namespace vox::fem {
@@ -12,18 +9,10 @@ RestCholesky::RestCholesky(const Eigen::Matrix3d& frame, int refactor_iterations
 {
 }
 
-bool RestCholesky::same_holds(const std::vector<unsigned char>& fixed) const
-{
-    return fixed.size() >= m_fixed.size() && std::equal(m_fixed.begin(), m_fixed.end(), fixed.begin()) &&
-           std::all_of(fixed.begin() + static_cast<std::ptrdiff_t>(m_fixed.size()), fixed.end(), [](unsigned char f) { return f == 0; });
-}
-
 void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char>& fixed,
                           const std::vector<Eigen::Quaterniond>& node_rotation)
 {
-    const bool grown = node_rotation.size() > m_factored_rotation.size();
-    if (grown && !a) throw std::logic_error("RestCholesky::update: a grown system needs the assembled matrix");
-    if (m_stale || !same_holds(fixed) || node_rotation.size() < m_factored_rotation.size()) {
+    if (m_stale || m_fixed != fixed || m_factored_rotation.size() != node_rotation.size()) {
         if (!a) throw std::logic_error("RestCholesky::update: a new factor needs the assembled matrix");
         const Eigen::SparseMatrix<double> column_major(*a);
         const bool new_pattern = m_factorizations == 0 || m_fixed != fixed || a->rows() != m_rows || a->nonZeros() != m_nonzeros;
@@ -45,28 +34,13 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
         m_baseline = -1;
         m_excess = 0.0;
     }
-    // World-frame rotation of each factored block since the factorisation: F Q_now Q_factored^-1 F^T.
-    const std::size_t factored = m_factored_rotation.size();
-    m_warp.resize(factored);
-    for (std::size_t n = 0; n < factored; ++n)
+    // World-frame rotation of each block since the factorisation: F Q_now Q_factored^-1 F^T.
+    m_warp.resize(node_rotation.size());
+    for (std::size_t n = 0; n < node_rotation.size(); ++n)
         m_warp[n] = m_frame * (node_rotation[n] * m_factored_rotation[n].conjugate()).toRotationMatrix() * m_frame.transpose();
     m_jump_warp.resize(m_jumps.size());
-    for (std::size_t j = 0; j < m_jumps.size(); ++j) {
-        const JumpBlock& jump = m_jumps[j];
-        m_jump_warp[j] = jump.block < factored && jump.node < factored ? Eigen::Matrix3d(jump.sign * (m_warp[jump.block] - m_warp[jump.node]))
-                                                                      : Eigen::Matrix3d::Zero();
-    }
-    // Blocks added since: the inverse of their current diagonal block.
-    m_grown_inverse.resize(node_rotation.size() - factored);
-    for (std::size_t b = factored; b < node_rotation.size(); ++b) {
-        Eigen::Matrix3d block;
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) block(i, j) = a->coeff(static_cast<Eigen::Index>(3 * b) + i, static_cast<Eigen::Index>(3 * b) + j);
-        Eigen::Matrix3d inverse;
-        bool invertible = false;
-        block.computeInverseWithCheck(inverse, invertible);
-        m_grown_inverse[b - factored] = invertible ? inverse : Eigen::Matrix3d::Zero();
-    }
+    for (std::size_t j = 0; j < m_jumps.size(); ++j)
+        m_jump_warp[j] = m_jumps[j].sign * (m_warp[m_jumps[j].block] - m_warp[m_jumps[j].node]);
 }
 
 void RestCholesky::report_iterations(int iterations)
@@ -78,8 +52,8 @@ void RestCholesky::report_iterations(int iterations)
 
 void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
 {
-    // z = W A_0^-1 W^T r on the factored blocks, W the warp with its jump couplings.
-    m_scratch.resize(m_rows);
+    // z = W A_0^-1 W^T r, W the warp with its jump couplings.
+    m_scratch.resize(r.size());
     for (std::size_t n = 0; n < m_warp.size(); ++n) {
         const auto i = static_cast<Eigen::Index>(3 * n);
         m_scratch.segment<3>(i) = m_warp[n].transpose() * r.segment<3>(i);
@@ -87,7 +61,7 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
     for (std::size_t j = 0; j < m_jumps.size(); ++j)
         m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node)) +=
             m_jump_warp[j].transpose() * r.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block));
-    for (Eigen::Index i = 0; i < m_rows; ++i)
+    for (Eigen::Index i = 0; i < r.size(); ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) m_scratch[i] = 0.0;
     m_factor.solve(m_scratch);
     z.resize(r.size());
@@ -98,10 +72,6 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
     for (std::size_t j = 0; j < m_jumps.size(); ++j)
         z.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block)) +=
             m_jump_warp[j] * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node));
-    for (std::size_t b = 0; b < m_grown_inverse.size(); ++b) {
-        const auto i = 3 * static_cast<Eigen::Index>(m_warp.size() + b);
-        z.segment<3>(i) = m_grown_inverse[b] * r.segment<3>(i);
-    }
     for (std::size_t i = 0; i < m_fixed.size(); ++i)
         if (m_fixed[i]) z[static_cast<Eigen::Index>(i)] = 0.0;
 }

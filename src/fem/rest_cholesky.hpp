@@ -14,13 +14,13 @@
 // rule, which for one stretch between factorisations spends at most twice what the best choice in
 // hindsight would. A hard cap on the iterations of one solve refactors at once.
 //
-// Two things serve cut (XFEM) systems. Jump blocks (preconditioner.hpp) are warped with the two
-// sides of their crack, W = [R_node 0; sign (R_block - R_node) R_block] on (node, jump), so two
-// pieces turning apart keep the factor fresh. And a system that grew (a cut added enriched dofs,
-// leaving the matrix of the old ones as it was) keeps its factor for the old dofs and takes the
-// inverse of each new block's 3 x 3 diagonal block for the new ones, until the rent-or-buy rule
-// says the extra iterations pay for a new factor: a cut made frame by frame does not refactor every
-// frame.
+// Cut (XFEM) systems: jump blocks (preconditioner.hpp) are warped with the two sides of their
+// crack, W = [R_node 0; sign (R_block - R_node) R_block] on (node, jump), so two pieces turning
+// apart keep the factor fresh. A cut that adds dofs makes the solver factor the grown system anew:
+// keeping the old factor for the old dofs with block Jacobi on the new ones was tried and stalls
+// CG (no convergence in 2,000 iterations on the cut bar of data/scenes/bar_cut_isxfem.json): the
+// new enriched dofs couple strongly to their nodes' own, which a block-diagonal preconditioner
+// leaves out.
 
 #include "fem/preconditioner.hpp"
 
@@ -61,14 +61,11 @@ private:
     double m_excess = 0.0;        ///< iterations beyond the baseline since the factorisation
     SupernodalFactor m_factor;
     std::vector<Eigen::Quaterniond> m_factored_rotation;
-    std::vector<Eigen::Matrix3d> m_warp; ///< per factored block: world rotation from the factored state to now
+    std::vector<Eigen::Matrix3d> m_warp; ///< per block: world rotation from the factored state to now
     std::vector<JumpBlock> m_jumps;
-    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node), or zero when not factored
-    std::vector<Eigen::Matrix3d> m_grown_inverse; ///< per block added since the factorisation: its diagonal block's inverse
+    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node)
     std::vector<unsigned char> m_fixed;
-    Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last factored: a new pattern needs a new analysis
-    /// Whether `fixed` holds the factored dofs as factored and none of the dofs added since.
-    [[nodiscard]] bool same_holds(const std::vector<unsigned char>& fixed) const;
+    Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last analysed: a new pattern needs a new analysis
     mutable Eigen::VectorXd m_scratch;
 };
 

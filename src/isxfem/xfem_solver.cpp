@@ -88,9 +88,7 @@ void XfemSolver::model_changed()
                 }
     if (m_preconditioner) {
         m_preconditioner->set_jump_blocks(m_jumps);
-        // A grown system keeps the factor of its old dofs (the cut left their matrix as it was);
-        // one that had failed is factored anew.
-        if (m_preconditioner_failed) m_preconditioner->invalidate();
+        m_preconditioner->invalidate(); // a grown system: factor it anew (rest_cholesky.hpp says why)
     }
     m_preconditioner_failed = false;
 }

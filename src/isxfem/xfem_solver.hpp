@@ -6,7 +6,7 @@
 // with Jacobi preconditioning (the scaling that keeps cut systems conditioned: docs/isxfem.md) or
 // a given preconditioner (the warped factor of fem/rest_cholesky.hpp: each node turned by the mean
 // rotation of what lies on its side, each enriched block as the jump between its node's two sides;
-// a cut keeps the factor of the old dofs until a new one pays).
+// a cut makes it factor the grown system anew).
 //
 // State per dof block: a node's position (world m) or an enriched block's displacement (m).
 // Rotations: a whole tetrahedron takes the rotational part of its deformation gradient; a cut one
