@@ -63,6 +63,7 @@ void XfemOperator::model_changed()
     const std::size_t blocks = m_model.block_count();
     m_rotation.resize(elements.size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
     m_r.resize(elements.size(), {Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()});
+    m_turned_gradient.resize(elements.size());
     m_was_cut.resize(elements.size(), 0);
     m_slot_start.assign(elements.size() + 1, 0);
     std::vector<std::uint32_t> count(blocks + 1, 0);
@@ -150,6 +151,7 @@ void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vect
             const Eigen::Matrix3d r = m_r[e][0] = m_rotation[e][0].toRotationMatrix();
             const Eigen::Matrix3d s = r * stress(r.transpose() * f - Eigen::Matrix3d::Identity(), m_lame_volume[e]);
             for (Eigen::Index c = 0; c < 4; ++c) Eigen::Map<Eigen::Vector3d>(force + 3 * c) = s * el.geometry.gradient.row(c).transpose();
+            m_turned_gradient[e].noalias() = r * el.geometry.gradient.transpose();
             return;
         }
         Eigen::Map<Eigen::Matrix<double, 24, 1>> f(force);
@@ -176,6 +178,23 @@ void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vect
     });
 }
 
+void XfemOperator::block_rotations(std::vector<Eigen::Quaterniond>& out) const
+{
+    const auto& elements = m_model.elements();
+    out.resize(m_model.block_count(), Eigen::Quaterniond::Identity());
+    parallel(m_model.block_count(), [&](std::size_t b) {
+        Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+        for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t) {
+            const XfemElement& el = elements[m_touch[t][0]];
+            const std::uint32_t corner = m_touch[t][1];
+            std::size_t side = 0;
+            if (el.cut >= 0) side = corner < 4 ? el.node_side[corner] : 1u - el.node_side[corner - 4];
+            fem::accumulate_rotation(sum, m_rotation[m_touch[t][0]][side]);
+        }
+        if (sum.squaredNorm() > 0.0) out[b].coeffs() = sum.normalized();
+    });
+}
+
 void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
 {
     const auto& elements = m_model.elements();
@@ -198,10 +217,10 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
         const std::uint32_t* ranks = &m_rank[m_rank_start[t]];
         if (el.cut < 0) {
             const double lambda = scale_k * m_lame_volume[e][0], mu = scale_k * m_lame_volume[e][1];
-            const Eigen::Matrix3d& r = m_r[e][0];
-            const Eigen::Vector3d ga = r * el.geometry.gradient.row(a).transpose();
+            const Eigen::Matrix<double, 3, 4>& turned = m_turned_gradient[e];
+            const Eigen::Vector3d ga = turned.col(a);
             for (Eigen::Index b = 0; b < 4; ++b) {
-                const Eigen::Vector3d gb = r * el.geometry.gradient.row(b).transpose();
+                const Eigen::Vector3d gb = turned.col(b);
                 Eigen::Matrix3d m = lambda * ga * gb.transpose() + mu * gb * ga.transpose();
                 m.diagonal().array() += mu * ga.dot(gb);
                 add(ranks[b], m);

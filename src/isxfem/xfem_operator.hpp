@@ -54,6 +54,11 @@ public:
     /// Per element its rotation, and per side for a cut one (side 0: phi < 0).
     [[nodiscard]] const std::array<Eigen::Quaterniond, 2>& rotation(std::size_t e) const { return m_rotation[e]; }
 
+    /// Per dof block the mean rotation of what turns it: a node's whole tetrahedra and its own side
+    /// of the cut ones; an enriched block (the jump across the crack) the other side of its cut
+    /// ones. What a warped preconditioner follows (fem::JumpBlock).
+    void block_rotations(std::vector<Eigen::Quaterniond>& out) const;
+
 private:
     void build_pattern();
     void fill_row(std::size_t block, double scale_m, double scale_k);
@@ -61,6 +66,7 @@ private:
     const XfemModel& m_model;
     std::vector<std::array<Eigen::Quaterniond, 2>> m_rotation;
     std::vector<std::array<Eigen::Matrix3d, 2>> m_r; ///< the same as matrices
+    std::vector<Eigen::Matrix<double, 3, 4>> m_turned_gradient; ///< per whole element: R g_c by corner
     std::vector<unsigned char> m_was_cut;
     std::vector<std::array<double, 2>> m_lame_volume; ///< per element: V lambda, V mu
     std::vector<std::uint32_t> m_slot_start;          ///< per element: first of its 12 or 24 force values in m_slots

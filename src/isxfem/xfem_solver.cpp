@@ -49,27 +49,6 @@ void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p)
     if (m_preconditioner) m_preconditioner->set_jump_blocks(m_jumps);
 }
 
-void XfemSolver::update_block_rotations()
-{
-    // A node turns with what lies on its side: its whole tetrahedra and its own side of the cut
-    // ones; an enriched block (the jump across the crack) with the other side, so the jump warp
-    // of RestCholesky follows two pieces turning apart.
-    std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
-    const auto& elements = m_model.elements();
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-        const XfemElement& el = elements[e];
-        const auto& rotation = m_operator.rotation(e);
-        for (std::size_t c = 0; c < 4; ++c) {
-            const std::size_t side = el.cut >= 0 ? el.node_side[c] : 0;
-            fem::accumulate_rotation(sum[el.node[c]], rotation[side]);
-            if (el.cut >= 0) fem::accumulate_rotation(sum[el.enriched[c]], rotation[1 - side]);
-        }
-    }
-    m_block_rotation.resize(m_x.size(), Eigen::Quaterniond::Identity());
-    for (std::size_t b = 0; b < m_x.size(); ++b)
-        if (sum[b].squaredNorm() > 0.0) m_block_rotation[b].coeffs() = sum[b].normalized();
-}
-
 void XfemSolver::model_changed()
 {
     const std::size_t blocks = m_model.block_count();
@@ -100,7 +79,7 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
         inv_d[i] = m_fixed[static_cast<std::size_t>(i)] || !(inv_d[i] > 0.0) ? 1.0 : 1.0 / inv_d[i];
     const bool factor = m_preconditioner && !m_preconditioner_failed;
     if (factor) {
-        update_block_rotations();
+        m_operator.block_rotations(m_block_rotation);
         m_preconditioner->update(&m_operator.matrix(), m_fixed, m_block_rotation);
         if (m_preconditioner->failed()) { // a (nearly) singular system: Jacobi carries on until the next cut
             m_preconditioner_failed = true;

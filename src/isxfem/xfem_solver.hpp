@@ -81,8 +81,6 @@ public:
 
 private:
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
-    /// The mean rotation of each dof block's tetrahedra (both sides of cut ones), for the warp.
-    void update_block_rotations();
 
     const XfemModel& m_model;
     XfemOptions m_options;
