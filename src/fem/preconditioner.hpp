@@ -42,6 +42,9 @@ public:
     /// The matrix has changed beyond what update() tracks (a new time step, newly held dofs):
     /// rebuild next time.
     virtual void invalidate() {}
+    /// The system grew or the rows of these dof blocks changed beyond what update() tracks (a crack
+    /// grew into their elements) while the rest stayed as it was. By default: rebuild.
+    virtual void blocks_changed(const std::vector<std::uint32_t>& /*blocks*/) { invalidate(); }
     /// The jump blocks of the system (see JumpBlock); ignored unless the preconditioner warps.
     virtual void set_jump_blocks(std::vector<JumpBlock> /*jumps*/) {}
     [[nodiscard]] virtual const char* name() const = 0;

@@ -16,14 +16,17 @@
 //
 // Cut (XFEM) systems: jump blocks (preconditioner.hpp) are warped with the two sides of their
 // crack, W = [R_node 0; sign (R_block - R_node) R_block] on (node, jump), so two pieces turning
-// apart keep the factor fresh. A cut that adds dofs makes the solver factor the grown system anew:
-// keeping the old factor for the old dofs with block Jacobi on the new ones was tried and stalls
-// CG (no convergence in 2,000 iterations on the cut bar of data/scenes/bar_cut_isxfem.json): the
-// new enriched dofs couple strongly to their nodes' own, which a block-diagonal preconditioner
-// leaves out.
+// apart keep the factor fresh. A cut that adds dofs and changes the rows of a few old ones
+// (blocks_changed) keeps the factor, extended by zero over the new dofs, and adds an exact solve
+// on the patch of new and changed blocks with one ring of neighbours (additive Schwarz,
+// fem/patch_solve.hpp), until the rent-or-buy rule says a new factor pays (the patch's solves count
+// as extra iterations) or the patch grows past an eighth of the system. (The factor with only block Jacobi on the new dofs stalls CG: the new
+// enriched dofs couple strongly to their nodes' own, measured on the cut bar of
+// data/scenes/bar_cut_isxfem.json: no convergence in 2,000 iterations.)
 
 #include "fem/preconditioner.hpp"
 
+#include "fem/patch_solve.hpp"
 #include "fem/supernodal_factor.hpp"
 
 namespace vox::fem {
@@ -42,6 +45,9 @@ public:
     void report_iterations(int iterations) override;
     void invalidate() override { m_stale = true; }
     void set_jump_blocks(std::vector<JumpBlock> jumps) override { m_jumps = std::move(jumps); }
+    void blocks_changed(const std::vector<std::uint32_t>& blocks) override;
+    /// Dofs of the patch solved exactly beside the factor (0 when the factor fits the system).
+    [[nodiscard]] std::size_t patch_dofs() const { return m_patch.dofs(); }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
     /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
@@ -57,13 +63,20 @@ private:
     bool m_stale = true, m_failed = false;
     int m_factorizations = 0;
     double m_refactor_cost = 0.0; ///< CG iterations
+    double m_iteration_flops = 0.0; ///< of one CG iteration with the factor alone
     int m_baseline = -1;          ///< fewest iterations of a solve since the factorisation
     double m_excess = 0.0;        ///< iterations beyond the baseline since the factorisation
     SupernodalFactor m_factor;
     std::vector<Eigen::Quaterniond> m_factored_rotation;
     std::vector<Eigen::Matrix3d> m_warp; ///< per block: world rotation from the factored state to now
     std::vector<JumpBlock> m_jumps;
-    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node)
+    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node); zero past the factor
+    std::vector<unsigned char> m_changed;     ///< per factored block: its rows changed since the factorisation
+    bool m_patch_dirty = false;
+    PatchSolve m_patch;
+    void refactor(const SystemMatrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>& node_rotation);
+    /// Whether `fixed` holds the factored dofs as factored and none added since.
+    [[nodiscard]] bool same_holds(const std::vector<unsigned char>& fixed) const;
     std::vector<unsigned char> m_fixed;
     Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last analysed: a new pattern needs a new analysis
     mutable Eigen::VectorXd m_scratch;

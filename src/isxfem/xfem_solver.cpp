@@ -51,14 +51,25 @@ void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p)
 
 void XfemSolver::model_changed()
 {
-    const std::size_t blocks = m_model.block_count();
+    const std::size_t blocks = m_model.block_count(), old_blocks = m_x.size();
+    // The old enriched blocks that newly cut tetrahedra share (a crack growing) have new rows;
+    // the nodes' own rows stay as they were (a cut tetrahedron's standard part is the whole one's).
+    std::vector<std::uint32_t> changed;
+    const auto& elements = m_model.elements();
+    m_cut.resize(elements.size(), 0);
+    for (std::size_t e = 0; e < elements.size(); ++e)
+        if (elements[e].cut >= 0 && !m_cut[e]) {
+            m_cut[e] = 1;
+            for (std::uint32_t b : elements[e].enriched)
+                if (b < old_blocks) changed.push_back(b);
+        }
     m_x.resize(blocks, Eigen::Vector3d::Zero());
     m_v.resize(blocks, Eigen::Vector3d::Zero());
     m_fixed.resize(3 * blocks, 0);
     m_operator.model_changed();
     m_jumps.clear();
     std::vector<unsigned char> seen(blocks, 0);
-    for (const XfemElement& el : m_model.elements())
+    for (const XfemElement& el : elements)
         if (el.cut >= 0)
             for (std::size_t c = 0; c < 4; ++c)
                 if (!seen[el.enriched[c]]) {
@@ -67,7 +78,8 @@ void XfemSolver::model_changed()
                 }
     if (m_preconditioner) {
         m_preconditioner->set_jump_blocks(m_jumps);
-        m_preconditioner->invalidate(); // a grown system: factor it anew (rest_cholesky.hpp says why)
+        m_preconditioner->blocks_changed(changed);
+        if (m_preconditioner_failed) m_preconditioner->invalidate();
     }
     m_preconditioner_failed = false;
 }

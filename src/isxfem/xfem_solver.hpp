@@ -6,7 +6,7 @@
 // with Jacobi preconditioning (the scaling that keeps cut systems conditioned: docs/isxfem.md) or
 // a given preconditioner (the warped factor of fem/rest_cholesky.hpp: each node turned by the mean
 // rotation of what lies on its side, each enriched block as the jump between its node's two sides;
-// a cut makes it factor the grown system anew).
+// after a cut it keeps its factor and solves the changed patch exactly beside it).
 //
 // State per dof block: a node's position (world m) or an enriched block's displacement (m).
 // Rotations: a whole tetrahedron takes the rotational part of its deformation gradient; a cut one
@@ -93,6 +93,7 @@ private:
     std::string m_fallback_note;
     std::vector<Eigen::Quaterniond> m_block_rotation;
     std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
+    std::vector<unsigned char> m_cut;    ///< per element: cut when the model last changed
 };
 
 } // namespace vox::isxfem
