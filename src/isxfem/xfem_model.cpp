@@ -1,5 +1,8 @@
 #include "isxfem/xfem_model.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -31,7 +34,12 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
     const int id = extend >= 0 ? extend : m_cuts;
     std::unordered_map<std::uint32_t, std::uint32_t> fresh;
     std::unordered_map<std::uint32_t, std::uint32_t>& block_of_node = extend >= 0 ? m_cut_blocks[static_cast<std::size_t>(extend)] : fresh;
-    for (XfemElement& e : m_elements) {
+    // Which tetrahedra the cut separates whole, then their cut matrices on all threads (the
+    // moment-fitted quadrature is most of a cut's time), then their enriched blocks in order.
+    std::vector<std::uint32_t> candidates;
+    std::vector<std::array<double, 4>> candidate_phi;
+    for (std::size_t t = 0; t < m_elements.size(); ++t) {
+        const XfemElement& e = m_elements[t];
         std::array<double, 4> phi{};
         bool negative = false, positive = false;
         for (std::size_t c = 0; c < 4; ++c) {
@@ -48,34 +56,44 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         for (std::size_t a = 0; a < 4 && whole && inside; ++a)
             for (std::size_t b = a + 1; b < 4 && whole; ++b)
                 if ((phi[a] < 0.0) != (phi[b] < 0.0)) {
-                    const double t = phi[a] / (phi[a] - phi[b]);
-                    whole = inside(m_mesh.nodes[e.node[a]] + t * (m_mesh.nodes[e.node[b]] - m_mesh.nodes[e.node[a]]));
+                    const double f = phi[a] / (phi[a] - phi[b]);
+                    whole = inside(m_mesh.nodes[e.node[a]] + f * (m_mesh.nodes[e.node[b]] - m_mesh.nodes[e.node[a]]));
                 }
         if (!whole) {
             ++report.partial_tets;
             continue;
         }
-        const TetMaterial& m = m_materials[e.material];
-        std::array<Eigen::Vector3d, 4> x{};
-        for (std::size_t c = 0; c < 4; ++c) x[c] = m_mesh.nodes[e.node[c]];
-        const CutTet c = cut_tet(x, phi, m_k, m.lame, m.density, m_fitting);
+        candidates.push_back(static_cast<std::uint32_t>(t));
+        candidate_phi.push_back(phi);
+    }
+    std::vector<CutTet> matrices(candidates.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+            const XfemElement& e = m_elements[candidates[i]];
+            const TetMaterial& m = m_materials[e.material];
+            matrices[i] = cut_tet(m_mesh.corners(candidates[i]), candidate_phi[i], m_k, m.lame, m.density, m_fitting);
+        }
+    });
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        XfemElement& e = m_elements[candidates[i]];
+        const CutTet& c = matrices[i];
         if (std::min(c.side_volume[0], c.side_volume[1]) <= 0.0) {
             ++report.partial_tets; // the plane only touches it (through nodes): nothing to separate
             continue;
         }
         e.cut = id;
-        e.phi = phi;
+        e.phi = candidate_phi[i];
         e.node_side = c.node_side;
         e.side_volume = c.side_volume;
         e.side_stiffness = c.side_stiffness;
         e.mass = c.mass;
-        for (std::size_t i = 0; i < 4; ++i) {
-            const auto [it, added] = block_of_node.try_emplace(e.node[i], static_cast<std::uint32_t>(block_count()));
+        for (std::size_t n = 0; n < 4; ++n) {
+            const auto [it, added] = block_of_node.try_emplace(e.node[n], static_cast<std::uint32_t>(block_count()));
             if (added) {
-                m_enriched_node.push_back(e.node[i]);
+                m_enriched_node.push_back(e.node[n]);
                 ++report.new_blocks;
             }
-            e.enriched[i] = it->second;
+            e.enriched[n] = it->second;
         }
         ++report.cut_tets;
     }

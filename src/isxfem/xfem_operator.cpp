@@ -67,7 +67,6 @@ void XfemOperator::model_changed()
     m_was_cut.resize(elements.size(), 0);
     m_slot_start.assign(elements.size() + 1, 0);
     std::vector<std::uint32_t> count(blocks + 1, 0);
-    std::vector<Eigen::Triplet<double>> mass;
     for (std::size_t e = 0; e < elements.size(); ++e) {
         const XfemElement& el = elements[e];
         if (el.cut >= 0 && !m_was_cut[e]) { // newly cut: both sides start from its rotation
@@ -77,36 +76,52 @@ void XfemOperator::model_changed()
         }
         const std::size_t n = el.block_count();
         m_slot_start[e + 1] = m_slot_start[e] + static_cast<std::uint32_t>(3 * n);
-        for (std::size_t a = 0; a < n; ++a) {
-            ++count[el.block(a) + 1];
-            for (std::size_t b = 0; b < n; ++b)
-                mass.emplace_back(static_cast<int>(el.block(a)), static_cast<int>(el.block(b)),
-                                  el.mass(static_cast<Eigen::Index>(3 * a), static_cast<Eigen::Index>(3 * b)));
-        }
+        for (std::size_t a = 0; a < n; ++a) ++count[el.block(a) + 1];
     }
-    // Every block keeps a diagonal entry, so the matrix has one even for a block no element touches.
-    for (std::size_t b = 0; b < blocks; ++b) mass.emplace_back(static_cast<int>(b), static_cast<int>(b), 0.0);
-    m_block_mass.resize(static_cast<Eigen::Index>(blocks), static_cast<Eigen::Index>(blocks));
-    m_block_mass.setFromTriplets(mass.begin(), mass.end());
     for (std::size_t b = 0; b < blocks; ++b) count[b + 1] += count[b];
     m_touch_start = count;
     m_touch.resize(count[blocks]);
     for (std::size_t e = 0; e < elements.size(); ++e)
         for (std::size_t a = 0; a < elements[e].block_count(); ++a)
             m_touch[count[elements[e].block(a)]++] = {static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(a)};
-    // Where each element's blocks sit in the rows of the blocks they touch.
-    const int* outer = m_block_mass.outerIndexPtr();
-    const int* inner = m_block_mass.innerIndexPtr();
-    m_rank_start.assign(m_touch.size() + 1, 0);
-    m_rank.clear();
-    for (std::size_t b = 0; b < blocks; ++b)
+    // Each block's neighbours (itself always, so the matrix keeps a diagonal even for a block no
+    // element touches), row by row on all threads.
+    std::vector<std::vector<std::uint32_t>> neighbours(blocks);
+    parallel(blocks, [&](std::size_t b) {
+        auto& list = neighbours[b];
+        list.push_back(static_cast<std::uint32_t>(b));
         for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t) {
             const XfemElement& el = elements[m_touch[t][0]];
-            for (std::size_t c = 0; c < el.block_count(); ++c)
-                m_rank.push_back(static_cast<std::uint32_t>(std::lower_bound(inner + outer[b], inner + outer[b + 1], static_cast<int>(el.block(c))) -
-                                                            (inner + outer[b])));
-            m_rank_start[t + 1] = static_cast<std::uint32_t>(m_rank.size());
+            for (std::size_t c = 0; c < el.block_count(); ++c) list.push_back(el.block(c));
         }
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+    });
+    m_block_mass.resize(static_cast<Eigen::Index>(blocks), static_cast<Eigen::Index>(blocks));
+    int* outer = m_block_mass.outerIndexPtr();
+    outer[0] = 0;
+    for (std::size_t b = 0; b < blocks; ++b) outer[b + 1] = outer[b] + static_cast<int>(neighbours[b].size());
+    m_block_mass.resizeNonZeros(outer[blocks]);
+    m_rank_start.assign(m_touch.size() + 1, 0);
+    for (std::size_t t = 0; t < m_touch.size(); ++t) m_rank_start[t + 1] = m_rank_start[t] + static_cast<std::uint32_t>(elements[m_touch[t][0]].block_count());
+    m_rank.resize(m_rank_start.back());
+    // The mass row by row, and where each element's blocks sit in the rows of the blocks they touch.
+    parallel(blocks, [&](std::size_t b) {
+        int* inner = m_block_mass.innerIndexPtr() + outer[b];
+        double* values = m_block_mass.valuePtr() + outer[b];
+        const auto& list = neighbours[b];
+        std::copy(list.begin(), list.end(), inner);
+        std::fill(values, values + list.size(), 0.0);
+        for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t) {
+            const XfemElement& el = elements[m_touch[t][0]];
+            const auto a = static_cast<Eigen::Index>(3 * m_touch[t][1]);
+            for (std::size_t c = 0; c < el.block_count(); ++c) {
+                const auto rank = static_cast<std::uint32_t>(std::lower_bound(list.begin(), list.end(), el.block(c)) - list.begin());
+                m_rank[m_rank_start[t] + c] = rank;
+                values[rank] += el.mass(a, static_cast<Eigen::Index>(3 * c));
+            }
+        }
+    });
     build_pattern();
     m_slots.resize(m_slot_start.back());
     m_force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * blocks));
@@ -122,15 +137,19 @@ void XfemOperator::build_pattern()
     m_matrix.resize(3 * blocks, 3 * blocks);
     m_matrix.resizeNonZeros(9 * m_block_mass.nonZeros());
     int* outer = m_matrix.outerIndexPtr();
+    for (Eigen::Index b = 0; b < blocks; ++b) {
+        const int width = 3 * (block_outer[b + 1] - block_outer[b]);
+        for (int i = 0; i < 3; ++i) outer[3 * b + i] = 9 * block_outer[b] + i * width;
+    }
+    outer[3 * blocks] = 9 * block_outer[blocks];
     int* inner = m_matrix.innerIndexPtr();
-    outer[0] = 0;
-    for (Eigen::Index b = 0; b < blocks; ++b)
-        for (int i = 0; i < 3; ++i) {
+    parallel(static_cast<std::size_t>(blocks), [&](std::size_t b) {
+        for (std::size_t i = 0; i < 3; ++i) {
             int position = outer[3 * b + i];
             for (int k = block_outer[b]; k < block_outer[b + 1]; ++k)
                 for (int j = 0; j < 3; ++j) inner[position++] = 3 * block_inner[k] + j;
-            outer[3 * b + i + 1] = position;
         }
+    });
 }
 
 void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vector<unsigned char>& fixed, double scale_m,
