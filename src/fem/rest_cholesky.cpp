@@ -30,6 +30,7 @@ void RestCholesky::refactor(const SystemMatrix& a, const std::vector<unsigned ch
     m_fixed = fixed;
     m_stale = false;
     m_changed.assign(node_rotation.size(), 0);
+    m_covered_blocks = node_rotation.size();
     m_patch.clear();
     m_patch_dirty = false;
     // A CG iteration streams the factor twice (2 flops an entry each way) and multiplies by
@@ -53,7 +54,9 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
                           const std::vector<Eigen::Quaterniond>& node_rotation)
 {
     const std::size_t factored = m_factored_rotation.size();
-    if (m_stale || !same_holds(fixed) || node_rotation.size() < factored) {
+    // Grown without blocks_changed(): nothing says what changed, so factor anew.
+    const bool unexplained = node_rotation.size() > m_covered_blocks && !m_patch_dirty;
+    if (m_stale || !same_holds(fixed) || node_rotation.size() < factored || unexplained) {
         if (!a) throw std::logic_error("RestCholesky::update: a new factor needs the assembled matrix");
         refactor(*a, fixed, node_rotation);
     } else if (m_patch_dirty) { // grown or changed since the factorisation: patch it
@@ -62,6 +65,7 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
         for (std::uint32_t b = 0; b < node_rotation.size(); ++b)
             if (b >= factored || m_changed[b]) seeds.push_back(b);
         m_patch_dirty = false;
+        m_covered_blocks = node_rotation.size();
         if (!m_patch.build(*a, seeds) || static_cast<Eigen::Index>(8 * m_patch.dofs()) > a->rows()) refactor(*a, fixed, node_rotation);
     }
     // World-frame rotation of each factored block since the factorisation: F Q_now Q_factored^-1 F^T.

@@ -73,6 +73,7 @@ private:
     std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node); zero past the factor
     std::vector<unsigned char> m_changed;     ///< per factored block: its rows changed since the factorisation
     bool m_patch_dirty = false;
+    std::size_t m_covered_blocks = 0; ///< blocks the factor and its patch were built for
     PatchSolve m_patch;
     void refactor(const SystemMatrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>& node_rotation);
     /// Whether `fixed` holds the factored dofs as factored and none added since.

@@ -1,7 +1,8 @@
 // The warped factor preconditioner: it applies W A^-1 W^T (checked against a double-precision
 // solve, unrotated and with every node turned), and it takes a new factor exactly when the CG
 // iterations beyond those it needed right after the last one add up to the cost of a
-// factorisation, or when one solve exceeds the hard cap, or when other dofs are held.
+// factorisation, or when one solve exceeds the hard cap, or when other dofs are held, or when the
+// system grew and nothing said which of its rows changed.
 
 #include "fem/rest_cholesky.hpp"
 
@@ -86,4 +87,23 @@ TEST(RestCholesky, RefactorsWhenTheExcessIterationsPayForIt)
     f.fixed[0] = 1; // other dofs held: a new factor even though nothing asked for one
     p.update(&f.a, f.fixed, f.rest);
     EXPECT_EQ(p.factorizations(), 4);
+}
+
+TEST(RestCholesky, AGrownSystemIsFactoredAnewUnlessToldWhatChanged)
+{
+    Fixture small;
+    RestCholesky p(Eigen::Matrix3d::Identity());
+    p.update(&small.a, small.fixed, small.rest);
+    // The same kind of system with more nodes: nothing said which rows changed, so a new factor.
+    const SystemMatrix grown = vox::test::grid_laplacian<Eigen::RowMajor>(6, 0.5, 3);
+    const std::vector<unsigned char> fixed(static_cast<std::size_t>(grown.rows()), 0);
+    const std::vector<Eigen::Quaterniond> rest(static_cast<std::size_t>(grown.rows() / 3), Eigen::Quaterniond::Identity());
+    p.update(&grown, fixed, rest);
+    EXPECT_EQ(p.factorizations(), 2);
+    EXPECT_EQ(p.patch_dofs(), 0u);
+    Eigen::VectorXd z;
+    p.apply(Eigen::VectorXd::Ones(grown.rows()), z);
+    const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> exact{Eigen::SparseMatrix<double>(grown)};
+    const Eigen::VectorXd expected = exact.solve(Eigen::VectorXd::Ones(grown.rows()));
+    EXPECT_LT((z - expected).norm() / expected.norm(), 1e-5);
 }
