@@ -46,7 +46,9 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
     std::filesystem::create_directories(out);
     log::info("{}: isxfem (k = {}), level {}, {} tetrahedra, {} degrees of freedom, {} frames of {} s", scene_path, scene.solver.isxfem_k,
               level, sim.tet_count(), sim.solver().dof_count(), frames, dt);
-    nlohmann::json stats{{"scene", scene_path}, {"solver", "isxfem"}, {"k", scene.solver.isxfem_k}, {"level", level},
+    nlohmann::json stats{{"scene", scene_path}, {"solver", "isxfem"}, {"k", scene.solver.isxfem_k},
+                         {"regularisation", {{"lambda", scene.solver.isxfem_regularisation_lambda}, {"threshold", scene.solver.isxfem_regularisation_threshold}}},
+                         {"level", level},
                          {"tetrahedra", sim.tet_count()}, {"dofs", sim.solver().dof_count()}, {"dt_s", dt},
                          {"linear_solver", std::string("CG, ") + sim.solver().preconditioner_name() + " preconditioner"}, {"frames", nlohmann::json::array()}};
     double total_ms = 0.0, max_ms = 0.0, cut_total_ms = 0.0;
@@ -94,7 +96,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"cut_tets", frame_cut.cut_tets},
                                    {"partly_crossed_tets", frame_cut.partial_tets},
                                    {"recut_tets_left", frame_cut.already_cut},
-                                   {"dofs", sim.solver().dof_count()}});
+                                   {"dofs", sim.solver().dof_count()},
+                                   {"regularised_blocks", sim.solver().regularised_blocks()}});
         if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
         progress.update(static_cast<std::uint64_t>(f));
     }

@@ -34,6 +34,8 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     o.cg_max_iterations = scene.solver.cg_max_iterations;
     o.rayleigh_mass_per_s = scene.solver.rayleigh_mass_per_s;
     o.rayleigh_stiffness_s = scene.solver.rayleigh_stiffness_s;
+    o.regularisation_lambda = scene.solver.isxfem_regularisation_lambda;
+    o.regularisation_threshold = scene.solver.isxfem_regularisation_threshold;
     m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, o);
     switch (scene.solver.preconditioner) {
     case io::PreconditionerChoice::multigrid:

@@ -364,6 +364,8 @@ SolverSettings read_solver(JsonReader r)
         s.lumped_mass = choose_enum(*node, mass_kinds);
     }
     s.isxfem_k = r.optional("k", s.isxfem_k, closed_range(0.0, 1.0));
+    s.isxfem_regularisation_lambda = r.optional("regularisation_lambda", s.isxfem_regularisation_lambda, at_least(0.0));
+    s.isxfem_regularisation_threshold = r.optional("regularisation_threshold", s.isxfem_regularisation_threshold, closed_range(0.0, 1.0));
     r.finish();
     return s;
 }

@@ -132,6 +132,8 @@ struct SolverSettings {
     /// isxfem: the enrichment parameter k in [0, 1] of Is-XFEM (0: standard XFEM); default 0.1,
     /// the sculpting paper's.
     double isxfem_k = 0.1;
+    double isxfem_regularisation_lambda = 0.0;     ///< isxfem: A + lambda I on enriched dofs below the threshold (relative to the mean diagonal)
+    double isxfem_regularisation_threshold = 1e-4; ///< isxfem: the volume ratio below which an enriched dof is regularised
 };
 
 enum class ConstraintType {

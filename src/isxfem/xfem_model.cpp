@@ -15,6 +15,7 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
     if (!(k >= 0.0 && k <= 1.0)) throw std::invalid_argument("XfemModel: k must be in [0, 1], got " + std::to_string(k));
     if (material.size() != m_mesh.tets.size()) throw std::invalid_argument("XfemModel: one material per tetrahedron");
     m_elements.resize(m_mesh.tets.size());
+    m_support.assign(m_mesh.nodes.size(), 0.0);
     for (std::size_t t = 0; t < m_mesh.tets.size(); ++t) {
         XfemElement& e = m_elements[t];
         e.node = m_mesh.tets[t];
@@ -24,6 +25,7 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
         const TetMaterial& m = m_materials[e.material];
         e.stiffness = tet_stiffness(e.geometry, m.lame);
         e.mass.topLeftCorner<12, 12>() = tet_mass(e.geometry, m.density);
+        for (std::uint32_t n : e.node) m_support[n] += e.geometry.volume;
     }
 }
 
@@ -91,9 +93,11 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
             const auto [it, added] = block_of_node.try_emplace(e.node[n], static_cast<std::uint32_t>(block_count()));
             if (added) {
                 m_enriched_node.push_back(e.node[n]);
+                m_enriched_across.push_back(0.0);
                 ++report.new_blocks;
             }
             e.enriched[n] = it->second;
+            m_enriched_across[it->second - node_count()] += c.side_volume[1u - c.node_side[n]];
         }
         ++report.cut_tets;
     }

@@ -73,6 +73,14 @@ public:
     /// The node an enriched block belongs to (block >= node_count()).
     [[nodiscard]] std::uint32_t enriched_node(std::uint32_t block) const { return m_enriched_node[block - node_count()]; }
     [[nodiscard]] int cut_count() const { return m_cuts; }
+    /// The volume ratio of a dof block (the sculpting paper's equation 17): for an enriched block,
+    /// the share of its node's support that lies across the cut from the node, what the k = 0
+    /// enrichment lives on and what goes to zero as a cut passes close to the node's far side;
+    /// 1 for a node's own block.
+    [[nodiscard]] double volume_ratio(std::uint32_t block) const
+    {
+        return block < node_count() ? 1.0 : m_enriched_across[block - node_count()] / m_support[enriched_node(block)];
+    }
     /// The plane of cut `id`.
     [[nodiscard]] const PlaneCut& cut_plane(int id) const { return m_cut_planes.at(static_cast<std::size_t>(id)); }
 
@@ -83,6 +91,8 @@ private:
     MomentFitting m_fitting;
     std::vector<XfemElement> m_elements;
     std::vector<std::uint32_t> m_enriched_node; ///< per enriched block
+    std::vector<double> m_enriched_across;      ///< per enriched block: volume across its cut in its node's support, m^3
+    std::vector<double> m_support;              ///< per node: volume of its tetrahedra, m^3
     std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> m_cut_blocks; ///< per cut: node -> enriched block
     std::vector<PlaneCut> m_cut_planes;
     int m_cuts = 0;

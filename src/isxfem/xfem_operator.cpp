@@ -263,6 +263,29 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
     }
 }
 
+void XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative)
+{
+    auto diagonal_entry = [&](std::size_t dof) -> double& {
+        const std::size_t block = dof / 3;
+        const int* first = m_block_mass.innerIndexPtr() + m_block_mass.outerIndexPtr()[block];
+        const int* last = m_block_mass.innerIndexPtr() + m_block_mass.outerIndexPtr()[block + 1];
+        const auto rank = static_cast<int>(std::lower_bound(first, last, static_cast<int>(block)) - first);
+        return m_matrix.valuePtr()[m_matrix.outerIndexPtr()[dof] + 3 * rank + static_cast<int>(dof % 3)];
+    };
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t dof = 0; dof < 3 * m_model.node_count(); ++dof)
+        if (!m_fixed[dof]) {
+            sum += diagonal_entry(dof);
+            ++count;
+        }
+    if (count == 0) return;
+    const double shift = relative * sum / static_cast<double>(count);
+    for (std::uint32_t b : blocks)
+        for (std::size_t i = 0; i < 3; ++i)
+            if (!m_fixed[3 * b + i]) diagonal_entry(3 * b + i) += shift;
+}
+
 void XfemOperator::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
     out.resize(p.size());

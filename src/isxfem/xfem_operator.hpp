@@ -42,6 +42,11 @@ public:
     /// (positions of nodes, then enriched displacements); `fixed` flags held dofs.
     void update(const std::vector<Eigen::Vector3d>& x, const std::vector<unsigned char>& fixed, double scale_m, double scale_k);
 
+    /// Adds `relative` times the mean diagonal of the free standard dofs to the diagonal of the
+    /// free dofs of `blocks` (the regularisation A + lambda I of the sculpting paper, section
+    /// 4.3.2), until the next update().
+    void add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative);
+
     /// out = A p, the matrix of the last update().
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     /// out = M p.

@@ -25,6 +25,10 @@ void XfemOptions::validate() const
     if (!(cg_tolerance > 0.0 && cg_tolerance < 1.0)) throw InputError("isxfem solver: cg_tolerance must be in (0, 1)");
     if (cg_max_iterations < 1) throw InputError("isxfem solver: cg_max_iterations must be at least 1");
     if (!(rayleigh_mass_per_s >= 0.0) || !(rayleigh_stiffness_s >= 0.0)) throw InputError("isxfem solver: Rayleigh damping must be >= 0");
+    if (!(regularisation_lambda >= 0.0) || !std::isfinite(regularisation_lambda))
+        throw InputError("isxfem solver: regularisation_lambda must be >= 0");
+    if (!(regularisation_threshold >= 0.0 && regularisation_threshold <= 1.0))
+        throw InputError("isxfem solver: regularisation_threshold must be in [0, 1]");
 }
 
 XfemSolver::XfemSolver(const XfemModel& model, const XfemOptions& options) : m_model(model), m_options(options), m_operator(model)
@@ -67,6 +71,10 @@ void XfemSolver::model_changed()
     m_v.resize(blocks, Eigen::Vector3d::Zero());
     m_fixed.resize(3 * blocks, 0);
     m_operator.model_changed();
+    m_regularised.clear();
+    if (m_options.regularisation_lambda > 0.0)
+        for (auto b = static_cast<std::uint32_t>(m_model.node_count()); b < blocks; ++b)
+            if (m_model.volume_ratio(b) < m_options.regularisation_threshold) m_regularised.push_back(b);
     m_jumps.clear();
     std::vector<unsigned char> seen(blocks, 0);
     for (const XfemElement& el : elements)
@@ -119,6 +127,8 @@ XfemStepStats XfemSolver::step()
     const double dt = m_options.dt_s;
     const auto n = static_cast<Eigen::Index>(dof_count());
     m_operator.update(m_x, m_fixed, 1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt);
+    if (!m_regularised.empty())
+        m_operator.add_to_diagonal(m_regularised, m_options.regularisation_lambda);
     Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
     // Gravity acts through the nodes' own shape functions: the right-hand side is
     // M (v + dt g) - dt f_int.

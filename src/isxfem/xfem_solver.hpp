@@ -34,6 +34,13 @@ struct XfemOptions {
     int cg_max_iterations = 1000;
     double rayleigh_mass_per_s = 0.0;
     double rayleigh_stiffness_s = 0.0;
+    /// The regularisation of the sculpting paper (section 4.3.2): enriched blocks whose volume
+    /// ratio is below `regularisation_threshold` get lambda times the mean diagonal of the free
+    /// standard dofs added to their diagonal in every solve (A + lambda I on those dofs). Off by
+    /// default: it conditions XFEM's near-node systems (docs/isxfem.md) but holds the jump across
+    /// a sliver, whose stiff field then ties the two pieces together.
+    double regularisation_lambda = 0.0;
+    double regularisation_threshold = 1e-4;
     /// Throws InputError naming the offending option.
     void validate() const;
 };
@@ -78,6 +85,8 @@ public:
     [[nodiscard]] double kinetic_energy() const;
     [[nodiscard]] Eigen::Vector3d momentum() const;
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }
+    /// Enriched blocks regularised (their volume ratio below the threshold; none when lambda is 0).
+    [[nodiscard]] std::size_t regularised_blocks() const { return m_regularised.size(); }
 
 private:
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
@@ -94,6 +103,7 @@ private:
     std::vector<Eigen::Quaterniond> m_block_rotation;
     std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
     std::vector<unsigned char> m_cut;    ///< per element: cut when the model last changed
+    std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
 };
 
 } // namespace vox::isxfem

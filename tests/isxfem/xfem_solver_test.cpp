@@ -6,7 +6,9 @@
 
 #include "isxfem/xfem_solver.hpp"
 
+#include "core/error.hpp"
 #include "fem/rest_cholesky.hpp"
+#include "isxfem/plane_cut_system.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -206,4 +208,51 @@ TEST(XfemSolver, ACutKeepsTheWarpedFactorAndSolvesThePatchBesideIt)
     EXPECT_TRUE(s.converged);
     EXPECT_LE(s.cg_iterations, 25);
     EXPECT_EQ(warped->factorizations(), 1);
+}
+
+TEST(XfemSolver, VolumeRatiosMatchThePlaneCutSystemAndTheRegularisationTakesTheSmallOnes)
+{
+    // The model's volume ratio of each enriched block (accumulated cut by cut) against the plane-cut
+    // assembly's (computed from the whole mesh at once), on a cut 1e-3 h from a node plane.
+    const PlaneCut plane{Eigen::Vector3d::UnitX(), 4.001 * k_h};
+    XfemModel model = bar_model(0.0);
+    model.cut(plane);
+    const PlaneCutSystem reference = assemble_plane_cut(cube_lattice({8, 2, 2}, k_h), plane, 0.0, grid::lame_from_young_poisson(1e6, 0.3), 1000.0);
+    std::size_t small = 0;
+    for (auto b = static_cast<std::uint32_t>(model.node_count()); b < model.block_count(); ++b) {
+        const std::uint32_t node = model.enriched_node(b);
+        ASSERT_GE(reference.enriched[node], 0);
+        const double expected = reference.volume_ratio[3 * (model.node_count() + static_cast<std::size_t>(reference.enriched[node]))];
+        EXPECT_NEAR(model.volume_ratio(b), expected, 1e-12 * std::max(1.0, expected));
+        small += model.volume_ratio(b) < 1e-4;
+    }
+    ASSERT_GT(small, 0u);
+
+    XfemOptions off, on;
+    on.regularisation_lambda = 1e-3;
+    XfemSolver plain(model, off), regularised(model, on);
+    EXPECT_EQ(plain.regularised_blocks(), 0u);
+    EXPECT_EQ(regularised.regularised_blocks(), small);
+    for (XfemSolver* s : {&plain, &regularised}) {
+        s->set_gravity({0, 0, -9.81});
+        for (std::size_t n = 0; n < model.node_count(); ++n)
+            if (model.mesh().nodes[n].x() < 1e-9) s->fix(static_cast<std::uint32_t>(n), 7);
+    }
+    XfemStepStats p{}, r{};
+    for (int i = 0; i < 5; ++i) {
+        p = plain.step();
+        r = regularised.step();
+    }
+    EXPECT_TRUE(p.converged);
+    EXPECT_TRUE(r.converged);
+    // A + lambda I holds the small-ratio jumps: they move less than unregularised.
+    double free_jump = 0.0, held_jump = 0.0;
+    for (auto b = static_cast<std::uint32_t>(model.node_count()); b < model.block_count(); ++b)
+        if (model.volume_ratio(b) < 1e-4) {
+            free_jump = std::max(free_jump, plain.velocities()[b].norm());
+            held_jump = std::max(held_jump, regularised.velocities()[b].norm());
+        }
+    EXPECT_LT(held_jump, 0.5 * free_jump);
+    on.regularisation_lambda = -1.0;
+    EXPECT_THROW(on.validate(), InputError);
 }
