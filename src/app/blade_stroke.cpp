@@ -7,8 +7,8 @@
 namespace vox::app {
 
 BladeStroke::BladeStroke(const io::ToolSpec& tool)
-    : m_profile((tool.shape == io::ToolShape::scalpel ? contact::ToolShape::scalpel(tool.size_mm) : contact::ToolShape::box(tool.size_mm))
-                    .profile())
+    : m_swept((tool.shape == io::ToolShape::scalpel ? contact::ToolShape::scalpel(tool.size_mm) : contact::ToolShape::box(tool.size_mm))
+                  .profile())
 {
 }
 
@@ -18,50 +18,32 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     const Eigen::Vector3d normal = r.col(1);
     // The stroke goes on while the plane stays put, whether or not it has cut anything yet: a
     // blade shorter than a tetrahedron cuts it once its sweep has covered it.
-    const bool same_plane = !m_segments.empty() && (normal - m_rotation.col(1)).norm() < 1e-9 &&
+    const bool same_plane = !m_swept.empty() && (normal - m_rotation.col(1)).norm() < 1e-9 &&
                             std::abs((to.position_mm - m_origin_mm).dot(normal)) < 1e-6;
     if (!same_plane) {
         m_cut = -1;
         m_rotation = r;
         m_origin_mm = to.position_mm;
-        m_segments.clear();
+        m_swept.clear();
     }
-    // The motion in the plane, in the stroke's x-z coordinates (motion across it is ignored).
+    // A pose in the stroke's x-z coordinates: the turn within the plane and the offset (motion
+    // across the plane is ignored).
     auto in_plane = [&](const Eigen::Vector3d& p_mm) {
         const Eigen::Vector3d local = m_rotation.transpose() * (p_mm - m_origin_mm);
         return Eigen::Vector2d(local.x(), local.z());
     };
-    m_segments.push_back({in_plane(from.placed ? from.position_mm : to.position_mm), in_plane(to.position_mm)});
-    const auto inside = [this, &in_plane](const Eigen::Vector3d& p_m) { return covered(in_plane(p_m * 1e3)); };
+    auto turn = [&](const Eigen::Quaterniond& q) {
+        const Eigen::Matrix3d relative = m_rotation.transpose() * q.toRotationMatrix(); // about y when in the plane
+        Eigen::Matrix2d m;
+        m << relative(0, 0), relative(0, 2), relative(2, 0), relative(2, 2);
+        return m;
+    };
+    const io::ToolPose& start = from.placed && (from.orientation.toRotationMatrix().col(1) - normal).norm() < 1e-9 ? from : to;
+    m_swept.add(turn(start.orientation), in_plane(start.position_mm), turn(to.orientation), in_plane(to.position_mm));
+    const auto inside = [this, &in_plane](const Eigen::Vector3d& p_m) { return m_swept.covers(in_plane(p_m * 1e3)); };
     const isxfem::CutReport report = sim.cut(m_origin_mm * 1e-3, m_rotation.col(1), inside, m_cut);
     if (report.cut >= 0) m_cut = report.cut;
     return report;
-}
-
-bool BladeStroke::covered(const Eigen::Vector2d& q) const
-{
-    // Some t in [0, 1] with q - a - t (b - a) inside every edge's half-plane of the convex,
-    // counter-clockwise profile: an interval of t per edge.
-    for (const auto& [a, b] : m_segments) {
-        double lo = 0.0, hi = 1.0;
-        const Eigen::Vector2d d = b - a, p = q - a;
-        for (std::size_t k = 0; k < m_profile.size() && lo <= hi; ++k) {
-            const Eigen::Vector2d& e0 = m_profile[k];
-            const Eigen::Vector2d& e1 = m_profile[(k + 1) % m_profile.size()];
-            const Eigen::Vector2d outward(e1.y() - e0.y(), e0.x() - e1.x()); // right of a counter-clockwise edge
-            // outward . (p - t d - e0) <= 0  <=>  t (outward . d) >= outward . (p - e0)
-            const double c = outward.dot(p - e0), s = outward.dot(d);
-            if (std::abs(s) < 1e-300) {
-                if (c > 0.0) hi = -1.0;
-            } else if (s > 0.0) {
-                lo = std::max(lo, c / s);
-            } else {
-                hi = std::min(hi, c / s);
-            }
-        }
-        if (lo <= hi) return true;
-    }
-    return false;
 }
 
 isxfem::CutReport cut_frame(const io::Scene& scene, IsxfemSimulation& sim, std::vector<BladeStroke>& strokes, int frame, double dt)

@@ -1,15 +1,15 @@
 #pragma once
 // Blades and scalpels cutting an Is-XFEM simulation along their mid-plane (the tool's x-z plane).
-// While the plane stays put a stroke is one cut, and the region it covers is the union of the
-// tool's profile swept frame by frame, so a tetrahedron the blade crosses whole only over several
-// frames is cut once it has been.
+// While the plane stays put a stroke is one cut, and the region it covers is the tool's profile
+// swept frame by frame as it moves and turns within the plane (contact/swept_profile.hpp), so a
+// tetrahedron the blade crosses whole only over several frames is cut once it has been.
 
 #include "app/isxfem_simulation.hpp"
+#include "contact/swept_profile.hpp"
 #include "io/tool_script.hpp"
 
 #include <Eigen/Core>
 
-#include <utility>
 #include <vector>
 
 namespace vox::app {
@@ -19,18 +19,14 @@ public:
     explicit BladeStroke(const io::ToolSpec& tool);
 
     /// The blade moved from `from` to `to` over a frame; cuts where it has passed. Starts a new cut
-    /// when its plane moved or turned.
+    /// when its plane moved or tilted (turning within the plane goes on with the stroke).
     isxfem::CutReport advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to);
 
 private:
-    /// Whether q (stroke plane coordinates, mm) lies in the profile moved along any segment.
-    [[nodiscard]] bool covered(const Eigen::Vector2d& q) const;
-
-    std::vector<Eigen::Vector2d> m_profile; ///< mm, tool x-z
+    contact::SweptProfile m_swept; ///< in the stroke's plane coordinates, mm
     int m_cut = -1;
-    Eigen::Matrix3d m_rotation = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d m_rotation = Eigen::Matrix3d::Identity(); ///< the stroke's frame: its first pose
     Eigen::Vector3d m_origin_mm = Eigen::Vector3d::Zero();
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> m_segments;
 };
 
 /// Every placed tool of `scene` cuts for frame f (from (f - 1) dt to f dt); the frame's totals.
