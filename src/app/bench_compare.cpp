@@ -1,6 +1,6 @@
 #include "app/bench_compare.hpp"
 
-#include "app/blade_stroke.hpp"
+#include "app/isxfem_tools.hpp"
 #include "app/isxfem_simulation.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/tool_session.hpp"
@@ -76,12 +76,10 @@ Run run_isxfem_k(io::Scene scene, const grid::LabelGrid& labels, int frames, dou
 {
     scene.solver.type = io::SolverType::isxfem;
     scene.solver.isxfem_k = k;
-    check_isxfem_tools(scene);
     const int level = scene.object.levels;
     const grid::BranchedGrid g = build_scene_grid(scene, labels, std::max(level, 1));
     IsxfemSimulation sim(scene, g, level);
-    std::vector<BladeStroke> strokes;
-    for (const io::ToolSpec& t : scene.tools) strokes.emplace_back(t);
+    IsxfemTools tools(scene);
     Run r;
     char name[48];
     std::snprintf(name, sizeof name, k > 0.0 ? "Is-XFEM (k = %g)" : "XFEM (k = %g)", k);
@@ -91,7 +89,7 @@ Run run_isxfem_k(io::Scene scene, const grid::LabelGrid& labels, int frames, dou
     const double dt = scene.solver.dt_s;
     for (int f = 1; f <= frames; ++f) {
         const auto t = std::chrono::steady_clock::now();
-        const isxfem::CutReport cut = cut_frame(scene, sim, strokes, f, dt);
+        const isxfem::CutReport cut = tools.frame(sim, f, dt).cut;
         if (cut.cut_tets > 0) r.cut_ms.push_back(ms_since(t));
         const isxfem::XfemStepStats s = sim.solver().step();
         r.step_ms.push_back(s.step_ms);

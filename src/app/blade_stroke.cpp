@@ -46,30 +46,4 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     return report;
 }
 
-isxfem::CutReport cut_frame(const io::Scene& scene, IsxfemSimulation& sim, std::vector<BladeStroke>& strokes, int frame, double dt)
-{
-    isxfem::CutReport total;
-    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
-        const io::ToolPose from = io::tool_pose(scene, k, (frame - 1) * dt), to = io::tool_pose(scene, k, frame * dt);
-        if (!to.placed) continue;
-        const isxfem::CutReport r = strokes[k].advance(sim, from, to);
-        total.cut_tets += r.cut_tets;
-        total.new_blocks += r.new_blocks;
-        total.partial_tets += r.partial_tets;
-        total.already_cut += r.already_cut;
-    }
-    return total;
-}
-
-void check_isxfem_tools(const io::Scene& scene)
-{
-    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
-        const io::ToolSpec& t = scene.tools[k];
-        if (t.action != io::ToolAction::cut || (t.shape != io::ToolShape::blade && t.shape != io::ToolShape::scalpel))
-            throw scene.error("tools[" + std::to_string(k) + "]",
-                              "\"" + t.name + "\": \"isxfem\" scenes cut with blades and scalpels only so far; pushing and wetting tools need \"type\": \"dbg\"");
-        if (t.two_phase) throw scene.error("tools[" + std::to_string(k) + "].two_phase", "\"isxfem\" has no two-phase cutting yet");
-    }
-}
-
 } // namespace vox::app

@@ -29,11 +29,4 @@ private:
     Eigen::Vector3d m_origin_mm = Eigen::Vector3d::Zero();
 };
 
-/// Every placed tool of `scene` cuts for frame f (from (f - 1) dt to f dt); the frame's totals.
-isxfem::CutReport cut_frame(const io::Scene& scene, IsxfemSimulation& sim, std::vector<BladeStroke>& strokes, int frame, double dt);
-
-/// Refuses, with the scene's message, tools Is-XFEM cannot simulate yet (pushing, wetting,
-/// two-phase).
-void check_isxfem_tools(const io::Scene& scene);
-
 } // namespace vox::app

@@ -186,19 +186,7 @@ void add_run_command(CLI::App& app)
             if (!std::isfinite(last.elastic_energy_j) || !std::isfinite(last.kinetic_energy_j))
                 throw InputError(args->scene + ": the simulation diverged at frame " + std::to_string(f) +
                                  " (non-finite energy); reduce solver.dt_s or check the materials");
-            nlohmann::json tool_frames = nlohmann::json::array();
-            for (const ToolFrame& t : tf.tools) {
-                if (!t.placed) {
-                    tool_frames.push_back(nullptr);
-                    continue;
-                }
-                tool_frames.push_back({{"position_mm", {t.position_mm.x(), t.position_mm.y(), t.position_mm.z()}},
-                                       {"force_n", {t.force_n.x(), t.force_n.y(), t.force_n.z()}},
-                                       {"torque_n_mm", {t.torque_n_mm.x(), t.torque_n_mm.y(), t.torque_n_mm.z()}},
-                                       {"pressure_pa", t.pressure_pa},
-                                       {"contact_area_mm2", t.contact_area_mm2},
-                                       {"cut", t.cut}});
-            }
+            const nlohmann::json tool_frames = tool_frames_json(tf.tools);
             stats["frames"].push_back({{"frame", f},
                                        {"t_s", f * dt},
                                        {"step_ms", last.step_ms},

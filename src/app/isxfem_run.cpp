@@ -1,6 +1,6 @@
 #include "app/isxfem_run.hpp"
 
-#include "app/blade_stroke.hpp"
+#include "app/isxfem_tools.hpp"
 #include "app/isxfem_simulation.hpp"
 #include "app/run_output.hpp"
 #include "app/scene_simulation.hpp"
@@ -31,14 +31,12 @@ void write_surface(const std::filesystem::path& path, const IsxfemSimulation& si
 
 void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::optional<int> frame_count, const std::filesystem::path& out)
 {
-    check_isxfem_tools(scene);
     if (scene.object.auto_levels) throw scene.error("object.levels", "\"isxfem\" needs a fixed level (0 to 6), not \"auto\"");
     const grid::LabelGrid labels = io::load_scene_object(scene);
     const int level = scene.object.levels;
     const grid::BranchedGrid g = build_scene_grid(scene, labels, std::max(level, 1));
     IsxfemSimulation sim(scene, g, level);
-    std::vector<BladeStroke> strokes;
-    for (const io::ToolSpec& t : scene.tools) strokes.emplace_back(t);
+    IsxfemTools tools(scene);
 
     const double dt = scene.solver.dt_s;
     const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
@@ -60,7 +58,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
     const auto& rest = sim.model().mesh().nodes;
     for (int f = 1; f <= frames; ++f) {
         const auto cut_start = std::chrono::steady_clock::now();
-        const isxfem::CutReport frame_cut = cut_frame(scene, sim, strokes, f, dt);
+        const IsxfemToolFrame tool_frame = tools.frame(sim, f, dt);
+        const isxfem::CutReport& frame_cut = tool_frame.cut;
         const double cut_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cut_start).count();
         cut_total_ms += cut_ms;
         cut_tets += frame_cut.cut_tets;
@@ -97,7 +96,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"partly_crossed_tets", frame_cut.partial_tets},
                                    {"recut_tets_left", frame_cut.already_cut},
                                    {"dofs", sim.solver().dof_count()},
-                                   {"regularised_blocks", sim.solver().regularised_blocks()}});
+                                   {"regularised_blocks", sim.solver().regularised_blocks()},
+                                   {"tools", tool_frames_json(tool_frame.tools)}});
         if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
         progress.update(static_cast<std::uint64_t>(f));
     }

@@ -122,10 +122,10 @@ std::pair<std::array<double, 4>, double> barycentric(const isxfem::TetMesh& mesh
 
 } // namespace
 
-surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
+void IsxfemSimulation::closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
 {
     const surface::SurfaceMesh rest = m_surface->mesh(m_grid); // rest, world mm, the used vertices in slot order
-    std::vector<CapVertex> vertices;
+    vertices.clear();
     vertices.reserve(m_vertices.size());
     for (std::size_t k = 0; k < m_vertices.size(); ++k) {
         const Embedded& e = m_vertices[k];
@@ -134,13 +134,63 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
         for (std::size_t c = 0; c < 4; ++c) phi += e.bary[c] * el.phi[c];
         vertices.push_back({e.tet, e.bary, el.cut >= 0 && phi >= 0.0 ? 1 : 0, e.rest_m, rest.labels[k]});
     }
-    std::vector<Eigen::Vector3i> triangles = rest.triangles;
+    triangles = rest.triangles;
     for (int cut = 0; cut < m_model->cut_count(); ++cut) close_cut(cut, vertices, triangles);
+}
+
+surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
+{
+    std::vector<CapVertex> vertices;
     surface::SurfaceMesh out;
-    out.triangles = std::move(triangles);
+    closed_surface(vertices, out.triangles);
     for (const CapVertex& v : vertices) {
         out.positions.push_back(1e3 * m_solver->position(v.tet, v.bary, v.side));
         out.labels.push_back(v.label);
+    }
+    return out;
+}
+
+IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                                                const contact::PlacedShape* from) const
+{
+    std::vector<CapVertex> vertices;
+    std::vector<Eigen::Vector3i> triangles;
+    closed_surface(vertices, triangles);
+    // Only vertices within the tool's reach (at both poses) are measured.
+    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
+    std::vector<Eigen::Vector3d> position(vertices.size());
+    for (std::size_t v = 0; v < vertices.size(); ++v) position[v] = 1e3 * m_solver->position(vertices[v].tet, vertices[v].bary, vertices[v].side);
+    std::vector<std::uint32_t> near;
+    std::vector<unsigned char> is_near(vertices.size(), 0);
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+        if (reach.contains(position[v])) is_near[v] = 1;
+    // Each near vertex carries a third of its triangles' area and their area-weighted normal.
+    std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
+    std::vector<double> area(vertices.size(), 0.0);
+    for (const Eigen::Vector3i& t : triangles) {
+        if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
+        const Eigen::Vector3d n = (position[static_cast<std::size_t>(t[1])] - position[static_cast<std::size_t>(t[0])])
+                                      .cross(position[static_cast<std::size_t>(t[2])] - position[static_cast<std::size_t>(t[0])]);
+        for (int c = 0; c < 3; ++c) {
+            normal[static_cast<std::size_t>(t[c])] += n;
+            area[static_cast<std::size_t>(t[c])] += n.norm() / 6.0;
+        }
+    }
+    std::vector<Eigen::Vector3d> points, normals;
+    std::vector<double> areas;
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+        if (is_near[v] && area[v] > 0.0) {
+            near.push_back(static_cast<std::uint32_t>(v));
+            points.push_back(position[v]);
+            areas.push_back(area[v]);
+            normals.push_back(normal[v].normalized());
+        }
+    Touch out;
+    out.contact = contact::penalty_contact(tool, parameters, points, areas, normals, from && from->shape ? from : nullptr);
+    for (const contact::PointContact& c : out.contact.points) {
+        const CapVertex& v = vertices[near[c.point]];
+        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
     }
     return out;
 }

@@ -6,6 +6,7 @@
 // in the tetrahedra by barycentric coordinates (each vertex on its side of any cut through its
 // tetrahedron).
 
+#include "contact/penalty_contact.hpp"
 #include "io/scene.hpp"
 #include "isxfem/grid_tets.hpp"
 #include "isxfem/xfem_solver.hpp"
@@ -41,8 +42,22 @@ public:
     /// branched-grid simulation of the same scene and level.
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const;
 
+    /// A tool pressed against the deformed, closed surface (contact::penalty_contact on its
+    /// vertices, each carrying a third of its triangles' area and their area-weighted normal),
+    /// and the contact's forces as point loads at the vertices' material points for the solver.
+    /// With `from`, the tool's pose at the previous frame: the penalty is integrated over the
+    /// move (continuous penalty).
+    struct Touch {
+        contact::ContactResult contact;
+        std::vector<isxfem::PointLoad> loads;
+    };
+    [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                              const contact::PlacedShape* from = nullptr) const;
+
 private:
     struct CapVertex;
+    /// The closed surface's vertices (material points) and triangles.
+    void closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
     void close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
 
     const grid::BranchedGrid& m_grid;

@@ -11,9 +11,8 @@
 #include <utility>
 
 namespace vox::app {
-namespace {
 
-contact::ToolShape make_shape(const io::ToolSpec& t)
+contact::ToolShape make_tool_shape(const io::ToolSpec& t)
 {
     switch (t.shape) {
     case io::ToolShape::blade:
@@ -27,17 +26,15 @@ contact::ToolShape make_shape(const io::ToolSpec& t)
         return contact::ToolShape::from_mesh({m.vertices, m.triangles});
     }
     }
-    throw std::logic_error("make_shape: unknown tool shape");
+    throw std::logic_error("make_tool_shape: unknown tool shape");
 }
-
-} // namespace
 
 ToolSession::ToolSession(const io::Scene& scene)
     : m_scene(scene), m_previous_section(scene.tools.size()), m_marked_from(scene.tools.size()),
       m_episode_cut(scene.tools.size(), false), m_driven(scene.tools.size(), false), m_driven_pose(scene.tools.size()),
       m_last_pose(scene.tools.size())
 {
-    for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_shape(t));
+    for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_tool_shape(t));
 }
 
 void ToolSession::drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation)

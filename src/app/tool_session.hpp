@@ -13,6 +13,9 @@
 
 namespace vox::app {
 
+/// The contact shape of a scene tool. Throws InputError when a mesh tool's file cannot be read.
+contact::ToolShape make_tool_shape(const io::ToolSpec& tool);
+
 /// One tool during one frame.
 struct ToolFrame {
     bool placed = false;

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace vox::isxfem {
 namespace {
@@ -284,6 +285,21 @@ void XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, dou
     for (std::uint32_t b : blocks)
         for (std::size_t i = 0; i < 3; ++i)
             if (!m_fixed[3 * b + i]) diagonal_entry(3 * b + i) += shift;
+}
+
+void XfemOperator::add_to_element_block(std::size_t e, std::size_t a, std::size_t b, const Eigen::Matrix3d& m)
+{
+    const XfemElement& el = m_model.elements()[e];
+    const std::uint32_t row = el.block(a);
+    std::uint32_t t = m_touch_start[row];
+    while (t < m_touch_start[row + 1] && !(m_touch[t][0] == e && m_touch[t][1] == a)) ++t;
+    if (t == m_touch_start[row + 1]) throw std::logic_error("XfemOperator::add_to_element_block: the element does not touch its block");
+    const std::uint32_t rank = m_rank[m_rank_start[t] + b];
+    const std::uint32_t column = el.block(b);
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j)
+            if (!m_fixed[3 * row + i] && !m_fixed[3 * column + j])
+                m_matrix.valuePtr()[m_matrix.outerIndexPtr()[3 * row + i] + 3 * rank + j] += m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
 }
 
 void XfemOperator::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const

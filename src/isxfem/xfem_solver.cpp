@@ -137,6 +137,17 @@ XfemStepStats XfemSolver::step()
     Eigen::VectorXd rhs;
     m_operator.mass_multiply(moved, rhs);
     rhs -= dt * m_operator.internal_force();
+    // Point loads (tool contact) act through the interpolation at their points, implicitly:
+    // f(x') ~ f - S (x' - x) adds dt f to the right-hand side and dt^2 w_a w_b S to the matrix.
+    for (const PointLoad& l : m_loads) {
+        const XfemElement& el = m_model.elements()[l.tet];
+        const std::array<double, 8> w = weights(l.tet, l.bary, l.side);
+        for (std::size_t a = 0; a < el.block_count(); ++a) {
+            rhs.segment<3>(3 * static_cast<Eigen::Index>(el.block(a))) += dt * w[a] * l.force_n;
+            for (std::size_t b = 0; b < el.block_count(); ++b)
+                if (w[a] * w[b] != 0.0) m_operator.add_to_element_block(l.tet, a, b, dt * dt * w[a] * w[b] * l.stiffness_n_per_m);
+        }
+    }
     Eigen::VectorXd next = v;
     for (Eigen::Index i = 0; i < n; ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = next[i] = 0.0;
@@ -152,20 +163,33 @@ XfemStepStats XfemSolver::step()
     return s;
 }
 
-Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>& n, int side) const
+std::array<double, 8> XfemSolver::weights(std::size_t t, const std::array<double, 4>& n, int side) const
 {
     const XfemElement& el = m_model.elements()[t];
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (std::size_t c = 0; c < 4; ++c) p += n[c] * m_x[el.node[c]];
-    if (el.cut < 0) return p;
+    std::array<double, 8> w{};
+    for (std::size_t c = 0; c < 4; ++c) w[c] = n[c];
+    if (el.cut < 0) return w;
     double gamma = 0.0;
     for (std::size_t c = 0; c < 4; ++c) gamma += n[c] * el.node_side[c];
     const double k = m_model.k();
-    for (std::size_t c = 0; c < 4; ++c) {
-        const double psi = side - (k * gamma + (1.0 - k) * el.node_side[c]);
-        p += psi * n[c] * m_x[el.enriched[c]];
-    }
+    for (std::size_t c = 0; c < 4; ++c) w[4 + c] = (side - (k * gamma + (1.0 - k) * el.node_side[c])) * n[c]; // psi_c N_c
+    return w;
+}
+
+Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>& n, int side) const
+{
+    const XfemElement& el = m_model.elements()[t];
+    const std::array<double, 8> w = weights(t, n, side);
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (std::size_t a = 0; a < el.block_count(); ++a) p += w[a] * m_x[el.block(a)];
     return p;
+}
+
+void XfemSolver::set_point_loads(std::vector<PointLoad> loads)
+{
+    for (const PointLoad& l : loads)
+        if (l.tet >= m_model.elements().size()) throw std::out_of_range("XfemSolver::set_point_loads: no tetrahedron " + std::to_string(l.tet));
+    m_loads = std::move(loads);
 }
 
 double XfemSolver::kinetic_energy() const

@@ -45,6 +45,16 @@ struct XfemOptions {
     void validate() const;
 };
 
+/// A force at a material point (tool contact): tetrahedron, barycentric coordinates and side (of
+/// its cut, 0 when uncut), the force at the current positions and its stiffness -d force / d x.
+struct PointLoad {
+    std::size_t tet = 0;
+    std::array<double, 4> bary{};
+    int side = 0;
+    Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero(); ///< symmetric, positive semidefinite
+};
+
 struct XfemStepStats {
     double step_ms = 0.0, assembly_ms = 0.0, solve_ms = 0.0;
     int cg_iterations = 0;
@@ -79,6 +89,13 @@ public:
     [[nodiscard]] const std::vector<Eigen::Vector3d>& state() const { return m_x; }
     [[nodiscard]] std::vector<Eigen::Vector3d>& velocities() { return m_v; }
     [[nodiscard]] const std::vector<Eigen::Vector3d>& velocities() const { return m_v; }
+    /// Forces at material points for the following steps (replacing the last ones), taken
+    /// implicitly with their stiffness. Throws std::out_of_range for a tetrahedron that is not there.
+    void set_point_loads(std::vector<PointLoad> loads);
+    /// The weights of the dof blocks of tetrahedron t (its nodes, then when cut their enriched
+    /// blocks: psi_c N_c) at the point with barycentric coordinates `n` on side `side`: the point
+    /// moves by sum_a w_a x_a, and a force f there acts on block a as w_a f.
+    [[nodiscard]] std::array<double, 8> weights(std::size_t t, const std::array<double, 4>& n, int side) const;
     /// World position of the material point with barycentric coordinates `n` in tetrahedron t,
     /// on side `side` (0: phi < 0, 1: phi >= 0) when the tetrahedron is cut.
     [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int side) const;
@@ -104,6 +121,7 @@ private:
     std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
     std::vector<unsigned char> m_cut;    ///< per element: cut when the model last changed
     std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
+    std::vector<PointLoad> m_loads;
 };
 
 } // namespace vox::isxfem

@@ -1,0 +1,45 @@
+#pragma once
+// The scene's tools acting on an Is-XFEM simulation, frame by frame: blades and scalpels cut along
+// their mid-plane where they have passed (app/blade_stroke.hpp); pushing tools press on the
+// deformed, closed surface with the penalty contact of the branched-grid runs
+// (contact/penalty_contact.hpp, integrated over the tool's move), and their forces are the
+// solver's point loads for the next step.
+//
+// Not yet: the cut pressure threshold and two-phase cutting for blades (they cut wherever they
+// pass), wetting tools.
+
+#include "app/blade_stroke.hpp"
+#include "app/isxfem_simulation.hpp"
+#include "app/tool_session.hpp"
+
+#include <optional>
+#include <vector>
+
+namespace vox::app {
+
+struct IsxfemToolFrame {
+    isxfem::CutReport cut;        ///< the frame's cuts, all tools together
+    std::vector<ToolFrame> tools; ///< one per scene tool
+};
+
+class IsxfemTools {
+public:
+    /// Refuses (the scene's InputError) tools Is-XFEM cannot simulate yet; throws InputError when a
+    /// mesh tool's file cannot be read.
+    explicit IsxfemTools(const io::Scene& scene);
+
+    /// Frame f, from (f - 1) dt to f dt: cuts, then sets the solver's point loads.
+    IsxfemToolFrame frame(IsxfemSimulation& sim, int frame, double dt);
+
+private:
+    const io::Scene& m_scene;
+    std::vector<contact::ToolShape> m_shapes;
+    std::vector<std::optional<BladeStroke>> m_strokes; ///< per tool: blades and scalpels only
+    std::vector<contact::PlacedShape> m_last_pose;      ///< per tool, at the last frame it was placed
+};
+
+/// Refuses, with the scene's message, tools Is-XFEM cannot simulate yet (wetting, two-phase,
+/// cutting with other shapes than blades and scalpels).
+void check_isxfem_tools(const io::Scene& scene);
+
+} // namespace vox::app
