@@ -4,7 +4,7 @@
 // dt 0.01 s, CG to 1e-6, with the warped factor
 // and with Jacobi. Per frame: cut update (the tetrahedra the blade has crossed whole) plus the step.
 // Reports median, 95th percentile and max frame time, the frame rate that median gives, the
-// medians of the frames the blade cut in (each factors the grown system anew) and of those after,
+// medians of the frames the blade cut in (the factor kept and the cut patched) and of those after,
 // of the step's update (rotations, forces, matrix) and solve, and the CG iterations. The target: a 10,000-tetrahedron object being cut at 100 Hz or better on
 // 2 cores.
 // Usage: vox_isxfem_bench [FRAMES] [THREADS] (defaults 60 and 1); VOX_BENCH_FACTOR_ONLY=1 skips the

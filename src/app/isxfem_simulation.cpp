@@ -42,7 +42,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         throw scene.error("solver.preconditioner", "\"isxfem\" has no multigrid; use \"auto\", \"cholesky\" or \"jacobi\"");
     case io::PreconditionerChoice::jacobi:
         break;
-    default: // the warped factor, taken again after each cut and when the object has turned away from it
+    default: // the warped factor, patched across cuts and taken again when that or the turning costs more
         m_solver->set_preconditioner(std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity()));
     }
     m_solver->set_gravity(scene.gravity_m_s2);

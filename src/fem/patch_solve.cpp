@@ -4,7 +4,7 @@
 
 namespace vox::fem {
 
-bool PatchSolve::build(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const std::vector<std::uint32_t>& blocks)
+bool PatchSolve::build(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const std::vector<std::uint32_t>& blocks, Eigen::Index max_dofs)
 {
     const auto block_count = static_cast<std::size_t>(a.rows() / 3);
     std::vector<unsigned char> in(block_count, 0);
@@ -21,6 +21,10 @@ bool PatchSolve::build(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, co
         for (int i = 0; i < 3; ++i)
             for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(a, 3 * static_cast<Eigen::Index>(patch[s]) + i); it; ++it)
                 take(static_cast<std::uint32_t>(it.col() / 3));
+    if (static_cast<Eigen::Index>(3 * patch.size()) > max_dofs) {
+        m_dofs.clear();
+        return false;
+    }
     std::sort(patch.begin(), patch.end());
     std::vector<int> local(static_cast<std::size_t>(a.rows()), -1);
     m_dofs.clear();

@@ -16,8 +16,9 @@ namespace vox::fem {
 class PatchSolve {
 public:
     /// Builds the patch of `blocks` (3 dofs each) in the row-major symmetric matrix `a` and
-    /// factors it. False when the patch is not positive definite.
-    bool build(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const std::vector<std::uint32_t>& blocks);
+    /// factors it. False (and empty) when the patch would hold more than `max_dofs` dofs or is not
+    /// positive definite.
+    bool build(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const std::vector<std::uint32_t>& blocks, Eigen::Index max_dofs);
     void clear() { m_dofs.clear(); }
     [[nodiscard]] bool empty() const { return m_dofs.empty(); }
     [[nodiscard]] std::size_t dofs() const { return m_dofs.size(); }

@@ -66,7 +66,7 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
             if (b >= factored || m_changed[b]) seeds.push_back(b);
         m_patch_dirty = false;
         m_covered_blocks = node_rotation.size();
-        if (!m_patch.build(*a, seeds) || static_cast<Eigen::Index>(8 * m_patch.dofs()) > a->rows()) refactor(*a, fixed, node_rotation);
+        if (!m_patch.build(*a, seeds, a->rows() / 8)) refactor(*a, fixed, node_rotation); // failed, or past an eighth of the system
     }
     // World-frame rotation of each factored block since the factorisation: F Q_now Q_factored^-1 F^T.
     const std::size_t blocks = m_factored_rotation.size();
@@ -99,9 +99,12 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
         const auto i = static_cast<Eigen::Index>(3 * n);
         m_scratch.segment<3>(i) = m_warp[n].transpose() * r.segment<3>(i);
     }
+    const std::size_t factored = m_warp.size();
+    auto coupled = [&](const JumpBlock& jump) { return jump.block < factored && jump.node < factored; }; // else J = 0
     for (std::size_t j = 0; j < m_jumps.size(); ++j)
-        m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node)) +=
-            m_jump_warp[j].transpose() * r.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block));
+        if (coupled(m_jumps[j]))
+            m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node)) +=
+                m_jump_warp[j].transpose() * r.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block));
     for (Eigen::Index i = 0; i < m_rows; ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) m_scratch[i] = 0.0;
     m_factor.solve(m_scratch);
@@ -111,8 +114,9 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
         z.segment<3>(i) = m_warp[n] * m_scratch.segment<3>(i);
     }
     for (std::size_t j = 0; j < m_jumps.size(); ++j)
-        z.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block)) +=
-            m_jump_warp[j] * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node));
+        if (coupled(m_jumps[j]))
+            z.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block)) +=
+                m_jump_warp[j] * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node));
     if (!m_patch.empty()) m_patch.add_to(r, z);
     for (std::size_t i = 0; i < m_fixed.size(); ++i)
         if (m_fixed[i]) z[static_cast<Eigen::Index>(i)] = 0.0;

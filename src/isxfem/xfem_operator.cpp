@@ -211,7 +211,7 @@ void XfemOperator::block_rotations(std::vector<Eigen::Quaterniond>& out) const
             if (el.cut >= 0) side = corner < 4 ? el.node_side[corner] : 1u - el.node_side[corner - 4];
             fem::accumulate_rotation(sum, m_rotation[m_touch[t][0]][side]);
         }
-        if (sum.squaredNorm() > 0.0) out[b].coeffs() = sum.normalized();
+        out[b] = sum.squaredNorm() > 0.0 ? Eigen::Quaterniond(sum.normalized()) : Eigen::Quaterniond::Identity();
     });
 }
 
@@ -264,7 +264,7 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
     }
 }
 
-void XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative)
+double XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative)
 {
     auto diagonal_entry = [&](std::size_t dof) -> double& {
         const std::size_t block = dof / 3;
@@ -280,11 +280,12 @@ void XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, dou
             sum += diagonal_entry(dof);
             ++count;
         }
-    if (count == 0) return;
+    if (count == 0) return 0.0;
     const double shift = relative * sum / static_cast<double>(count);
     for (std::uint32_t b : blocks)
         for (std::size_t i = 0; i < 3; ++i)
             if (!m_fixed[3 * b + i]) diagonal_entry(3 * b + i) += shift;
+    return shift;
 }
 
 void XfemOperator::add_to_element_block(std::size_t e, std::size_t a, std::size_t b, const Eigen::Matrix3d& m)

@@ -44,8 +44,8 @@ public:
 
     /// Adds `relative` times the mean diagonal of the free standard dofs to the diagonal of the
     /// free dofs of `blocks` (the regularisation A + lambda I of the sculpting paper, section
-    /// 4.3.2), until the next update().
-    void add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative);
+    /// 4.3.2), until the next update(). Returns what was added.
+    double add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative);
 
     /// Adds m to the 3 x 3 block of the matrix between element e's dof blocks a and b (its local
     /// numbering: nodes, then enriched), leaving held dofs' identity rows and columns, until the

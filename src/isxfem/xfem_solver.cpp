@@ -127,8 +127,7 @@ XfemStepStats XfemSolver::step()
     const double dt = m_options.dt_s;
     const auto n = static_cast<Eigen::Index>(dof_count());
     m_operator.update(m_x, m_fixed, 1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt);
-    if (!m_regularised.empty())
-        m_operator.add_to_diagonal(m_regularised, m_options.regularisation_lambda);
+    const double shift = m_regularised.empty() ? 0.0 : m_operator.add_to_diagonal(m_regularised, m_options.regularisation_lambda);
     Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
     // Gravity acts through the nodes' own shape functions: the right-hand side is
     // M (v + dt g) - dt f_int.
@@ -148,6 +147,10 @@ XfemStepStats XfemSolver::step()
                 if (w[a] * w[b] != 0.0) m_operator.add_to_element_block(l.tet, a, b, dt * dt * w[a] * w[b] * l.stiffness_n_per_m);
         }
     }
+    // The regularisation as added inertia, (A + lambda I) v' = c + lambda v: it resists changes of
+    // the small jumps' velocities, not the velocities themselves, so it conditions the system
+    // without holding a jump that is already opening.
+    for (std::uint32_t b : m_regularised) rhs.segment<3>(3 * static_cast<Eigen::Index>(b)) += shift * v.segment<3>(3 * static_cast<Eigen::Index>(b));
     Eigen::VectorXd next = v;
     for (Eigen::Index i = 0; i < n; ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = next[i] = 0.0;

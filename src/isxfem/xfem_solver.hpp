@@ -36,9 +36,9 @@ struct XfemOptions {
     double rayleigh_stiffness_s = 0.0;
     /// The regularisation of the sculpting paper (section 4.3.2): enriched blocks whose volume
     /// ratio is below `regularisation_threshold` get lambda times the mean diagonal of the free
-    /// standard dofs added to their diagonal in every solve (A + lambda I on those dofs). Off by
-    /// default: it conditions XFEM's near-node systems (docs/isxfem.md) but holds the jump across
-    /// a sliver, whose stiff field then ties the two pieces together.
+    /// standard dofs added to their diagonal in every solve (A + lambda I on those dofs) and the
+    /// same times their velocity to the right-hand side: added inertia. Off by default: it
+    /// conditions XFEM's near-node systems but slows the pieces' separation (docs/isxfem.md).
     double regularisation_lambda = 0.0;
     double regularisation_threshold = 1e-4;
     /// Throws InputError naming the offending option.

@@ -107,3 +107,37 @@ TEST(RestCholesky, AGrownSystemIsFactoredAnewUnlessToldWhatChanged)
     const Eigen::VectorXd expected = exact.solve(Eigen::VectorXd::Ones(grown.rows()));
     EXPECT_LT((z - expected).norm() / expected.norm(), 1e-5);
 }
+
+TEST(RestCholesky, WarpsAJumpBlockWithTheTwoSidesOfItsCrack)
+{
+    // Blocks 0 .. n-1 of a grid Laplacian; block 1 is the jump of node 0 across a crack (the
+    // node on side 0). The node turns by r0, the far side by r1: P must be W A^-1 W^T with
+    // W = [r0 0; (r1 - r0) r1] on (node, jump) and the other blocks turned by their own rotation.
+    Fixture f;
+    RestCholesky p(Eigen::Matrix3d::Identity());
+    p.set_jump_blocks({JumpBlock{1, 0, 1.0}});
+    p.update(&f.a, f.fixed, f.rest);
+    const Eigen::Quaterniond q0(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+    const Eigen::Quaterniond q1(Eigen::AngleAxisd(1.1, Eigen::Vector3d(-2, 0, 1).normalized()));
+    std::vector<Eigen::Quaterniond> rotation(f.rest.size(), q0);
+    rotation[1] = q1;
+    p.update(nullptr, f.fixed, rotation);
+    const Eigen::Index n = f.a.rows();
+    Eigen::MatrixXd w = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::Index b = 0; b < n / 3; ++b) w.block<3, 3>(3 * b, 3 * b) = rotation[static_cast<std::size_t>(b)].toRotationMatrix();
+    w.block<3, 3>(3, 0) = q1.toRotationMatrix() - q0.toRotationMatrix();
+    const Eigen::MatrixXd inverse = Eigen::MatrixXd(f.a).inverse();
+    const Eigen::MatrixXd expected = w * inverse * w.transpose();
+    const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+    Eigen::VectorXd z;
+    p.apply(r, z);
+    EXPECT_LT((z - expected * r).norm() / (expected * r).norm(), 1e-5);
+    EXPECT_EQ(p.factorizations(), 1);
+    // With the sign for a node on side 1: W_jump,node = -(r_jump - r_node).
+    p.set_jump_blocks({JumpBlock{1, 0, -1.0}});
+    p.update(nullptr, f.fixed, rotation);
+    w.block<3, 3>(3, 0) *= -1.0;
+    p.apply(r, z);
+    const Eigen::VectorXd flipped = w * inverse * w.transpose() * r;
+    EXPECT_LT((z - flipped).norm() / flipped.norm(), 1e-5);
+}

@@ -60,7 +60,11 @@ TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
     XfemOperator op(model);
     const double scale_m = 1.05, scale_k = 1.2e-4;
     op.update(d.x, d.fixed, scale_m, scale_k);
+    const Eigen::MatrixXd first(op.matrix());
+    const Eigen::VectorXd first_force = op.internal_force();
     op.update(d.x, d.fixed, scale_m, scale_k); // a second, warm-started update changes nothing
+    EXPECT_LT((Eigen::MatrixXd(op.matrix()) - first).cwiseAbs().maxCoeff(), 1e-12 * first.cwiseAbs().maxCoeff());
+    EXPECT_LT((op.internal_force() - first_force).norm(), 1e-10 * first_force.norm());
 
     const auto n = static_cast<Eigen::Index>(3 * model.block_count());
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n), mass = Eigen::MatrixXd::Zero(n, n);
@@ -115,6 +119,22 @@ TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
     op.mass_multiply(p, mp);
     EXPECT_LT((ap - a * p).norm(), 1e-12 * (a * p).norm());
     EXPECT_LT((mp - mass * p).norm(), 1e-12 * (mass * p).norm());
+
+    // The regularisation adds the same to the free diagonal entries of the blocks it is given.
+    const auto jump = static_cast<std::uint32_t>(model.node_count());
+    const Eigen::VectorXd before = op.diagonal();
+    const double shift = op.add_to_diagonal({jump}, 1e-3);
+    double mean = 0.0;
+    int count = 0;
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(3 * model.node_count()); ++i)
+        if (!d.fixed[static_cast<std::size_t>(i)]) {
+            mean += before[i];
+            ++count;
+        }
+    EXPECT_NEAR(shift, 1e-3 * mean / count, 1e-12 * shift);
+    const Eigen::VectorXd added = op.diagonal() - before;
+    for (Eigen::Index i = 0; i < n; ++i)
+        EXPECT_NEAR(added[i], i / 3 == jump && !d.fixed[static_cast<std::size_t>(i)] ? shift : 0.0, 1e-12 * before.cwiseAbs().maxCoeff()) << i;
 }
 
 TEST(XfemOperator, AtRestHasNoForceAndTheRotationsStayIdentity)

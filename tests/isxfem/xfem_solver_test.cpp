@@ -212,7 +212,7 @@ TEST(XfemSolver, ACutKeepsTheWarpedFactorAndSolvesThePatchBesideIt)
 
 TEST(XfemSolver, VolumeRatiosMatchThePlaneCutSystemAndTheRegularisationTakesTheSmallOnes)
 {
-    // The model's volume ratio of each enriched block (accumulated cut by cut) against the plane-cut
+    // The model's volume ratio of each enriched block (summed over its cut tetrahedra) against the plane-cut
     // assembly's (computed from the whole mesh at once), on a cut 1e-3 h from a node plane.
     const PlaneCut plane{Eigen::Vector3d::UnitX(), 4.001 * k_h};
     XfemModel model = bar_model(0.0);
@@ -245,7 +245,7 @@ TEST(XfemSolver, VolumeRatiosMatchThePlaneCutSystemAndTheRegularisationTakesTheS
     }
     EXPECT_TRUE(p.converged);
     EXPECT_TRUE(r.converged);
-    // A + lambda I holds the small-ratio jumps: they move less than unregularised.
+    // A + lambda I as added inertia resists the small-ratio jumps: they move less than unregularised.
     double free_jump = 0.0, held_jump = 0.0;
     for (auto b = static_cast<std::uint32_t>(model.node_count()); b < model.block_count(); ++b)
         if (model.volume_ratio(b) < 1e-4) {
