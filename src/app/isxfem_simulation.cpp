@@ -66,6 +66,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         std::tie(e.tet, e.bary) = isxfem::locate(m_model->mesh(), embedding.vertex_element(v), e.rest_m);
         m_vertices.push_back(e);
     }
+    m_rest = m_surface->mesh(grid); // the used vertices in slot order, as m_vertices
 }
 
 isxfem::CutReport IsxfemSimulation::cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
@@ -88,6 +89,23 @@ std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
         u.push_back(m_solver->position(v.tet, v.bary, side) - v.rest_m);
     }
     return u;
+}
+
+Eigen::Vector3d IsxfemSimulation::mean_displacement_mm(const Eigen::AlignedBox3d& box) const
+{
+    const auto& rest = m_model->mesh().nodes;
+    const auto& x = m_solver->state();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    for (const isxfem::XfemElement& el : m_model->elements()) {
+        Eigen::AlignedBox3d deformed;
+        deformed.setEmpty();
+        for (std::uint32_t n : el.node) deformed.extend(1e3 * x[n]);
+        if (!deformed.intersects(box)) continue;
+        for (std::uint32_t n : el.node) sum += 1e3 * (x[n] - rest[n]);
+        count += 4;
+    }
+    return count ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
 }
 
 std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
@@ -124,7 +142,6 @@ std::pair<std::array<double, 4>, double> barycentric(const isxfem::TetMesh& mesh
 
 void IsxfemSimulation::closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
 {
-    const surface::SurfaceMesh rest = m_surface->mesh(m_grid); // rest, world mm, the used vertices in slot order
     vertices.clear();
     vertices.reserve(m_vertices.size());
     for (std::size_t k = 0; k < m_vertices.size(); ++k) {
@@ -132,9 +149,9 @@ void IsxfemSimulation::closed_surface(std::vector<CapVertex>& vertices, std::vec
         const isxfem::XfemElement& el = m_model->elements()[e.tet];
         double phi = 0.0;
         for (std::size_t c = 0; c < 4; ++c) phi += e.bary[c] * el.phi[c];
-        vertices.push_back({e.tet, e.bary, el.cut >= 0 && phi >= 0.0 ? 1 : 0, e.rest_m, rest.labels[k]});
+        vertices.push_back({e.tet, e.bary, el.cut >= 0 && phi >= 0.0 ? 1 : 0, e.rest_m, m_rest.labels[k]});
     }
-    triangles = rest.triangles;
+    triangles = m_rest.triangles;
     for (int cut = 0; cut < m_model->cut_count(); ++cut) close_cut(cut, vertices, triangles);
 }
 
@@ -159,17 +176,43 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     // Only vertices within the tool's reach (at both poses) are measured.
     Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
-    std::vector<Eigen::Vector3d> position(vertices.size());
-    for (std::size_t v = 0; v < vertices.size(); ++v) position[v] = 1e3 * m_solver->position(vertices[v].tet, vertices[v].bary, vertices[v].side);
+    // Only the vertices of tetrahedra whose deformed box (both sides of a cut one) meets the reach
+    // are placed: a large surface is mostly far from the tool.
+    const auto& x = m_solver->state();
+    std::vector<unsigned char> tet_near(m_model->elements().size(), 0);
+    for (std::size_t t = 0; t < m_model->elements().size(); ++t) {
+        const isxfem::XfemElement& el = m_model->elements()[t];
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        double jump = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) {
+            box.extend(1e3 * x[el.node[c]]);
+            if (el.cut < 0) continue;
+            for (double side : {0.0, 1.0}) box.extend(1e3 * (x[el.node[c]] + (side - el.node_side[c]) * x[el.enriched[c]]));
+            jump += 1e3 * x[el.enriched[c]].norm();
+        }
+        // For k > 0 a side's field is the linear one plus k gamma-weighted jumps, at most k sum |a|.
+        const Eigen::Vector3d pad = Eigen::Vector3d::Constant(m_model->k() * jump);
+        tet_near[t] = Eigen::AlignedBox3d(box.min() - pad, box.max() + pad).intersects(reach);
+    }
+    std::vector<Eigen::Vector3d> position(vertices.size(), Eigen::Vector3d::Constant(INFINITY));
     std::vector<std::uint32_t> near;
     std::vector<unsigned char> is_near(vertices.size(), 0);
-    for (std::size_t v = 0; v < vertices.size(); ++v)
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+        if (!tet_near[vertices[v].tet]) continue;
+        position[v] = 1e3 * m_solver->position(vertices[v].tet, vertices[v].bary, vertices[v].side);
         if (reach.contains(position[v])) is_near[v] = 1;
+    }
     // Each near vertex carries a third of its triangles' area and their area-weighted normal.
     std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
     std::vector<double> area(vertices.size(), 0.0);
     for (const Eigen::Vector3i& t : triangles) {
         if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
+        for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
+            if (!std::isfinite(position[static_cast<std::size_t>(t[c])].x())) {
+                const CapVertex& v = vertices[static_cast<std::size_t>(t[c])];
+                position[static_cast<std::size_t>(t[c])] = 1e3 * m_solver->position(v.tet, v.bary, v.side);
+            }
         const Eigen::Vector3d n = (position[static_cast<std::size_t>(t[1])] - position[static_cast<std::size_t>(t[0])])
                                       .cross(position[static_cast<std::size_t>(t[2])] - position[static_cast<std::size_t>(t[0])]);
         for (int c = 0; c < 3; ++c) {

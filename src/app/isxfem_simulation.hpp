@@ -54,6 +54,10 @@ public:
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                               const contact::PlacedShape* from = nullptr) const;
 
+    /// The mean displacement (mm) of the nodes of the tetrahedra whose deformed box meets `box`
+    /// (world mm): how far the material there has moved from rest.
+    [[nodiscard]] Eigen::Vector3d mean_displacement_mm(const Eigen::AlignedBox3d& box) const;
+
 private:
     struct CapVertex;
     /// The closed surface's vertices (material points) and triangles.
@@ -71,6 +75,7 @@ private:
         std::uint64_t key = 0;
     };
     std::vector<Embedded> m_vertices; ///< per used surface vertex, in mesh order
+    surface::SurfaceMesh m_rest;      ///< the surface at rest: its triangles and labels
 };
 
 } // namespace vox::app

@@ -39,19 +39,11 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         t.placed = to.placed;
         if (!to.placed) {
             m_last_pose[k] = {}; // back later: from wherever it reappears
+            if (m_strokes[k]) m_strokes[k]->end();
             continue;
         }
         t.position_mm = to.position_mm;
-        if (m_strokes[k]) {
-            const isxfem::CutReport r = m_strokes[k]->advance(sim, from, to);
-            out.cut.cut_tets += r.cut_tets;
-            out.cut.new_blocks += r.new_blocks;
-            out.cut.partial_tets += r.partial_tets;
-            out.cut.already_cut += r.already_cut;
-            t.cut = r.cut_tets > 0;
-            continue;
-        }
-        // A pushing tool: the penalty integrated over its move since the last frame.
+        // The penalty integrated over the tool's move since the last frame.
         const contact::PlacedShape placed{&m_shapes[k], to.position_mm, to.orientation};
         const IsxfemSimulation::Touch touch =
             sim.touch(placed, {spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, m_last_pose[k].shape ? &m_last_pose[k] : nullptr);
@@ -61,6 +53,21 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         t.torque_n_mm = touch.contact.torque_on_tool_n_mm;
         t.pressure_pa = touch.contact.pressure_pa;
         t.contact_area_mm2 = touch.contact.area_mm2;
+        if (!m_strokes[k]) continue;
+        BladeStroke& stroke = *m_strokes[k];
+        if (stroke.cutting() && touch.contact.points.empty()) { // let go: the next touch starts a new stroke
+            stroke.end();
+            continue;
+        }
+        const bool breaks_in = touch.contact.inner_reaches_surface() && touch.contact.pressure_pa >= spec.cut_pressure_pa;
+        const Eigen::Vector3d moved = stroke.cutting() || breaks_in ? sim.mean_displacement_mm(placed.world_bounds(spec.push_margin_mm))
+                                                                      : Eigen::Vector3d::Zero();
+        const isxfem::CutReport r = stroke.advance(sim, from, to, breaks_in, moved);
+        out.cut.cut_tets += r.cut_tets;
+        out.cut.new_blocks += r.new_blocks;
+        out.cut.partial_tets += r.partial_tets;
+        out.cut.already_cut += r.already_cut;
+        t.cut = r.cut_tets > 0;
     }
     sim.solver().set_point_loads(std::move(loads));
     return out;

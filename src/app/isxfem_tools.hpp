@@ -1,12 +1,15 @@
 #pragma once
-// The scene's tools acting on an Is-XFEM simulation, frame by frame: blades and scalpels cut along
-// their mid-plane where they have passed (app/blade_stroke.hpp); pushing tools press on the
+// The scene's tools acting on an Is-XFEM simulation, frame by frame. Every tool presses on the
 // deformed, closed surface with the penalty contact of the branched-grid runs
-// (contact/penalty_contact.hpp, integrated over the tool's move), and their forces are the
-// solver's point loads for the next step.
+// (contact/penalty_contact.hpp, integrated over the tool's move), and its forces are the solver's
+// point loads for the next step. Blades and scalpels also cut along their mid-plane
+// (app/blade_stroke.hpp): a stroke breaks in when the blade's inner shape reaches the surface with
+// the contact pressure at or above the tool's cut_pressure_pa, as a branched-grid cut begins, and
+// from then on cuts wherever the blade passes until it lets go (leaves the surface's reach) or
+// changes plane. Past the break-in the crack's own faces are not in the contact surface (slits stay
+// open), so the pressure at the blade's edge inside the material is not measured.
 //
-// Not yet: the cut pressure threshold and two-phase cutting for blades (they cut wherever they
-// pass), wetting tools.
+// Not yet: two-phase cutting, wetting tools.
 
 #include "app/blade_stroke.hpp"
 #include "app/isxfem_simulation.hpp"
