@@ -89,8 +89,9 @@ Run run_isxfem_k(io::Scene scene, const grid::LabelGrid& labels, int frames, dou
     const double dt = scene.solver.dt_s;
     for (int f = 1; f <= frames; ++f) {
         const auto t = std::chrono::steady_clock::now();
-        const isxfem::CutReport cut = tools.frame(sim, f, dt).cut;
-        if (cut.cut_tets > 0) r.cut_ms.push_back(ms_since(t));
+        const IsxfemToolFrame tf = tools.frame(sim, f, dt);
+        if (tf.cut.cut_tets > 0) r.cut_ms.push_back(ms_since(t));
+        if (tf.hold_object) continue;
         const isxfem::XfemStepStats s = sim.solver().step();
         r.step_ms.push_back(s.step_ms);
         r.iterations.push_back(s.cg_iterations);

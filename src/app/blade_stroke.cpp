@@ -12,28 +12,22 @@ BladeStroke::BladeStroke(const io::ToolSpec& tool)
 {
 }
 
-isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to, bool breaks_in,
-                                       const Eigen::Vector3d& moved_mm)
+isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to,
+                                       const Eigen::Vector3d& moved_mm, bool cut)
 {
     const Eigen::Matrix3d r = to.orientation.toRotationMatrix();
     const Eigen::Vector3d normal = r.col(1);
     // The stroke goes on while the plane stays put in the world, whether or not it has cut
     // anything yet: a blade shorter than a tetrahedron cuts it once its sweep has covered it.
-    const bool same_plane = m_started && (normal - m_rotation.col(1)).norm() < 1e-9 &&
+    const bool same_plane = !m_swept.empty() && (normal - m_rotation.col(1)).norm() < 1e-9 &&
                             std::abs((to.position_mm - m_world_origin_mm).dot(normal)) < 1e-6;
-    if (!same_plane) {
+    if (!same_plane) { // the cut's plane, carried back to rest space where the stroke begins
         m_cut = -1;
         m_rotation = r;
         m_world_origin_mm = to.position_mm;
-        m_swept.clear();
-        m_started = true;
-        m_cutting = false;
-    }
-    if (!m_cutting && breaks_in) { // the cut's plane, carried back to rest space where it breaks in
-        m_cutting = true;
         m_origin_mm = to.position_mm - moved_mm;
+        m_swept.clear();
     }
-    if (!m_cutting) return {};
     // A pose in the stroke's rest-space x-z coordinates: the turn within the plane and the offset
     // (motion across the plane is ignored).
     auto in_plane = [&](const Eigen::Vector3d& p_mm) {
@@ -48,6 +42,7 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     };
     const io::ToolPose& start = from.placed && (from.orientation.toRotationMatrix().col(1) - normal).norm() < 1e-9 ? from : to;
     m_swept.add(turn(start.orientation), in_plane(start.position_mm), turn(to.orientation), in_plane(to.position_mm));
+    if (!cut) return {};
     const auto inside = [this, &moved_mm, &in_plane](const Eigen::Vector3d& p_m) { return m_swept.covers(in_plane(p_m * 1e3 + moved_mm)); };
     const isxfem::CutReport report = sim.cut(m_origin_mm * 1e-3, m_rotation.col(1), inside, m_cut);
     if (report.cut >= 0) m_cut = report.cut;

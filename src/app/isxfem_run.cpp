@@ -73,7 +73,14 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                           f, frame_cut.already_cut);
             left_whole.insert(static_cast<std::size_t>(f));
         }
-        last = sim.solver().step();
+        if (tool_frame.hold_object) { // a two-phase cut is being marked: the object is held, no step
+            last.step_ms = last.assembly_ms = last.solve_ms = 0.0;
+            last.cg_iterations = 0;
+            last.residual = 0.0;
+            last.converged = true;
+        } else {
+            last = sim.solver().step();
+        }
         total_ms += last.step_ms;
         max_ms = std::max(max_ms, last.step_ms);
         converged += last.converged;
@@ -97,6 +104,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"recut_tets_left", frame_cut.already_cut},
                                    {"dofs", sim.solver().dof_count()},
                                    {"regularised_blocks", sim.solver().regularised_blocks()},
+                                   {"object_held", tool_frame.hold_object},
                                    {"tools", tool_frames_json(tool_frame.tools)}});
         if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
         progress.update(static_cast<std::uint64_t>(f));

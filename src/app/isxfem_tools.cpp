@@ -13,11 +13,10 @@ void check_isxfem_tools(const io::Scene& scene)
             throw scene.error(where, "\"" + t.name + "\": \"isxfem\" does not wet yet; wetting tools need \"type\": \"dbg\"");
         if (t.action == io::ToolAction::cut && t.shape != io::ToolShape::blade && t.shape != io::ToolShape::scalpel)
             throw scene.error(where, "\"" + t.name + "\": \"isxfem\" cuts with blades and scalpels only so far; other cutting shapes need \"type\": \"dbg\"");
-        if (t.two_phase) throw scene.error(where + ".two_phase", "\"isxfem\" has no two-phase cutting yet");
     }
 }
 
-IsxfemTools::IsxfemTools(const io::Scene& scene) : m_scene(scene), m_last_pose(scene.tools.size())
+IsxfemTools::IsxfemTools(const io::Scene& scene) : m_scene(scene), m_last_pose(scene.tools.size()), m_done(scene.tools.size(), false)
 {
     check_isxfem_tools(scene);
     for (const io::ToolSpec& t : scene.tools) {
@@ -40,6 +39,7 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         if (!to.placed) {
             m_last_pose[k] = {}; // back later: from wherever it reappears
             if (m_strokes[k]) m_strokes[k]->end();
+            m_done[k] = false;
             continue;
         }
         t.position_mm = to.position_mm;
@@ -55,14 +55,24 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         t.contact_area_mm2 = touch.contact.area_mm2;
         if (!m_strokes[k]) continue;
         BladeStroke& stroke = *m_strokes[k];
-        if (stroke.cutting() && touch.contact.points.empty()) { // let go: the next touch starts a new stroke
+        if (touch.contact.points.empty()) { // let go (or not yet touching): the next touch starts anew
             stroke.end();
+            m_done[k] = false;
             continue;
         }
         const bool breaks_in = touch.contact.inner_reaches_surface() && touch.contact.pressure_pa >= spec.cut_pressure_pa;
-        const Eigen::Vector3d moved = stroke.cutting() || breaks_in ? sim.mean_displacement_mm(placed.world_bounds(spec.push_margin_mm))
-                                                                      : Eigen::Vector3d::Zero();
-        const isxfem::CutReport r = stroke.advance(sim, from, to, breaks_in, moved);
+        isxfem::CutReport r;
+        if (spec.two_phase && !m_done[k]) {
+            // Marking: the object is held (so the material around the blade has not moved since the
+            // marking began) and the blade's path counts from the first touch.
+            r = stroke.advance(sim, from, to, sim.mean_displacement_mm(placed.world_bounds(spec.push_margin_mm)), breaks_in);
+            m_done[k] = breaks_in;
+            out.hold_object = out.hold_object || !breaks_in;
+        } else {
+            m_done[k] = m_done[k] || breaks_in;
+            if (!m_done[k]) continue;
+            r = stroke.advance(sim, from, to, sim.mean_displacement_mm(placed.world_bounds(spec.push_margin_mm)), true);
+        }
         out.cut.cut_tets += r.cut_tets;
         out.cut.new_blocks += r.new_blocks;
         out.cut.partial_tets += r.partial_tets;

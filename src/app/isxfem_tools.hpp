@@ -9,7 +9,14 @@
 // changes plane. Past the break-in the crack's own faces are not in the contact surface (slits stay
 // open), so the pressure at the blade's edge inside the material is not measured.
 //
-// Not yet: two-phase cutting, wetting tools.
+// Two-phase tools (the sculpting paper's section 5): from the first touch the object is held still
+// (no solver step) while the blade marks its path, so it cannot slip away from the blade before
+// the pressure reaches the threshold; then the whole marked path is cut at once, the object moves
+// again, and the blade goes on cutting where it passes until it lets go, as a one-phase stroke.
+// (The branched-grid runs stop cutting after the marked path; a blade marking a few tenths of a
+// millimetre would cut no tetrahedron whole.)
+//
+// Not yet: wetting tools.
 
 #include "app/blade_stroke.hpp"
 #include "app/isxfem_simulation.hpp"
@@ -23,6 +30,7 @@ namespace vox::app {
 struct IsxfemToolFrame {
     isxfem::CutReport cut;        ///< the frame's cuts, all tools together
     std::vector<ToolFrame> tools; ///< one per scene tool
+    bool hold_object = false;     ///< a two-phase tool is marking: no solver step this frame
 };
 
 class IsxfemTools {
@@ -39,10 +47,13 @@ private:
     std::vector<contact::ToolShape> m_shapes;
     std::vector<std::optional<BladeStroke>> m_strokes; ///< per tool: blades and scalpels only
     std::vector<contact::PlacedShape> m_last_pose;      ///< per tool, at the last frame it was placed
+    /// Per tool: its stroke has broken in (one phase), or its marking has cut (two phases), since
+    /// it last touched.
+    std::vector<bool> m_done;
 };
 
-/// Refuses, with the scene's message, tools Is-XFEM cannot simulate yet (wetting, two-phase,
-/// cutting with other shapes than blades and scalpels).
+/// Refuses, with the scene's message, tools Is-XFEM cannot simulate yet (wetting, cutting with
+/// other shapes than blades and scalpels).
 void check_isxfem_tools(const io::Scene& scene);
 
 } // namespace vox::app

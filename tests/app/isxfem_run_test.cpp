@@ -98,6 +98,35 @@ TEST(IsxfemRun, AFingerPushesOnTheTetrahedraAsOnTheBranchedGrid)
     EXPECT_LT(tetrahedra, 2.5 * branched);
 }
 
+TEST(IsxfemRun, ATwoPhaseKnifeHoldsTheBlockWhileItMarksThenCuts)
+{
+    // The knife of press_and_cut_two_phase.json on the tetrahedra: while it touches, the block is
+    // held (no step) and the force rises; at the cut pressure the block moves again and the knife
+    // cuts where it goes on.
+    const fs::path d = fresh_dir("isxfem_two_phase");
+    const fs::path scene = edited_scene(d, "press_and_cut_two_phase.json", {{"\"type\": \"dbg\"", "\"type\": \"isxfem\""}});
+    const auto r = run_voxsculpt("run " + quote(scene.string()) + " --out " + quote((d / "out").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(d / "out" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    int held = 0, last_held = -1, first_cut = -1;
+    double force_held = 0.0;
+    for (const auto& f : stats["frames"]) {
+        const int frame = f["frame"].get<int>();
+        if (f["object_held"].get<bool>()) {
+            EXPECT_TRUE(last_held < 0 || last_held == frame - 1) << frame; // one marking, while it touches
+            ++held;
+            last_held = frame;
+            force_held = std::max(force_held, f["tools"][0]["force_n"][2].get<double>());
+        }
+        if (f["cut_tets"].get<int>() > 0 && first_cut < 0) first_cut = frame;
+    }
+    EXPECT_GE(held, 3);
+    EXPECT_GT(force_held, 0.01); // the force rose while the block was held
+    ASSERT_GT(first_cut, last_held); // the cuts come once the marking has reached the pressure
+    EXPECT_GT(stats["summary"]["cut_tets"].get<int>(), 0);
+}
+
 TEST(IsxfemRun, WhatItCannotDoYetIsRefusedByName)
 {
     const fs::path d = fresh_dir("isxfem_refused");
