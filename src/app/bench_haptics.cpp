@@ -2,16 +2,20 @@
 // cutting simulation runs beside it. The threads are those of a live session:
 //  - the haptic thread (its own, 1 kHz on absolute deadlines) reads a scripted device pressing a
 //    knife into the block of data/scenes/press_and_cut.json again and again, a little further
-//    along each time, and jabbing it in between (jumps of several mm a tick); couples the tool to it (virtual coupling against the penalty contact with
+//    along each time, and jabbing it in between (jumps of several mm a tick); couples the tool to
+//    it (virtual coupling against the penalty contact with
 //    the newest surface snapshot); publishes the tool's pose;
 //  - the simulation thread (this one) puts the tool where the haptic thread says, lets it cut,
-//    steps the FEM, publishes the surface near the tool, and keeps simulated time in pace with
+//    steps the simulation (the branched grid, or Is-XFEM with --isxfem), publishes the surface
+//    near the tool, and keeps simulated time in pace with
 //    wall time. The scene is press_and_cut.json one level coarser, which one core steps in real
 //    time: the snapshots stay fresher than the safety stage's 50 ms.
 // They share only two triple buffers. Prints period error and force-computation time (p50, p99,
 // max), with the cutting and the snapshots' sizes.
 
 #include "app/bench_haptics.hpp"
+#include "app/isxfem_simulation.hpp"
+#include "app/isxfem_tools.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/tool_session.hpp"
 #include "core/log.hpp"
@@ -26,6 +30,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <functional>
+#include <memory>
 #include <chrono>
 #include <thread>
 #include <cstdio>
@@ -65,20 +71,50 @@ std::vector<haptics::KeyFrame> presses(double seconds)
 
 } // namespace
 
-void run_haptics_bench(double seconds)
+void run_haptics_bench(double seconds, bool isxfem)
 {
     // The press-and-cut scene one level coarser (2 mm -> 4 mm elements), so that the simulation
     // thread alone keeps its snapshots fresh (under the 50 ms the safety stage allows).
     io::Scene scene = io::load_scene(VOX_DATA_DIR "/scenes/press_and_cut.json");
     scene.object.levels = 2;
+    if (isxfem) scene.solver.type = io::SolverType::isxfem;
     const grid::LabelGrid labels = io::load_scene_object(scene);
     grid::BranchedGrid g = build_scene_grid(scene, labels, scene.object.levels);
-    SceneSimulation sim(scene, g, scene.object.levels);
-    ToolSession tools(scene);
     const io::ToolSpec& knife = scene.tools.front();
     const contact::ContactParameters parameters{knife.push_margin_mm, knife.contact_stiffness_n_per_mm};
     constexpr std::size_t snapshot_capacity = 50000;
-    haptics::CoupledTool coupled(tools.shape(0), parameters, haptics::CouplingSettings{}, snapshot_capacity);
+    const contact::ToolShape knife_shape = make_tool_shape(knife);
+    haptics::CoupledTool coupled(knife_shape, parameters, haptics::CouplingSettings{}, snapshot_capacity);
+    // One simulation frame with the knife where the device put it: tools, step, the surface near
+    // the knife into `out`; true when it cut.
+    std::function<bool(const contact::PlacedShape&, int, contact::SurfacePoints&)> simulate;
+    std::unique_ptr<SceneSimulation> dbg;
+    std::unique_ptr<ToolSession> dbg_tools;
+    std::unique_ptr<IsxfemSimulation> xfem;
+    std::unique_ptr<IsxfemTools> xfem_tools;
+    const Eigen::AlignedBox3d::VectorType reach = Eigen::Vector3d::Constant(knife.push_margin_mm + 5.0);
+    if (isxfem) {
+        xfem = std::make_unique<IsxfemSimulation>(scene, g, scene.object.levels);
+        xfem_tools = std::make_unique<IsxfemTools>(scene);
+        simulate = [&](const contact::PlacedShape& pose, int frame, contact::SurfacePoints& out) {
+            xfem_tools->drive(0, pose.position, pose.orientation);
+            const IsxfemToolFrame t = xfem_tools->frame(*xfem, frame, scene.solver.dt_s);
+            if (!t.hold_object) xfem->solver().step();
+            const Eigen::AlignedBox3d box = pose.world_bounds(0.0);
+            xfem->sample_surface(Eigen::AlignedBox3d(box.min() - reach, box.max() + reach), out);
+            return t.cut.cut_tets > 0;
+        };
+    } else {
+        dbg = std::make_unique<SceneSimulation>(scene, g, scene.object.levels);
+        dbg_tools = std::make_unique<ToolSession>(scene);
+        simulate = [&](const contact::PlacedShape& pose, int frame, contact::SurfacePoints& out) {
+            dbg_tools->drive(0, pose.position, pose.orientation);
+            const ToolFrameStats t = dbg_tools->frame(*dbg, g, frame * scene.solver.dt_s, scene.solver.dt_s);
+            if (!t.hold_object) dbg->solver().step();
+            cut::sample_surface(dbg->surface(), dbg->solver().positions(), pose.world_bounds(knife.push_margin_mm + 5.0), out);
+            return t.separated_faces + t.removed_voxels > 0;
+        };
+    }
 
     // Surface near the tool (simulation -> haptics) and the tool's pose (haptics -> simulation).
     haptics::TripleBuffer<contact::SurfacePoints> snapshots{contact::SurfacePoints(snapshot_capacity)};
@@ -113,7 +149,7 @@ void run_haptics_bench(double seconds)
         },
         haptics::SafetySettings{}, capacity);
 
-    log::info("bench haptics: 1 kHz loop for {} s against a cutting simulation ({})", seconds, scene.source);
+    log::info("bench haptics: 1 kHz loop for {} s against a cutting simulation ({}, {})", seconds, scene.source, isxfem ? "isxfem" : "dbg");
     loop.start();
     int frames = 0, cutting_frames = 0;
     std::vector<double> snapshot_points, frame_ms;
@@ -122,12 +158,8 @@ void run_haptics_bench(double seconds)
     while (now_s() < seconds) {
         const auto frame_start = clock::now();
         if (poses.update()) pose = poses.read_slot();
-        tools.drive(0, pose.position, pose.orientation);
-        const ToolFrameStats t = tools.frame(sim, g, (frames + 1) * scene.solver.dt_s, scene.solver.dt_s);
-        cutting_frames += t.separated_faces + t.removed_voxels > 0;
-        if (!t.hold_object) sim.solver().step();
         contact::SurfacePoints& out = snapshots.write_slot();
-        cut::sample_surface(sim.surface(), sim.solver().positions(), pose.world_bounds(knife.push_margin_mm + 5.0), out);
+        cutting_frames += simulate(pose, frames + 1, out);
         out.t_s = now_s();
         snapshots.publish();
         snapshot_points.push_back(static_cast<double>(out.count));

@@ -3,7 +3,8 @@
 
 namespace vox::app {
 
-/// Runs the 1 kHz loop for `seconds` beside the liver simulation and prints its timing table.
-void run_haptics_bench(double seconds);
+/// Runs the 1 kHz loop for `seconds` beside the press-and-cut simulation (the branched grid, or
+/// Is-XFEM with `isxfem`) and prints its timing table.
+void run_haptics_bench(double seconds, bool isxfem = false);
 
 } // namespace vox::app

@@ -243,7 +243,9 @@ void add_bench_command(CLI::App& app)
     auto seconds = std::make_shared<double>(10.0);
     CLI::App* haptics = bench->add_subcommand("haptics", "Period error and force time of the 1 kHz loop beside a running simulation");
     haptics->add_option("--seconds", *seconds, "How long to run (default 10)")->check(CLI::Range(0.5, 3600.0));
-    haptics->callback([seconds] { run_haptics_bench(*seconds); });
+    auto isxfem = std::make_shared<bool>(false);
+    haptics->add_flag("--isxfem", *isxfem, "Simulate with the Is-XFEM solver instead of the branched grid");
+    haptics->callback([seconds, isxfem] { run_haptics_bench(*seconds, *isxfem); });
 
     auto cutting_runs = std::make_shared<int>(5);
     CLI::App* cutting = bench->add_subcommand("cutting", "Cutting-frame time on the liver at level 4 during a 5 cm incision");

@@ -167,15 +167,22 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
     return out;
 }
 
-IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
-                                                const contact::PlacedShape* from) const
+/// The closed surface's vertices within a box: their material points, deformed positions (mm),
+/// areas and normals, and the triangles with all three corners among them.
+struct IsxfemSimulation::NearSurface {
+    std::vector<CapVertex> vertices;              ///< all of the closed surface's
+    std::vector<std::uint32_t> near;              ///< the ones in the box
+    std::vector<Eigen::Vector3d> positions, normals;
+    std::vector<double> areas;
+    std::vector<Eigen::Vector3i> triangles;       ///< among `near` (indices into it)
+};
+
+IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach) const
 {
-    std::vector<CapVertex> vertices;
+    NearSurface out;
     std::vector<Eigen::Vector3i> triangles;
-    closed_surface(vertices, triangles);
-    // Only vertices within the tool's reach (at both poses) are measured.
-    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
+    closed_surface(out.vertices, triangles);
+    const std::vector<CapVertex>& vertices = out.vertices;
     // Only the vertices of tetrahedra whose deformed box (both sides of a cut one) meets the reach
     // are placed: a large surface is mostly far from the tool.
     const auto& x = m_solver->state();
@@ -196,7 +203,6 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
         tet_near[t] = Eigen::AlignedBox3d(box.min() - pad, box.max() + pad).intersects(reach);
     }
     std::vector<Eigen::Vector3d> position(vertices.size(), Eigen::Vector3d::Constant(INFINITY));
-    std::vector<std::uint32_t> near;
     std::vector<unsigned char> is_near(vertices.size(), 0);
     for (std::size_t v = 0; v < vertices.size(); ++v) {
         if (!tet_near[vertices[v].tet]) continue;
@@ -206,6 +212,7 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     // Each near vertex carries a third of its triangles' area and their area-weighted normal.
     std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
     std::vector<double> area(vertices.size(), 0.0);
+    std::vector<Eigen::Vector3i> touching;
     for (const Eigen::Vector3i& t : triangles) {
         if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
         for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
@@ -219,23 +226,52 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
             normal[static_cast<std::size_t>(t[c])] += n;
             area[static_cast<std::size_t>(t[c])] += n.norm() / 6.0;
         }
+        touching.push_back(t);
     }
-    std::vector<Eigen::Vector3d> points, normals;
-    std::vector<double> areas;
+    std::vector<int> index(vertices.size(), -1);
     for (std::size_t v = 0; v < vertices.size(); ++v)
         if (is_near[v] && area[v] > 0.0) {
-            near.push_back(static_cast<std::uint32_t>(v));
-            points.push_back(position[v]);
-            areas.push_back(area[v]);
-            normals.push_back(normal[v].normalized());
+            index[v] = static_cast<int>(out.near.size());
+            out.near.push_back(static_cast<std::uint32_t>(v));
+            out.positions.push_back(position[v]);
+            out.areas.push_back(area[v]);
+            out.normals.push_back(normal[v].normalized());
         }
+    for (const Eigen::Vector3i& t : touching)
+        if (index[static_cast<std::size_t>(t[0])] >= 0 && index[static_cast<std::size_t>(t[1])] >= 0 && index[static_cast<std::size_t>(t[2])] >= 0)
+            out.triangles.emplace_back(index[static_cast<std::size_t>(t[0])], index[static_cast<std::size_t>(t[1])], index[static_cast<std::size_t>(t[2])]);
+    return out;
+}
+
+IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                                                const contact::PlacedShape* from) const
+{
+    // Only the surface within the tool's reach (at both poses) is measured.
+    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
+    const NearSurface s = near_surface(reach);
     Touch out;
-    out.contact = contact::penalty_contact(tool, parameters, points, areas, normals, from && from->shape ? from : nullptr);
+    out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
-        const CapVertex& v = vertices[near[c.point]];
+        const CapVertex& v = s.vertices[s.near[c.point]];
         out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
     }
     return out;
+}
+
+void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out) const
+{
+    const NearSurface s = near_surface(box);
+    out.count = std::min(s.positions.size(), out.capacity());
+    out.truncated = s.positions.size() > out.capacity();
+    std::copy_n(s.positions.begin(), out.count, out.positions_mm.begin());
+    std::copy_n(s.normals.begin(), out.count, out.normals.begin());
+    std::copy_n(s.areas.begin(), out.count, out.areas_mm2.begin());
+    out.triangles.clear();
+    for (const Eigen::Vector3i& t : s.triangles)
+        if (t.maxCoeff() < static_cast<int>(out.count)) out.triangles.push_back(t);
+    const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
+    out.triangle_tree.rebuild(positions, positions, out.triangles);
 }
 
 void IsxfemSimulation::close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const

@@ -7,6 +7,7 @@
 // tetrahedron).
 
 #include "contact/penalty_contact.hpp"
+#include "contact/surface_points.hpp"
 #include "io/scene.hpp"
 #include "isxfem/grid_tets.hpp"
 #include "isxfem/xfem_solver.hpp"
@@ -54,12 +55,19 @@ public:
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                               const contact::PlacedShape* from = nullptr) const;
 
+    /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
+    /// with its area and outward normal, and the triangles among them: the snapshot the haptic
+    /// thread touches (at most out.capacity() points; out.truncated says when more were near).
+    void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out) const;
+
     /// The mean displacement (mm) of the nodes of the tetrahedra whose deformed box meets `box`
     /// (world mm): how far the material there has moved from rest.
     [[nodiscard]] Eigen::Vector3d mean_displacement_mm(const Eigen::AlignedBox3d& box) const;
 
 private:
     struct CapVertex;
+    struct NearSurface;
+    [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box) const;
     /// The closed surface's vertices (material points) and triangles.
     void closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
     void close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;

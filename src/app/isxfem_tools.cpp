@@ -16,7 +16,8 @@ void check_isxfem_tools(const io::Scene& scene)
     }
 }
 
-IsxfemTools::IsxfemTools(const io::Scene& scene) : m_scene(scene), m_last_pose(scene.tools.size()), m_done(scene.tools.size(), false)
+IsxfemTools::IsxfemTools(const io::Scene& scene)
+    : m_scene(scene), m_last_pose(scene.tools.size()), m_done(scene.tools.size(), false), m_driven(scene.tools.size())
 {
     check_isxfem_tools(scene);
     for (const io::ToolSpec& t : scene.tools) {
@@ -26,6 +27,15 @@ IsxfemTools::IsxfemTools(const io::Scene& scene) : m_scene(scene), m_last_pose(s
     }
 }
 
+void IsxfemTools::drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation)
+{
+    io::ToolPose pose;
+    pose.placed = true;
+    pose.position_mm = position_mm;
+    pose.orientation = orientation;
+    m_driven.at(tool) = pose;
+}
+
 IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
 {
     IsxfemToolFrame out;
@@ -33,7 +43,14 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
     std::vector<isxfem::PointLoad> loads;
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
         const io::ToolSpec& spec = m_scene.tools[k];
-        const io::ToolPose from = io::tool_pose(m_scene, k, (frame - 1) * dt), to = io::tool_pose(m_scene, k, frame * dt);
+        io::ToolPose from = io::tool_pose(m_scene, k, (frame - 1) * dt), to = io::tool_pose(m_scene, k, frame * dt);
+        if (m_driven[k]) { // a device moves this tool: from where it was at the last frame
+            from = to = *m_driven[k];
+            if (m_last_pose[k].shape) {
+                from.position_mm = m_last_pose[k].position;
+                from.orientation = m_last_pose[k].orientation;
+            }
+        }
         ToolFrame& t = out.tools[k];
         t.placed = to.placed;
         if (!to.placed) {

@@ -41,6 +41,9 @@ public:
 
     /// Frame f, from (f - 1) dt to f dt: cuts, then sets the solver's point loads.
     IsxfemToolFrame frame(IsxfemSimulation& sim, int frame, double dt);
+    /// A device moves `tool` from now on (its script entries are ignored): its pose for the next
+    /// frames, world mm.
+    void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation);
 
 private:
     const io::Scene& m_scene;
@@ -50,6 +53,7 @@ private:
     /// Per tool: its stroke has broken in (one phase), or its marking has cut (two phases), since
     /// it last touched.
     std::vector<bool> m_done;
+    std::vector<std::optional<io::ToolPose>> m_driven; ///< per tool: the device's pose, when a device moves it
 };
 
 /// Refuses, with the scene's message, tools Is-XFEM cannot simulate yet (wetting, cutting with

@@ -1,7 +1,8 @@
 // `voxsculpt run` with the Is-XFEM solver, end to end: the bundled bar is cut through by its blade
 // over several frames into one crack, its far half falls away while the held half stays, and the
 // surface comes out closed along the cut (two closed pieces, the bar's volume between them); a
-// finger pressing on the cylinder pushes as it does on the branched grid; a scene asking Is-XFEM
+// finger pressing on the cylinder pushes as it does on the branched grid; a two-phase knife holds
+// the block while it marks; the haptic loop runs beside it; a scene asking Is-XFEM
 // for what it does not do yet is refused with one message naming the key.
 
 #include "app/run_command.hpp"
@@ -125,6 +126,20 @@ TEST(IsxfemRun, ATwoPhaseKnifeHoldsTheBlockWhileItMarksThenCuts)
     EXPECT_GT(force_held, 0.01); // the force rose while the block was held
     ASSERT_GT(first_cut, last_held); // the cuts come once the marking has reached the pressure
     EXPECT_GT(stats["summary"]["cut_tets"].get<int>(), 0);
+}
+
+TEST(IsxfemRun, TheHapticLoopRunsBesideIt)
+{
+    // One second of the 1 kHz loop against Is-XFEM pressing and cutting (the timings are the
+    // benchmark's business, not this test's): it runs, ticks and publishes snapshots with points.
+    const auto r = run_voxsculpt("bench haptics --seconds 1 --isxfem");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::size_t row = r.out.find("\n| ", r.out.find("|---"));
+    ASSERT_NE(row, std::string::npos) << r.out;
+    std::stringstream cells(r.out.substr(row + 3));
+    int ticks = 0;
+    cells >> ticks;
+    EXPECT_GT(ticks, 500) << r.out;
 }
 
 TEST(IsxfemRun, WhatItCannotDoYetIsRefusedByName)
