@@ -122,6 +122,7 @@ private:
     std::vector<unsigned char> m_cut;    ///< per element: cut when the model last changed
     std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
     std::vector<PointLoad> m_loads;
+    Eigen::VectorXd m_previous_v;
 };
 
 } // namespace vox::isxfem
