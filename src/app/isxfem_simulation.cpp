@@ -14,6 +14,15 @@
 
 namespace vox::app {
 
+/// A surface vertex while the cut faces are made: where it is embedded and on which side.
+struct IsxfemSimulation::CapVertex {
+    std::size_t tet = 0;
+    std::array<double, 4> bary{};
+    int side = 0;
+    Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
+    std::int32_t label = 0;
+};
+
 IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level) : m_grid(grid)
 {
     if (scene.solver.mode != io::SolverMode::dynamic)
@@ -116,15 +125,6 @@ std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
     return keys;
 }
 
-/// A surface vertex while the cut faces are made: where it is embedded and on which side.
-struct IsxfemSimulation::CapVertex {
-    std::size_t tet = 0;
-    std::array<double, 4> bary{};
-    int side = 0;
-    Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
-    std::int32_t label = 0;
-};
-
 namespace {
 
 /// Barycentric coordinates of x in tetrahedron t, and the smallest of them.
@@ -140,7 +140,18 @@ std::pair<std::array<double, 4>, double> barycentric(const isxfem::TetMesh& mesh
 
 } // namespace
 
-void IsxfemSimulation::closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
+IsxfemSimulation::~IsxfemSimulation() = default;
+
+void IsxfemSimulation::refresh_closed_surface() const
+{
+    // It depends on the cuts only (material points and rest triangles): rebuilt when they change.
+    if (m_closed_revision != m_model->revision() || m_closed_vertices.empty()) {
+        build_closed_surface(m_closed_vertices, m_closed_triangles);
+        m_closed_revision = m_model->revision();
+    }
+}
+
+void IsxfemSimulation::build_closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
 {
     vertices.clear();
     vertices.reserve(m_vertices.size());
@@ -157,10 +168,10 @@ void IsxfemSimulation::closed_surface(std::vector<CapVertex>& vertices, std::vec
 
 surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
 {
-    std::vector<CapVertex> vertices;
+    refresh_closed_surface();
     surface::SurfaceMesh out;
-    closed_surface(vertices, out.triangles);
-    for (const CapVertex& v : vertices) {
+    out.triangles = m_closed_triangles;
+    for (const CapVertex& v : m_closed_vertices) {
         out.positions.push_back(1e3 * m_solver->position(v.tet, v.bary, v.side));
         out.labels.push_back(v.label);
     }
@@ -170,7 +181,7 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
 /// The closed surface's vertices within a box: their material points, deformed positions (mm),
 /// areas and normals, and the triangles with all three corners among them.
 struct IsxfemSimulation::NearSurface {
-    std::vector<CapVertex> vertices;              ///< all of the closed surface's
+    const std::vector<CapVertex>* vertices = nullptr; ///< all of the closed surface's
     std::vector<std::uint32_t> near;              ///< the ones in the box
     std::vector<Eigen::Vector3d> positions, normals;
     std::vector<double> areas;
@@ -180,9 +191,10 @@ struct IsxfemSimulation::NearSurface {
 IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach) const
 {
     NearSurface out;
-    std::vector<Eigen::Vector3i> triangles;
-    closed_surface(out.vertices, triangles);
-    const std::vector<CapVertex>& vertices = out.vertices;
+    refresh_closed_surface();
+    out.vertices = &m_closed_vertices;
+    const std::vector<CapVertex>& vertices = m_closed_vertices;
+    const std::vector<Eigen::Vector3i>& triangles = m_closed_triangles;
     // Only the vertices of tetrahedra whose deformed box (both sides of a cut one) meets the reach
     // are placed: a large surface is mostly far from the tool.
     const auto& x = m_solver->state();
@@ -253,7 +265,7 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     Touch out;
     out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
-        const CapVertex& v = s.vertices[s.near[c.point]];
+        const CapVertex& v = (*s.vertices)[s.near[c.point]];
         out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
     }
     return out;

@@ -21,6 +21,7 @@ class IsxfemSimulation {
 public:
     /// Throws the scene's InputError when a constraint or load box catches no node.
     IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+    ~IsxfemSimulation();
 
     [[nodiscard]] const isxfem::XfemModel& model() const { return *m_model; }
     [[nodiscard]] isxfem::XfemSolver& solver() { return *m_solver; }
@@ -68,8 +69,9 @@ private:
     struct CapVertex;
     struct NearSurface;
     [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box) const;
-    /// The closed surface's vertices (material points) and triangles.
-    void closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
+    /// The closed surface's vertices (material points) and triangles, kept until the next cut.
+    void refresh_closed_surface() const;
+    void build_closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
     void close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
 
     const grid::BranchedGrid& m_grid;
@@ -84,6 +86,9 @@ private:
     };
     std::vector<Embedded> m_vertices; ///< per used surface vertex, in mesh order
     surface::SurfaceMesh m_rest;      ///< the surface at rest: its triangles and labels
+    mutable std::vector<CapVertex> m_closed_vertices; ///< closed_surface() as of the model's revision
+    mutable std::vector<Eigen::Vector3i> m_closed_triangles;
+    mutable std::size_t m_closed_revision = 0;
 };
 
 } // namespace vox::app

@@ -102,6 +102,7 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         ++report.cut_tets;
     }
     if (report.cut_tets > 0) {
+        ++m_revision;
         report.cut = id;
         if (extend < 0) {
             m_cut_blocks.push_back(std::move(fresh));

@@ -73,6 +73,9 @@ public:
     /// The node an enriched block belongs to (block >= node_count()).
     [[nodiscard]] std::uint32_t enriched_node(std::uint32_t block) const { return m_enriched_node[block - node_count()]; }
     [[nodiscard]] int cut_count() const { return m_cuts; }
+    /// Counts the calls to cut() that cut something: what was derived from the cuts is stale
+    /// when it changed.
+    [[nodiscard]] std::size_t revision() const { return m_revision; }
     /// The volume ratio of a dof block (the sculpting paper's equation 17): for an enriched block,
     /// the share of its node's support that lies across the cut from the node, what the k = 0
     /// enrichment lives on and what goes to zero as a cut passes close to the node's far side;
@@ -96,6 +99,7 @@ private:
     std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> m_cut_blocks; ///< per cut: node -> enriched block
     std::vector<PlaneCut> m_cut_planes;
     int m_cuts = 0;
+    std::size_t m_revision = 0;
 };
 
 } // namespace vox::isxfem
