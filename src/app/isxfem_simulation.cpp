@@ -91,13 +91,18 @@ std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
     std::vector<Eigen::Vector3d> u;
     u.reserve(m_vertices.size());
     for (const Embedded& v : m_vertices) {
-        const isxfem::XfemElement& el = m_model->elements()[v.tet];
-        double phi = 0.0;
-        for (std::size_t c = 0; c < 4; ++c) phi += v.bary[c] * el.phi[c];
-        const int side = el.cut >= 0 && phi >= 0.0 ? 1 : 0;
-        u.push_back(m_solver->position(v.tet, v.bary, side) - v.rest_m);
+        u.push_back(m_solver->position(v.tet, v.bary, side_of(v.tet, v.bary)) - v.rest_m);
     }
     return u;
+}
+
+int IsxfemSimulation::side_of(std::size_t tet, const std::array<double, 4>& bary) const
+{
+    const isxfem::XfemElement& el = m_model->elements()[tet];
+    if (el.cut < 0) return 0;
+    double phi = 0.0;
+    for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * el.phi[c];
+    return phi >= 0.0 ? 1 : 0;
 }
 
 Eigen::Vector3d IsxfemSimulation::mean_displacement_mm(const Eigen::AlignedBox3d& box) const
@@ -157,10 +162,7 @@ void IsxfemSimulation::build_closed_surface(std::vector<CapVertex>& vertices, st
     vertices.reserve(m_vertices.size());
     for (std::size_t k = 0; k < m_vertices.size(); ++k) {
         const Embedded& e = m_vertices[k];
-        const isxfem::XfemElement& el = m_model->elements()[e.tet];
-        double phi = 0.0;
-        for (std::size_t c = 0; c < 4; ++c) phi += e.bary[c] * el.phi[c];
-        vertices.push_back({e.tet, e.bary, el.cut >= 0 && phi >= 0.0 ? 1 : 0, e.rest_m, m_rest.labels[k]});
+        vertices.push_back({e.tet, e.bary, side_of(e.tet, e.bary), e.rest_m, m_rest.labels[k]});
     }
     triangles = m_rest.triangles;
     for (int cut = 0; cut < m_model->cut_count(); ++cut) close_cut(cut, vertices, triangles);

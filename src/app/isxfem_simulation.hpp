@@ -61,6 +61,10 @@ public:
     /// thread touches (at most out.capacity() points; out.truncated says when more were near).
     void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out) const;
 
+    /// The side (of its cut; 0 when uncut) of the material point with barycentric coordinates
+    /// `bary` in tetrahedron `tet`.
+    [[nodiscard]] int side_of(std::size_t tet, const std::array<double, 4>& bary) const;
+
     /// The mean displacement (mm) of the nodes of the tetrahedra whose deformed box meets `box`
     /// (world mm): how far the material there has moved from rest.
     [[nodiscard]] Eigen::Vector3d mean_displacement_mm(const Eigen::AlignedBox3d& box) const;

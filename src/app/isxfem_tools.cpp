@@ -96,6 +96,9 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         out.cut.already_cut += r.already_cut;
         t.cut = r.cut_tets > 0;
     }
+    // A cut this frame may have cut a loaded point's tetrahedron: the point acts on its own side.
+    if (out.cut.cut_tets > 0)
+        for (isxfem::PointLoad& l : loads) l.side = sim.side_of(l.tet, l.bary);
     sim.solver().set_point_loads(std::move(loads));
     return out;
 }

