@@ -1,10 +1,11 @@
 #pragma once
 // A scene simulated with the Is-XFEM solver (`"solver": {"type": "isxfem"}`): the tetrahedra of the
 // scene's object at the chosen level (isxfem/grid_tets.hpp: the branched elements split in six,
-// so the supports and loads catch the same nodes as the branched-grid solver's), the scene's
-// gravity, constraints, loads and solver settings, blade cuts, and the object's surface embedded
-// in the tetrahedra by barycentric coordinates (each vertex on its side of any cut through its
-// tetrahedron).
+// so the supports catch the same nodes as the branched-grid solver's), the scene's gravity,
+// constraints and solver settings, blade cuts, and the object's surface embedded in the
+// tetrahedra by barycentric coordinates (each vertex on its side of any cut through its
+// tetrahedron), closed along through-cuts: what tools touch, the haptic loop samples and runs
+// export.
 
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
