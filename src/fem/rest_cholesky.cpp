@@ -73,12 +73,10 @@ void RestCholesky::update(const SystemMatrix* a, const std::vector<unsigned char
     m_warp.resize(blocks);
     for (std::size_t n = 0; n < blocks; ++n)
         m_warp[n] = m_frame * (node_rotation[n] * m_factored_rotation[n].conjugate()).toRotationMatrix() * m_frame.transpose();
-    m_jump_warp.resize(m_jumps.size());
-    for (std::size_t j = 0; j < m_jumps.size(); ++j) {
-        const JumpBlock& jump = m_jumps[j];
-        m_jump_warp[j] = jump.block < blocks && jump.node < blocks ? Eigen::Matrix3d(jump.sign * (m_warp[jump.block] - m_warp[jump.node]))
-                                                                    : Eigen::Matrix3d::Zero();
-    }
+    // The jumps the factor holds (newer ones live in the patch only).
+    m_jump_warp.clear();
+    for (const JumpBlock& jump : m_jumps)
+        if (jump.block < blocks && jump.node < blocks) m_jump_warp.push_back({jump, jump.sign * (m_warp[jump.block] - m_warp[jump.node])});
 }
 
 void RestCholesky::report_iterations(int iterations)
@@ -99,12 +97,8 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
         const auto i = static_cast<Eigen::Index>(3 * n);
         m_scratch.segment<3>(i) = m_warp[n].transpose() * r.segment<3>(i);
     }
-    const std::size_t factored = m_warp.size();
-    auto coupled = [&](const JumpBlock& jump) { return jump.block < factored && jump.node < factored; }; // else J = 0
-    for (std::size_t j = 0; j < m_jumps.size(); ++j)
-        if (coupled(m_jumps[j]))
-            m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node)) +=
-                m_jump_warp[j].transpose() * r.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block));
+    for (const auto& [jump, j] : m_jump_warp)
+        m_scratch.segment<3>(3 * static_cast<Eigen::Index>(jump.node)) += j.transpose() * r.segment<3>(3 * static_cast<Eigen::Index>(jump.block));
     for (Eigen::Index i = 0; i < m_rows; ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) m_scratch[i] = 0.0;
     m_factor.solve(m_scratch);
@@ -113,10 +107,8 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
         const auto i = static_cast<Eigen::Index>(3 * n);
         z.segment<3>(i) = m_warp[n] * m_scratch.segment<3>(i);
     }
-    for (std::size_t j = 0; j < m_jumps.size(); ++j)
-        if (coupled(m_jumps[j]))
-            z.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].block)) +=
-                m_jump_warp[j] * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(m_jumps[j].node));
+    for (const auto& [jump, j] : m_jump_warp)
+        z.segment<3>(3 * static_cast<Eigen::Index>(jump.block)) += j * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(jump.node));
     if (!m_patch.empty()) m_patch.add_to(r, z);
     for (std::size_t i = 0; i < m_fixed.size(); ++i)
         if (m_fixed[i]) z[static_cast<Eigen::Index>(i)] = 0.0;

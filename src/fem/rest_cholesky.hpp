@@ -20,14 +20,17 @@
 // (blocks_changed) keeps the factor, extended by zero over the new dofs, and adds an exact solve
 // on the patch of new and changed blocks with one ring of neighbours (additive Schwarz,
 // fem/patch_solve.hpp), until the rent-or-buy rule says a new factor pays (the patch's solves count
-// as extra iterations) or the patch grows past an eighth of the system. (The factor with only block Jacobi on the new dofs stalls CG: the new
-// enriched dofs couple strongly to their nodes' own, measured on the cut bar of
-// data/scenes/bar_cut_isxfem.json: no convergence in 2,000 iterations.)
+// as extra iterations) or the patch grows past an eighth of the system. (The factor with only
+// block Jacobi on the new dofs stalls CG: the new enriched dofs couple strongly to their nodes'
+// own; measured on the cut bar of data/scenes/bar_cut_isxfem.json: no convergence in 2,000
+// iterations.)
 
 #include "fem/preconditioner.hpp"
 
 #include "fem/patch_solve.hpp"
 #include "fem/supernodal_factor.hpp"
+
+#include <utility>
 
 namespace vox::fem {
 
@@ -58,6 +61,10 @@ public:
     [[nodiscard]] double refactor_cost_iterations() const { return m_refactor_cost; }
 
 private:
+    void refactor(const SystemMatrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>& node_rotation);
+    /// Whether `fixed` holds the factored dofs as factored and none added since.
+    [[nodiscard]] bool same_holds(const std::vector<unsigned char>& fixed) const;
+
     Eigen::Matrix3d m_frame;
     int m_refactor_iterations;
     bool m_stale = true, m_failed = false;
@@ -70,14 +77,12 @@ private:
     std::vector<Eigen::Quaterniond> m_factored_rotation;
     std::vector<Eigen::Matrix3d> m_warp; ///< per block: world rotation from the factored state to now
     std::vector<JumpBlock> m_jumps;
-    std::vector<Eigen::Matrix3d> m_jump_warp; ///< per jump: sign (W_block - W_node); zero past the factor
+    /// The jumps the factor holds, each with sign (W_block - W_node).
+    std::vector<std::pair<JumpBlock, Eigen::Matrix3d>> m_jump_warp;
     std::vector<unsigned char> m_changed;     ///< per factored block: its rows changed since the factorisation
     bool m_patch_dirty = false;
     std::size_t m_covered_blocks = 0; ///< blocks the factor and its patch were built for
     PatchSolve m_patch;
-    void refactor(const SystemMatrix& a, const std::vector<unsigned char>& fixed, const std::vector<Eigen::Quaterniond>& node_rotation);
-    /// Whether `fixed` holds the factored dofs as factored and none added since.
-    [[nodiscard]] bool same_holds(const std::vector<unsigned char>& fixed) const;
     std::vector<unsigned char> m_fixed;
     Eigen::Index m_rows = 0, m_nonzeros = 0; ///< of the matrix last analysed: a new pattern needs a new analysis
     mutable Eigen::VectorXd m_scratch;
