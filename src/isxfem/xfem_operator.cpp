@@ -288,19 +288,24 @@ double XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, d
     return shift;
 }
 
-void XfemOperator::add_to_element_block(std::size_t e, std::size_t a, std::size_t b, const Eigen::Matrix3d& m)
+void XfemOperator::add_point_stiffness(std::size_t e, const std::array<double, 8>& w, const Eigen::Matrix3d& m)
 {
     const XfemElement& el = m_model.elements()[e];
-    const std::uint32_t row = el.block(a);
-    std::uint32_t t = m_touch_start[row];
-    while (t < m_touch_start[row + 1] && !(m_touch[t][0] == e && m_touch[t][1] == a)) ++t;
-    if (t == m_touch_start[row + 1]) throw std::logic_error("XfemOperator::add_to_element_block: the element does not touch its block");
-    const std::uint32_t rank = m_rank[m_rank_start[t] + b];
-    const std::uint32_t column = el.block(b);
-    for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j)
-            if (!m_fixed[3 * row + i] && !m_fixed[3 * column + j])
-                m_matrix.valuePtr()[m_matrix.outerIndexPtr()[3 * row + i] + 3 * rank + j] += m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+    for (std::size_t a = 0; a < el.block_count(); ++a) {
+        if (w[a] == 0.0) continue;
+        const std::uint32_t row = el.block(a);
+        std::uint32_t t = m_touch_start[row];
+        while (t < m_touch_start[row + 1] && !(m_touch[t][0] == e && m_touch[t][1] == a)) ++t;
+        if (t == m_touch_start[row + 1]) throw std::logic_error("XfemOperator::add_point_stiffness: the element does not touch its block");
+        for (std::size_t b = 0; b < el.block_count(); ++b) {
+            const std::uint32_t rank = m_rank[m_rank_start[t] + b], column = el.block(b);
+            for (std::size_t i = 0; i < 3; ++i)
+                for (std::size_t j = 0; j < 3; ++j)
+                    if (!m_fixed[3 * row + i] && !m_fixed[3 * column + j])
+                        m_matrix.valuePtr()[m_matrix.outerIndexPtr()[3 * row + i] + 3 * rank + j] +=
+                            w[a] * w[b] * m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+        }
+    }
 }
 
 void XfemOperator::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const

@@ -47,10 +47,10 @@ public:
     /// 4.3.2), until the next update(). Returns what was added.
     double add_to_diagonal(const std::vector<std::uint32_t>& blocks, double relative);
 
-    /// Adds m to the 3 x 3 block of the matrix between element e's dof blocks a and b (its local
-    /// numbering: nodes, then enriched), leaving held dofs' identity rows and columns, until the
-    /// next update().
-    void add_to_element_block(std::size_t e, std::size_t a, std::size_t b, const Eigen::Matrix3d& m);
+    /// Adds w_a w_b m to the 3 x 3 blocks of the matrix between element e's dof blocks a and b
+    /// (its local numbering: nodes, then enriched): the stiffness m of a point load acting through
+    /// the weights w. Held dofs keep their identity rows and columns; until the next update().
+    void add_point_stiffness(std::size_t e, const std::array<double, 8>& w, const Eigen::Matrix3d& m);
 
     /// out = A p, the matrix of the last update().
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;

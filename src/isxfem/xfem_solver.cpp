@@ -141,11 +141,8 @@ XfemStepStats XfemSolver::step()
     for (const PointLoad& l : m_loads) {
         const XfemElement& el = m_model.elements()[l.tet];
         const std::array<double, 8> w = weights(l.tet, l.bary, l.side);
-        for (std::size_t a = 0; a < el.block_count(); ++a) {
-            rhs.segment<3>(3 * static_cast<Eigen::Index>(el.block(a))) += dt * w[a] * l.force_n;
-            for (std::size_t b = 0; b < el.block_count(); ++b)
-                if (w[a] * w[b] != 0.0) m_operator.add_to_element_block(l.tet, a, b, dt * dt * w[a] * w[b] * l.stiffness_n_per_m);
-        }
+        for (std::size_t a = 0; a < el.block_count(); ++a) rhs.segment<3>(3 * static_cast<Eigen::Index>(el.block(a))) += dt * w[a] * l.force_n;
+        m_operator.add_point_stiffness(l.tet, w, dt * dt * l.stiffness_n_per_m);
     }
     // The regularisation as added inertia, (A + lambda I) v' = c + lambda v: it resists changes of
     // the small jumps' velocities, not the velocities themselves, so it conditions the system
