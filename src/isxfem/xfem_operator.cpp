@@ -58,10 +58,12 @@ XfemOperator::XfemOperator(const XfemModel& model) : m_model(model)
     model_changed();
 }
 
-void XfemOperator::model_changed()
+std::vector<std::uint32_t> XfemOperator::model_changed()
 {
     const auto& elements = m_model.elements();
     const std::size_t blocks = m_model.block_count();
+    const auto old_blocks = static_cast<std::uint32_t>(m_block_mass.rows());
+    std::vector<std::uint32_t> changed;
     m_rotation.resize(elements.size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
     m_r.resize(elements.size(), {Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()});
     m_turned_gradient.resize(elements.size());
@@ -74,6 +76,8 @@ void XfemOperator::model_changed()
             m_rotation[e][1] = m_rotation[e][0];
             m_r[e][1] = m_r[e][0];
             m_was_cut[e] = 1;
+            for (std::uint32_t b : el.enriched)
+                if (b < old_blocks) changed.push_back(b);
         }
         const std::size_t n = el.block_count();
         m_slot_start[e + 1] = m_slot_start[e] + static_cast<std::uint32_t>(3 * n);
@@ -126,6 +130,7 @@ void XfemOperator::model_changed()
     build_pattern();
     m_slots.resize(m_slot_start.back());
     m_force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * blocks));
+    return changed;
 }
 
 void XfemOperator::build_pattern()

@@ -35,8 +35,11 @@ public:
     explicit XfemOperator(const XfemModel& model);
 
     /// After the model was cut: sizes, the matrix pattern and the mass for the grown set of dof
-    /// blocks. Newly cut tetrahedra turn both sides as they turned whole.
-    void model_changed();
+    /// blocks. Newly cut tetrahedra turn both sides as they turned whole. Returns the dof blocks
+    /// that existed before and whose rows changed: the old enriched blocks newly cut tetrahedra
+    /// share (a crack growing); the nodes' own rows stay as they were (a cut tetrahedron's standard
+    /// part is the whole one's).
+    std::vector<std::uint32_t> model_changed();
 
     /// Rotations (each warm-started from the last), elastic forces and the matrix at the state x
     /// (positions of nodes, then enriched displacements); `fixed` flags held dofs.

@@ -55,22 +55,12 @@ void XfemSolver::set_preconditioner(std::unique_ptr<fem::Preconditioner> p)
 
 void XfemSolver::model_changed()
 {
-    const std::size_t blocks = m_model.block_count(), old_blocks = m_x.size();
-    // The old enriched blocks that newly cut tetrahedra share (a crack growing) have new rows;
-    // the nodes' own rows stay as they were (a cut tetrahedron's standard part is the whole one's).
-    std::vector<std::uint32_t> changed;
+    const std::size_t blocks = m_model.block_count();
     const auto& elements = m_model.elements();
-    m_cut.resize(elements.size(), 0);
-    for (std::size_t e = 0; e < elements.size(); ++e)
-        if (elements[e].cut >= 0 && !m_cut[e]) {
-            m_cut[e] = 1;
-            for (std::uint32_t b : elements[e].enriched)
-                if (b < old_blocks) changed.push_back(b);
-        }
     m_x.resize(blocks, Eigen::Vector3d::Zero());
     m_v.resize(blocks, Eigen::Vector3d::Zero());
     m_fixed.resize(3 * blocks, 0);
-    m_operator.model_changed();
+    const std::vector<std::uint32_t> changed = m_operator.model_changed();
     m_regularised.clear();
     if (m_options.regularisation_lambda > 0.0)
         for (auto b = static_cast<std::uint32_t>(m_model.node_count()); b < blocks; ++b)

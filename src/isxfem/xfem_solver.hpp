@@ -119,7 +119,6 @@ private:
     std::string m_fallback_note;
     std::vector<Eigen::Quaterniond> m_block_rotation;
     std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
-    std::vector<unsigned char> m_cut;    ///< per element: cut when the model last changed
     std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
     std::vector<PointLoad> m_loads;
     Eigen::VectorXd m_previous_v;
