@@ -232,8 +232,8 @@ void add_run_command(CLI::App& app)
              {"final_elastic_energy_j", last.elastic_energy_j},
              {"final_kinetic_energy_j", last.kinetic_energy_j}});
         if (!sim.solver().fallback_note().empty()) {
-          log::warn("{}", sim.solver().fallback_note());
-          stats["linear_solver"] = sim.solver().fallback_note();
+            log::warn("{}", sim.solver().fallback_note());
+            stats["linear_solver"] = sim.solver().fallback_note();
         }
         write_surface(out / "final.obj", sim);
         if (pictures) pictures->write(out / "final.png", sim, tools, scene);
