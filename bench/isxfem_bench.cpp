@@ -74,7 +74,9 @@ void run(bool factor, int frames)
     std::sort(sorted.begin(), sorted.end());
     const double p95 = sorted[static_cast<std::size_t>(0.95 * static_cast<double>(sorted.size() - 1))];
     char note[160] = "";
-    if (warped) std::snprintf(note, sizeof note, "%d factorisations", warped->factorizations());
+    if (warped)
+        std::snprintf(note, sizeof note, "%d factorisations; solves in %zu parallel groups, serial top %.0f %%", warped->factorizations(),
+                      warped->factor().parallel_groups(), 100.0 * warped->factor().top_share());
     if (!solver.fallback_note().empty()) std::snprintf(note, sizeof note, "%s", solver.fallback_note().c_str());
     std::printf("| %s | %zu | %zu | %.2f ms | %.2f ms | %.2f ms | %.0f Hz | %.2f ms | %.2f ms | %.2f ms | %.2f ms | %.0f | %s |\n",
                 factor ? "warped Cholesky" : "Jacobi", tets, solver.dof_count(), fs.median, p95, fs.max, 1000.0 / fs.median,

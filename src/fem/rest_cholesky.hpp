@@ -57,6 +57,8 @@ public:
     [[nodiscard]] bool failed() const override { return m_failed; }
     /// Factorisations taken so far.
     [[nodiscard]] int factorizations() const { return m_factorizations; }
+    /// The factor itself (its size, how its solves split over threads).
+    [[nodiscard]] const SupernodalFactor& factor() const { return m_factor; }
     /// What a factorisation costs, in CG iterations (see the .cpp for the model).
     [[nodiscard]] double refactor_cost_iterations() const { return m_refactor_cost; }
 

@@ -3,9 +3,13 @@
 #include <Eigen/Core>
 
 #include <cholmod.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 namespace vox::fem {
@@ -46,7 +50,8 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     view.packed = a.isCompressed() ? 1 : 0;
     if (!view.packed) throw std::logic_error("SupernodalFactor: the matrix must be compressed");
     cholmod_common& c = m_cholmod->common;
-    if (new_pattern || !m_cholmod->factor) {
+    const bool analyse = new_pattern || !m_cholmod->factor;
+    if (analyse) {
         if (m_cholmod->factor) cholmod_free_factor(&m_cholmod->factor, &c);
         m_cholmod->factor = cholmod_analyze(&view, &c);
         if (!m_cholmod->factor) throw std::runtime_error("SupernodalFactor: CHOLMOD could not analyse the matrix");
@@ -77,40 +82,168 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
         }
     }
     m_b.resize(l->n);
-    m_tmp.resize(l->n);
+    if (analyse) { // the tree is the analysis's
+        const auto threads = static_cast<std::size_t>(std::min<long>(tbb::this_task_arena::max_concurrency(),
+                                                                     static_cast<long>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+        schedule(std::min<std::size_t>(threads, 8));
+    }
     return smallest > 1e-10 * largest;
+}
+
+void SupernodalFactor::schedule(std::size_t groups)
+{
+    const int supernodes = static_cast<int>(m_super.size()) - 1;
+    std::vector<int> column_super(static_cast<std::size_t>(m_super.back()));
+    for (int k = 0; k < supernodes; ++k)
+        for (int c = m_super[k]; c < m_super[k + 1]; ++c) column_super[static_cast<std::size_t>(c)] = k;
+    // The supernodal tree: a supernode's parent holds its first row below the diagonal block.
+    // Work is counted in factor entries (what a solve streams).
+    std::vector<std::vector<int>> children(static_cast<std::size_t>(supernodes));
+    std::vector<double> work(static_cast<std::size_t>(supernodes)), subtree(static_cast<std::size_t>(supernodes), 0.0);
+    std::vector<int> frontier; // the roots, then the subtrees left below the top
+    bool postordered = true;
+    for (int k = 0; k < supernodes; ++k) {
+        const int nc = m_super[k + 1] - m_super[k], nr = m_pi[k + 1] - m_pi[k];
+        work[static_cast<std::size_t>(k)] = static_cast<double>(nr) * nc;
+        if (nr == nc) {
+            frontier.push_back(k);
+            continue;
+        }
+        const int parent = column_super[static_cast<std::size_t>(m_s[static_cast<std::size_t>(m_pi[k] + nc)])];
+        postordered = postordered && parent > k;
+        children[static_cast<std::size_t>(parent)].push_back(k);
+    }
+    for (int k = 0; k < supernodes && postordered; ++k) {
+        subtree[static_cast<std::size_t>(k)] += work[static_cast<std::size_t>(k)];
+        const int nc = m_super[k + 1] - m_super[k], nr = m_pi[k + 1] - m_pi[k];
+        if (nr > nc) subtree[static_cast<std::size_t>(column_super[static_cast<std::size_t>(m_s[static_cast<std::size_t>(m_pi[k] + nc)])])] += subtree[static_cast<std::size_t>(k)];
+    }
+    // Split the heaviest subtree (its root joins the serial top) while that shortens the
+    // estimated solve, top plus the heaviest group (subtrees dealt largest first to the lightest
+    // group); keep the best split seen.
+    auto by_weight = [&](int a, int b) { return subtree[static_cast<std::size_t>(a)] > subtree[static_cast<std::size_t>(b)]; };
+    auto deal = [&](const std::vector<int>& trees) {
+        std::vector<std::vector<int>> dealt(groups);
+        std::vector<double> load(groups, 0.0);
+        for (int t : trees) {
+            const auto g = static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+            dealt[g].push_back(t);
+            load[g] += subtree[static_cast<std::size_t>(t)];
+        }
+        return std::pair{dealt, *std::max_element(load.begin(), load.end())};
+    };
+    double total = 0.0;
+    for (double w : work) total += w;
+    double top_work = 0.0, best = total, best_top = total;
+    std::vector<int> best_frontier;
+    for (int split = 0; postordered && groups > 1 && split < 256 && !frontier.empty(); ++split) {
+        std::sort(frontier.begin(), frontier.end(), by_weight);
+        const double cost = top_work + deal(frontier).second;
+        if (cost < 0.98 * best) {
+            best = cost;
+            best_top = top_work;
+            best_frontier = frontier;
+        }
+        const int heaviest = frontier.front();
+        if (children[static_cast<std::size_t>(heaviest)].empty()) break;
+        top_work += work[static_cast<std::size_t>(heaviest)];
+        frontier.erase(frontier.begin());
+        frontier.insert(frontier.end(), children[static_cast<std::size_t>(heaviest)].begin(), children[static_cast<std::size_t>(heaviest)].end());
+    }
+    // Groups of whole subtrees; everything else is the top.
+    m_groups.clear();
+    std::vector<unsigned char> grouped(static_cast<std::size_t>(supernodes), 0);
+    for (std::vector<int>& trees : deal(best_frontier).first) {
+        std::vector<int> nodes;
+        std::function<void(int)> collect = [&](int k) {
+            nodes.push_back(k);
+            grouped[static_cast<std::size_t>(k)] = 1;
+            for (int c : children[static_cast<std::size_t>(k)]) collect(c);
+        };
+        for (int t : trees) collect(t);
+        if (nodes.empty()) continue;
+        std::sort(nodes.begin(), nodes.end());
+        m_groups.push_back(std::move(nodes));
+    }
+    m_top.clear();
+    m_top_rows.clear();
+    m_top_place.assign(m_super.back() > 0 ? static_cast<std::size_t>(m_super.back()) : 0, -1);
+    for (int k = 0; k < supernodes; ++k)
+        if (!grouped[static_cast<std::size_t>(k)]) {
+            m_top.push_back(k);
+            for (int c = m_super[k]; c < m_super[k + 1]; ++c) {
+                m_top_place[static_cast<std::size_t>(c)] = static_cast<int>(m_top_rows.size());
+                m_top_rows.push_back(c);
+            }
+        }
+    m_top_share = total > 0.0 ? best_top / total : 1.0;
+    int widest = 0;
+    for (int k = 0; k < supernodes; ++k) widest = std::max(widest, m_pi[k + 1] - m_pi[k]);
+    m_tmp.assign(std::max<std::size_t>(m_groups.size(), 1), std::vector<float>(static_cast<std::size_t>(widest)));
+    m_delta.assign(m_groups.size(), std::vector<float>(m_top_rows.size()));
+}
+
+void SupernodalFactor::forward(int k, float* b, float* tmp, float* top_delta) const
+{
+    // L y = P b at supernode k: the diagonal block's triangle, then the rows below (into the
+    // top's deltas when solving a group in parallel).
+    const int c0 = m_super[k], nc = m_super[k + 1] - c0, nr = m_pi[k + 1] - m_pi[k], below = nr - nc;
+    const Eigen::Map<const Eigen::MatrixXf> block(m_values.data() + m_px[k], nr, nc);
+    Eigen::Map<Eigen::VectorXf> y(b + c0, nc);
+    block.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(y);
+    if (below == 0) return;
+    Eigen::Map<Eigen::VectorXf> t(tmp, below);
+    t.noalias() = block.bottomRows(below) * y;
+    const int* rows = m_s.data() + m_pi[k] + nc;
+    for (int i = 0; i < below; ++i) {
+        const int place = top_delta ? m_top_place[static_cast<std::size_t>(rows[i])] : -1;
+        if (place >= 0)
+            top_delta[place] += t[i];
+        else
+            b[rows[i]] -= t[i];
+    }
+}
+
+void SupernodalFactor::backward(int k, float* b, float* tmp) const
+{
+    // L^T x = y at supernode k: the rows below (solved already) first, then the triangle.
+    const int c0 = m_super[k], nc = m_super[k + 1] - c0, nr = m_pi[k + 1] - m_pi[k], below = nr - nc;
+    const Eigen::Map<const Eigen::MatrixXf> block(m_values.data() + m_px[k], nr, nc);
+    Eigen::Map<Eigen::VectorXf> x(b + c0, nc);
+    if (below > 0) {
+        Eigen::Map<Eigen::VectorXf> t(tmp, below);
+        const int* rows = m_s.data() + m_pi[k] + nc;
+        for (int i = 0; i < below; ++i) t[i] = b[rows[i]];
+        x.noalias() -= block.bottomRows(below).transpose() * t;
+    }
+    block.topRows(nc).transpose().triangularView<Eigen::Upper>().solveInPlace(x);
 }
 
 void SupernodalFactor::solve(Eigen::VectorXd& v) const
 {
     const int n = static_cast<int>(m_perm.size());
     for (int i = 0; i < n; ++i) m_b[static_cast<std::size_t>(i)] = static_cast<float>(v[m_perm[static_cast<std::size_t>(i)]]);
-    const int supernodes = static_cast<int>(m_super.size()) - 1;
-    // L y = P b, supernode by supernode: the diagonal block's triangle, then the rows below.
-    for (int k = 0; k < supernodes; ++k) {
-        const int c0 = m_super[k], nc = m_super[k + 1] - c0, nr = m_pi[k + 1] - m_pi[k], below = nr - nc;
-        const Eigen::Map<const Eigen::MatrixXf> block(m_values.data() + m_px[k], nr, nc);
-        Eigen::Map<Eigen::VectorXf> y(m_b.data() + c0, nc);
-        block.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(y);
-        if (below == 0) continue;
-        Eigen::Map<Eigen::VectorXf> t(m_tmp.data(), below);
-        t.noalias() = block.bottomRows(below) * y;
-        const int* rows = m_s.data() + m_pi[k] + nc;
-        for (int i = 0; i < below; ++i) m_b[static_cast<std::size_t>(rows[i])] -= t[i];
-    }
-    // L^T x = y, backwards.
-    for (int k = supernodes - 1; k >= 0; --k) {
-        const int c0 = m_super[k], nc = m_super[k + 1] - c0, nr = m_pi[k + 1] - m_pi[k], below = nr - nc;
-        const Eigen::Map<const Eigen::MatrixXf> block(m_values.data() + m_px[k], nr, nc);
-        Eigen::Map<Eigen::VectorXf> x(m_b.data() + c0, nc);
-        if (below > 0) {
-            Eigen::Map<Eigen::VectorXf> t(m_tmp.data(), below);
-            const int* rows = m_s.data() + m_pi[k] + nc;
-            for (int i = 0; i < below; ++i) t[i] = m_b[static_cast<std::size_t>(rows[i])];
-            x.noalias() -= block.bottomRows(below).transpose() * t;
-        }
-        block.topRows(nc).transpose().triangularView<Eigen::Upper>().solveInPlace(x);
-    }
+    float* b = m_b.data();
+    auto groups = [&](auto&& body) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_groups.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t g = r.begin(); g != r.end(); ++g) body(g);
+                          },
+                          tbb::simple_partitioner());
+    };
+    // Up: the groups' subtrees in parallel, their updates to the top summed, then the top.
+    groups([&](std::size_t g) {
+        std::fill(m_delta[g].begin(), m_delta[g].end(), 0.0f);
+        for (int k : m_groups[g]) forward(k, b, m_tmp[g].data(), m_delta[g].data());
+    });
+    for (const std::vector<float>& delta : m_delta)
+        for (std::size_t j = 0; j < delta.size(); ++j) b[m_top_rows[j]] -= delta[j];
+    for (int k : m_top) forward(k, b, m_tmp.front().data(), nullptr);
+    // Down: the top, then the groups in parallel.
+    for (auto k = m_top.rbegin(); k != m_top.rend(); ++k) backward(*k, b, m_tmp.front().data());
+    groups([&](std::size_t g) {
+        for (auto k = m_groups[g].rbegin(); k != m_groups[g].rend(); ++k) backward(*k, b, m_tmp[g].data());
+    });
     for (int i = 0; i < n; ++i) v[m_perm[static_cast<std::size_t>(i)]] = m_b[static_cast<std::size_t>(i)];
 }
 
