@@ -119,6 +119,10 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
          {"total_cut_ms", cut_total_ms},
          {"final_dofs", sim.solver().dof_count()},
          {"final_kinetic_energy_j", last.kinetic_energy_j}});
+    const isxfem::ClosureCounts closure = sim.closure_counts();
+    stats["summary"].update({{"crack_faces", closure.faces}, {"slit_faces", closure.slit_faces}, {"open_crack_chains", closure.open_chains}});
+    if (closure.open_chains > 0)
+        log::warn("{} run(s) of the cut surface could not be closed along their crack: the exported surface has holes there", closure.open_chains);
     if (!sim.solver().fallback_note().empty()) {
         log::warn("{}", sim.solver().fallback_note());
         stats["linear_solver"] = sim.solver().fallback_note();

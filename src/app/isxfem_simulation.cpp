@@ -4,24 +4,10 @@
 #include "cut/model_surface.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
-#include "isxfem/polygon_triangulation.hpp"
-
-#include <Eigen/LU>
 
 #include <algorithm>
-#include <map>
-#include <set>
 
 namespace vox::app {
-
-/// A surface vertex while the cut faces are made: where it is embedded and on which side.
-struct IsxfemSimulation::CapVertex {
-    std::size_t tet = 0;
-    std::array<double, 4> bary{};
-    int side = 0;
-    Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
-    std::int32_t label = 0;
-};
 
 IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level) : m_grid(grid)
 {
@@ -46,6 +32,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     o.regularisation_lambda = scene.solver.isxfem_regularisation_lambda;
     o.regularisation_threshold = scene.solver.isxfem_regularisation_threshold;
     m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, o);
+    m_closure = std::make_unique<isxfem::CutClosure>(*m_model);
     switch (scene.solver.preconditioner) {
     case io::PreconditionerChoice::multigrid:
         throw scene.error("solver.preconditioner", "\"isxfem\" has no multigrid; use \"auto\", \"cholesky\" or \"jacobi\"");
@@ -98,11 +85,7 @@ std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
 
 int IsxfemSimulation::side_of(std::size_t tet, const std::array<double, 4>& bary) const
 {
-    const isxfem::XfemElement& el = m_model->elements()[tet];
-    if (el.cut < 0) return 0;
-    double phi = 0.0;
-    for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * el.phi[c];
-    return phi >= 0.0 ? 1 : 0;
+    return m_closure->side_of(tet, bary);
 }
 
 Eigen::Vector3d IsxfemSimulation::mean_displacement_mm(const Eigen::AlignedBox3d& box) const
@@ -130,42 +113,34 @@ std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
     return keys;
 }
 
-namespace {
-
-/// Barycentric coordinates of x in tetrahedron t, and the smallest of them.
-std::pair<std::array<double, 4>, double> barycentric(const isxfem::TetMesh& mesh, std::size_t t, const Eigen::Vector3d& x)
-{
-    const auto c = mesh.corners(t);
-    Eigen::Matrix3d j;
-    for (int k = 0; k < 3; ++k) j.col(k) = c[static_cast<std::size_t>(k + 1)] - c[0];
-    const Eigen::Vector3d l = j.inverse() * (x - c[0]);
-    const std::array<double, 4> b{1.0 - l.sum(), l.x(), l.y(), l.z()};
-    return {b, *std::min_element(b.begin(), b.end())};
-}
-
-} // namespace
 
 IsxfemSimulation::~IsxfemSimulation() = default;
 
 void IsxfemSimulation::refresh_closed_surface() const
 {
     // It depends on the cuts only (material points and rest triangles): rebuilt when they change.
-    if (m_closed_revision != m_model->revision() || m_closed_vertices.empty()) {
-        build_closed_surface(m_closed_vertices, m_closed_triangles);
-        m_closed_revision = m_model->revision();
-    }
-}
-
-void IsxfemSimulation::build_closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
-{
-    vertices.clear();
-    vertices.reserve(m_vertices.size());
+    if (m_closed_revision == m_model->revision() && !m_closed_vertices.empty()) return;
+    m_closed_vertices.clear();
+    m_closed_vertices.reserve(m_vertices.size());
     for (std::size_t k = 0; k < m_vertices.size(); ++k) {
         const Embedded& e = m_vertices[k];
-        vertices.push_back({e.tet, e.bary, side_of(e.tet, e.bary), e.rest_m, m_rest.labels[k]});
+        m_closed_vertices.push_back({e.tet, e.bary, side_of(e.tet, e.bary), e.rest_m, m_rest.labels[k]});
     }
-    triangles = m_rest.triangles;
-    for (int cut = 0; cut < m_model->cut_count(); ++cut) close_cut(cut, vertices, triangles);
+    m_closed_triangles = m_rest.triangles;
+    m_closure_counts = {};
+    for (int cut = 0; cut < m_model->cut_count(); ++cut) {
+        const isxfem::ClosureCounts c = m_closure->close(cut, m_closed_vertices, m_closed_triangles);
+        m_closure_counts.faces += c.faces;
+        m_closure_counts.slit_faces += c.slit_faces;
+        m_closure_counts.open_chains += c.open_chains;
+    }
+    m_closed_revision = m_model->revision();
+}
+
+isxfem::ClosureCounts IsxfemSimulation::closure_counts() const
+{
+    refresh_closed_surface();
+    return m_closure_counts;
 }
 
 surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
@@ -173,7 +148,7 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
     refresh_closed_surface();
     surface::SurfaceMesh out;
     out.triangles = m_closed_triangles;
-    for (const CapVertex& v : m_closed_vertices) {
+    for (const isxfem::SurfacePoint& v : m_closed_vertices) {
         out.positions.push_back(1e3 * m_solver->position(v.tet, v.bary, v.side));
         out.labels.push_back(v.label);
     }
@@ -183,7 +158,7 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
 /// The closed surface's vertices within a box: their material points, deformed positions (mm),
 /// areas and normals, and the triangles with all three corners among them.
 struct IsxfemSimulation::NearSurface {
-    const std::vector<CapVertex>* vertices = nullptr; ///< all of the closed surface's
+    const std::vector<isxfem::SurfacePoint>* vertices = nullptr; ///< all of the closed surface's
     std::vector<std::uint32_t> near;              ///< the ones in the box
     std::vector<Eigen::Vector3d> positions, normals;
     std::vector<double> areas;
@@ -195,7 +170,7 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
     NearSurface out;
     refresh_closed_surface();
     out.vertices = &m_closed_vertices;
-    const std::vector<CapVertex>& vertices = m_closed_vertices;
+    const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
     const std::vector<Eigen::Vector3i>& triangles = m_closed_triangles;
     // Only the vertices of tetrahedra whose deformed box (both sides of a cut one) meets the reach
     // are placed: a large surface is mostly far from the tool.
@@ -231,7 +206,7 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
         if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
         for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
             if (!std::isfinite(position[static_cast<std::size_t>(t[c])].x())) {
-                const CapVertex& v = vertices[static_cast<std::size_t>(t[c])];
+                const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
                 position[static_cast<std::size_t>(t[c])] = 1e3 * m_solver->position(v.tet, v.bary, v.side);
             }
         const Eigen::Vector3d n = (position[static_cast<std::size_t>(t[1])] - position[static_cast<std::size_t>(t[0])])
@@ -267,7 +242,7 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     Touch out;
     out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
-        const CapVertex& v = (*s.vertices)[s.near[c.point]];
+        const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
         out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
     }
     return out;
@@ -286,108 +261,6 @@ void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::S
         if (t.maxCoeff() < static_cast<int>(out.count)) out.triangles.push_back(t);
     const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
     out.triangle_tree.rebuild(positions, positions, out.triangles);
-}
-
-void IsxfemSimulation::close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const
-{
-    // Triangles the cut's plane crosses where it cut a tetrahedron of theirs are split along the
-    // plane, each piece keeping the side it lies on (new vertices on the plane, one copy per side);
-    // the closed loops the split edges make are filled on both sides.
-    const isxfem::PlaneCut& plane = m_model->cut_plane(cut);
-    std::map<std::pair<int, int>, std::array<int, 2>> crossing; // edge -> its point on the plane, per side
-    auto point_on = [&](int a, int b) {
-        const auto key = std::minmax(a, b);
-        if (const auto it = crossing.find(key); it != crossing.end()) return it->second;
-        const CapVertex& va = vertices[static_cast<std::size_t>(key.first)];
-        const CapVertex& vb = vertices[static_cast<std::size_t>(key.second)];
-        const double fa = plane.at(va.rest_m), fb = plane.at(vb.rest_m);
-        const Eigen::Vector3d x = va.rest_m + fa / (fa - fb) * (vb.rest_m - va.rest_m);
-        // In whichever of its ends' tetrahedra holds it better (the edge is shorter than a cell).
-        const auto from_a = barycentric(m_model->mesh(), va.tet, x), from_b = barycentric(m_model->mesh(), vb.tet, x);
-        const bool use_b = from_b.second > from_a.second;
-        std::array<double, 4> bary = use_b ? from_b.first : from_a.first;
-        const std::size_t tet = use_b ? vb.tet : va.tet;
-        double sum = 0.0;
-        for (double& l : bary) sum += (l = std::max(l, 0.0));
-        for (double& l : bary) l /= sum;
-        const std::int32_t label = va.label; // va refers into `vertices`, which grows below
-        std::array<int, 2> copies{};
-        for (int side = 0; side < 2; ++side) {
-            copies[static_cast<std::size_t>(side)] = static_cast<int>(vertices.size());
-            vertices.push_back({tet, bary, side, x, label});
-        }
-        crossing.emplace(key, copies);
-        return copies;
-    };
-    std::vector<Eigen::Vector3i> kept;
-    std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> links; // crossing edge -> the crossing edges it joins
-    for (const Eigen::Vector3i& t : triangles) {
-        std::array<bool, 3> positive{};
-        bool in_cut = false;
-        for (int a = 0; a < 3; ++a) {
-            const CapVertex& v = vertices[static_cast<std::size_t>(t[a])];
-            positive[static_cast<std::size_t>(a)] = plane.at(v.rest_m) >= 0.0;
-            in_cut = in_cut || m_model->elements()[v.tet].cut == cut;
-        }
-        if (!in_cut || (positive[0] == positive[1] && positive[1] == positive[2])) {
-            kept.push_back(t);
-            continue;
-        }
-        // Each side's piece: its corners and the edge crossings, in the triangle's order.
-        std::array<std::pair<int, int>, 2> ends{};
-        int found = 0;
-        for (int side = 0; side < 2; ++side) {
-            std::vector<int> piece;
-            for (int a = 0; a < 3; ++a) {
-                const int b = (a + 1) % 3;
-                if (positive[static_cast<std::size_t>(a)] == (side == 1)) piece.push_back(t[a]);
-                if (positive[static_cast<std::size_t>(a)] != positive[static_cast<std::size_t>(b)]) {
-                    piece.push_back(point_on(t[a], t[b])[static_cast<std::size_t>(side)]);
-                    if (side == 0) ends[static_cast<std::size_t>(found++)] = std::minmax(t[a], t[b]);
-                }
-            }
-            for (std::size_t k = 1; k + 1 < piece.size(); ++k) kept.emplace_back(piece[0], piece[k], piece[k + 1]);
-        }
-        links[ends[0]].push_back(ends[1]);
-        links[ends[1]].push_back(ends[0]);
-    }
-    triangles = std::move(kept);
-    // Closed loops of crossing points; open chains (a cut that does not go through) are left open.
-    const Eigen::Vector3d n = plane.normal.normalized();
-    const Eigen::Vector3d u = n.unitOrthogonal(), w = n.cross(u);
-    std::set<std::pair<int, int>> visited;
-    for (const auto& [start, next] : links) {
-        if (visited.count(start) || next.size() != 2) continue;
-        std::vector<std::pair<int, int>> loop{start};
-        visited.insert(start);
-        std::pair<int, int> previous = start, current = next[0];
-        bool closed = false;
-        while (true) {
-            if (current == start) {
-                closed = true;
-                break;
-            }
-            const auto it = links.find(current);
-            if (it == links.end() || it->second.size() != 2 || visited.count(current)) break;
-            visited.insert(current);
-            loop.push_back(current);
-            const std::pair<int, int> after = it->second[0] == previous ? it->second[1] : it->second[0];
-            previous = current;
-            current = after;
-        }
-        if (!closed || loop.size() < 3) continue;
-        std::vector<Eigen::Vector2d> flat;
-        for (const auto& edge : loop) {
-            const Eigen::Vector3d& x = vertices[static_cast<std::size_t>(crossing.at(edge)[0])].rest_m;
-            flat.emplace_back(u.dot(x), w.dot(x));
-        }
-        // Counter-clockwise in (u, w) faces +n, out of the negative side.
-        for (const std::array<int, 3>& f : isxfem::triangulate_polygon(flat)) {
-            auto copy = [&](int i, int side) { return crossing.at(loop[static_cast<std::size_t>(i)])[static_cast<std::size_t>(side)]; };
-            triangles.emplace_back(copy(f[0], 0), copy(f[1], 0), copy(f[2], 0));
-            triangles.emplace_back(copy(f[0], 1), copy(f[2], 1), copy(f[1], 1));
-        }
-    }
 }
 
 } // namespace vox::app

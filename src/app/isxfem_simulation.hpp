@@ -4,12 +4,13 @@
 // so the supports catch the same nodes as the branched-grid solver's), the scene's gravity,
 // constraints and solver settings, blade cuts, and the object's surface embedded in the
 // tetrahedra by barycentric coordinates (each vertex on its side of any cut through its
-// tetrahedron), closed along through-cuts: what tools touch, the haptic loop samples and runs
-// export.
+// tetrahedron), closed along the cuts (isxfem/cut_closure.hpp): what tools touch, the haptic
+// loop samples and runs export.
 
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
 #include "io/scene.hpp"
+#include "isxfem/cut_closure.hpp"
 #include "isxfem/grid_tets.hpp"
 #include "isxfem/xfem_solver.hpp"
 #include "surface/embedded_surface.hpp"
@@ -34,11 +35,12 @@ public:
     isxfem::CutReport cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
                           const std::function<bool(const Eigen::Vector3d&)>& inside, int extend);
 
-    /// The deformed surface, world mm, closed along the cuts: triangles a cut's plane crosses
-    /// where it cut one of their tetrahedra are split along the plane (each piece moving with its
-    /// side), and each closed loop of split edges is filled on both sides. A cut that does not go
-    /// through the surface (a slit) leaves its opening as it is.
+    /// The deformed surface, world mm, closed along the cuts: triangles are split where a cut's
+    /// crack crosses them (each piece moving with its side) and each crack is filled on both
+    /// sides, through the object or, for a slit, up to its front (isxfem/cut_closure.hpp).
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
+    /// What closing the surface along the cuts made, and what it had to leave open.
+    [[nodiscard]] isxfem::ClosureCounts closure_counts() const;
     /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements() const;
     /// The identity (surface::SurfaceVertex::key) of each of those vertices, the same as in a
@@ -71,17 +73,15 @@ public:
     [[nodiscard]] Eigen::Vector3d mean_displacement_mm(const Eigen::AlignedBox3d& box) const;
 
 private:
-    struct CapVertex;
     struct NearSurface;
     [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box) const;
     /// The closed surface's vertices (material points) and triangles, kept until the next cut.
     void refresh_closed_surface() const;
-    void build_closed_surface(std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
-    void close_cut(int cut, std::vector<CapVertex>& vertices, std::vector<Eigen::Vector3i>& triangles) const;
 
     const grid::BranchedGrid& m_grid;
     std::unique_ptr<isxfem::XfemModel> m_model;
     std::unique_ptr<isxfem::XfemSolver> m_solver;
+    std::unique_ptr<isxfem::CutClosure> m_closure;
     std::unique_ptr<surface::EmbeddedSurface> m_surface;
     struct Embedded {
         std::size_t tet = 0;
@@ -91,8 +91,9 @@ private:
     };
     std::vector<Embedded> m_vertices; ///< per used surface vertex, in mesh order
     surface::SurfaceMesh m_rest;      ///< the surface at rest: its triangles and labels
-    mutable std::vector<CapVertex> m_closed_vertices; ///< closed_surface() as of the model's revision
+    mutable std::vector<isxfem::SurfacePoint> m_closed_vertices; ///< the closed surface as of the model's revision
     mutable std::vector<Eigen::Vector3i> m_closed_triangles;
+    mutable isxfem::ClosureCounts m_closure_counts;
     mutable std::size_t m_closed_revision = 0;
 };
 

@@ -97,11 +97,7 @@ std::pair<std::size_t, std::array<double, 4>> locate(const TetMesh& mesh, std::s
     std::array<double, 4> best_l{0.25, 0.25, 0.25, 0.25};
     double best_min = -INFINITY;
     for (std::size_t t = GridTets::first_tet(element); t < GridTets::first_tet(element) + 6; ++t) {
-        const auto c = mesh.corners(t);
-        Eigen::Matrix3d j;
-        for (int k = 0; k < 3; ++k) j.col(k) = c[static_cast<std::size_t>(k + 1)] - c[0];
-        const Eigen::Vector3d l = j.inverse() * (x - c[0]);
-        const std::array<double, 4> bary{1.0 - l.sum(), l.x(), l.y(), l.z()};
+        const std::array<double, 4> bary = barycentric(mesh, t, x);
         const double lowest = *std::min_element(bary.begin(), bary.end());
         if (lowest > best_min) {
             best_min = lowest;
@@ -109,11 +105,7 @@ std::pair<std::size_t, std::array<double, 4>> locate(const TetMesh& mesh, std::s
             best_l = bary;
         }
     }
-    // Clamp: a point on the cell's boundary may sit a rounding error outside.
-    double sum = 0.0;
-    for (double& b : best_l) sum += (b = std::max(b, 0.0));
-    for (double& b : best_l) b /= sum;
-    return {best, best_l};
+    return {best, clamped(best_l)}; // a point on the cell's boundary may sit a rounding error outside
 }
 
 } // namespace vox::isxfem

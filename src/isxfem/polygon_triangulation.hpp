@@ -10,7 +10,8 @@ namespace vox::isxfem {
 
 /// Triangles (indices into `polygon`, counter-clockwise) covering the simple polygon given in
 /// either orientation; n - 2 of them. A polygon that is not simple gets what ear clipping can
-/// find, then a fan over the rest.
-std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector2d>& polygon);
+/// find, then a fan over the rest. `apart` (optional, per vertex): diagonals joining two flagged
+/// vertices are avoided where another ear will do.
+std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector2d>& polygon, const std::vector<bool>& apart = {});
 
 } // namespace vox::isxfem

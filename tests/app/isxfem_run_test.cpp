@@ -1,9 +1,10 @@
 // `voxsculpt run` with the Is-XFEM solver, end to end: the bundled bar is cut through by its blade
 // over several frames into one crack, its far half falls away while the held half stays, and the
-// surface comes out closed along the cut (two closed pieces, the bar's volume between them); a
-// finger pressing on the cylinder pushes as it does on the branched grid; a two-phase knife holds
-// the block while it marks; the haptic loop runs beside it; a scene asking Is-XFEM
-// for what it does not do yet is refused with one message naming the key.
+// surface comes out closed along the cut (two closed pieces, the bar's volume between them), and
+// along the front of a slit that stops inside it; a finger pressing on the cylinder pushes as it
+// does on the branched grid; a two-phase knife holds the block while it marks; the haptic loop
+// runs beside it; a scene asking Is-XFEM for what it does not do yet is refused with one message
+// naming the key.
 
 #include "app/run_command.hpp"
 #include "test_support.hpp"
@@ -34,6 +35,9 @@ TEST(IsxfemRun, TheBarIsCutThroughAndItsFarHalfFalls)
     EXPECT_EQ(stats["summary"]["cuts"], 1);       // one stroke, one crack, however many frames it took
     EXPECT_EQ(stats["summary"]["cut_tets"], 54);  // the bar's 3 x 3 cells across at level 2, six tetrahedra each
     EXPECT_EQ(stats["summary"]["converged_frames"], 30);
+    EXPECT_EQ(stats["summary"]["crack_faces"], 1); // the bar's cross-section, on both sides
+    EXPECT_EQ(stats["summary"]["slit_faces"], 0);
+    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
     int cutting_frames = 0;
     for (const auto& f : stats["frames"]) cutting_frames += f["cut_tets"].get<int>() > 0;
     EXPECT_GT(cutting_frames, 1); // the blade goes down through it over several frames
@@ -79,6 +83,28 @@ double last_finger_force_z(const fs::path& stats_path)
 }
 
 } // namespace
+
+TEST(IsxfemRun, ASlitThatStopsInsideTheBarIsClosedAlongItsFront)
+{
+    // The same blade stopped with its edge at the bar's bottom face: the soft bar gives way
+    // under it, so the crack reaches about two thirds down and stops inside.
+    const fs::path d = fresh_dir("isxfem_slit");
+    const std::string down = "\"position_mm\": [50.3, 5, -15]", stop = "\"position_mm\": [50.3, 5, 10]";
+    const fs::path scene = edited_scene(d, "bar_cut_isxfem.json", {{down, stop}, {down, stop}}); // both poses below the bar
+    const auto r = run_voxsculpt("run " + quote(scene.string()) + " --frames 30 --out " + quote((d / "out").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(d / "out" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_GT(stats["summary"]["cut_tets"].get<int>(), 0);
+    EXPECT_LT(stats["summary"]["cut_tets"].get<int>(), 54); // not through
+    EXPECT_EQ(stats["summary"]["slit_faces"], 1);
+    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
+    const nlohmann::json mesh = vox::test::info_json(d / "out" / "final.obj");
+    EXPECT_EQ(mesh["closed"], true);
+    EXPECT_EQ(mesh["components"], 1);
+    EXPECT_EQ(mesh["consistently_oriented"], true);
+    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 150.0);
+}
 
 TEST(IsxfemRun, AFingerPushesOnTheTetrahedraAsOnTheBranchedGrid)
 {

@@ -1,0 +1,508 @@
+#include "isxfem/cut_closure.hpp"
+
+#include "isxfem/polygon_triangulation.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+
+namespace vox::isxfem {
+namespace {
+
+using VertexEdge = std::pair<int, int>;                   ///< a surface edge, sorted
+using NodeEdge = std::pair<std::uint32_t, std::uint32_t>; ///< a tetrahedron edge, sorted
+
+/// Where the surface's triangles cross the plane: on an edge, in the crack or not.
+struct Crossing {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    std::size_t tet = 0; ///< holding it
+    std::array<double, 4> bary{};
+    bool inside = false;           ///< in the crack: one point per side
+    std::array<int, 2> id{-1, -1}; ///< its point on each side (the same twice outside the crack), once placed
+    std::int32_t label = 0;
+};
+
+/// Where S's boundary crosses R's, inside a triangle: the crack's front meets the surface.
+struct Front {
+    int id = -1; ///< its point, shared by both sides
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    bool entering = false; ///< S's boundary (material on its left) enters the crack here
+    int segment = -1;      ///< R's boundary segment it lies on
+    double along = 0.0;    ///< where on it, 0 at its start
+    int chain = -1;        ///< the run of S's boundary inside R it starts or ends
+};
+
+/// A segment of R's boundary, R on its left (seen from the plane's normal): on the face of a cut
+/// tetrahedron whose neighbour across it is not cut by this cut.
+struct Segment {
+    NodeEdge from, to;
+    Eigen::Vector3d x_from, x_to;
+    std::size_t tet = 0;
+    int face = 0; ///< the corner opposite
+};
+
+/// One cut's closing (see the header): the state of a single call of CutClosure::close.
+class Closer {
+public:
+    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, const CutClosure& closure, int cut,
+           std::vector<SurfacePoint>& points)
+        : m_model(model), m_neighbours(neighbours), m_closure(closure), m_cut(cut), m_plane(model.cut_plane(cut)), m_points(points)
+    {
+        m_n = m_plane.normal.normalized();
+        m_u = m_n.unitOrthogonal();
+        m_w = m_n.cross(m_u);
+        build_boundary();
+    }
+
+    void split(std::vector<Eigen::Vector3i>& triangles);
+    void fill(std::vector<Eigen::Vector3i>& triangles);
+    ClosureCounts counts;
+
+private:
+    [[nodiscard]] bool in_crack(std::int64_t tet) const { return tet >= 0 && m_model.elements()[static_cast<std::size_t>(tet)].cut == m_cut; }
+    int add_point(std::size_t tet, const std::array<double, 4>& bary, int side, const Eigen::Vector3d& x, std::int32_t label)
+    {
+        m_points.push_back({tet, bary, side, x, label});
+        return static_cast<int>(m_points.size()) - 1;
+    }
+    /// A point not split by this cut, held by the tetrahedron across a segment's face (not cut by
+    /// it) so both sides place it alike; in the cut one, side 0, where that face is the mesh's.
+    int shared_point(std::size_t cut_tet, int face, const Eigen::Vector3d& x, std::int32_t label)
+    {
+        const std::int32_t across = m_neighbours[cut_tet][static_cast<std::size_t>(face)];
+        if (across < 0) return add_point(cut_tet, clamped(barycentric(m_model.mesh(), cut_tet, x)), 0, x, label);
+        const auto t = static_cast<std::size_t>(across);
+        const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), t, x));
+        return add_point(t, bary, m_closure.side_of(t, bary), x, label);
+    }
+    void build_boundary();
+    int crossing(int a, int b);
+    /// The crossing's points, placed on first use.
+    const std::array<int, 2>& ids(int crossing);
+    int front(int inside, int outside);
+    int corner_point(int segment);
+    /// Chain nodes: crossings by index, fronts as -(index + 1).
+    static int front_node(int f) { return -(f + 1); }
+    /// Triangulates a crack face given round its boundary (each corner's point per side) on both sides.
+    void emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles);
+
+    const XfemModel& m_model;
+    const std::vector<std::array<std::int32_t, 4>>& m_neighbours;
+    const CutClosure& m_closure;
+    int m_cut;
+    const PlaneCut& m_plane;
+    std::vector<SurfacePoint>& m_points;
+    Eigen::Vector3d m_n, m_u, m_w;
+
+    std::map<VertexEdge, int> m_crossing_of;
+    std::vector<Crossing> m_crossings;
+    std::vector<Front> m_fronts;
+    std::map<int, int> m_next; ///< S's boundary inside R, material on its left: node -> the next node
+    std::vector<Segment> m_segments;
+    std::multimap<NodeEdge, int> m_leaving;               ///< R's boundary: its segments by start
+    std::map<std::pair<std::size_t, int>, int> m_on_face; ///< (tet, face) -> its segment
+    std::map<NodeEdge, int> m_corner_points;              ///< R's boundary vertices placed so far
+};
+
+void Closer::build_boundary()
+{
+    const auto& elements = m_model.elements();
+    const auto& nodes = m_model.mesh().nodes;
+    for (std::size_t t = 0; t < elements.size(); ++t) {
+        const XfemElement& el = elements[t];
+        if (el.cut != m_cut) continue;
+        // The plane's crossing of a tetrahedron edge, from its lower node: the same bits in every
+        // tetrahedron around the edge.
+        auto on_edge = [&](std::size_t a, std::size_t b) {
+            if (el.node[a] > el.node[b]) std::swap(a, b);
+            const double f = el.phi[a] / (el.phi[a] - el.phi[b]);
+            return std::pair{NodeEdge{el.node[a], el.node[b]}, Eigen::Vector3d(nodes[el.node[a]] + f * (nodes[el.node[b]] - nodes[el.node[a]]))};
+        };
+        auto crossed = [&](std::size_t a, std::size_t b) { return (el.phi[a] < 0.0) != (el.phi[b] < 0.0); };
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        int count = 0;
+        for (std::size_t a = 0; a < 4; ++a)
+            for (std::size_t b = a + 1; b < 4; ++b)
+                if (crossed(a, b)) {
+                    centre += on_edge(a, b).second;
+                    ++count;
+                }
+        if (count < 3) continue;
+        centre /= count;
+        for (int face = 0; face < 4; ++face) {
+            if (in_crack(m_neighbours[t][static_cast<std::size_t>(face)])) continue;
+            std::vector<std::pair<NodeEdge, Eigen::Vector3d>> ends;
+            for (std::size_t a = 0; a < 4; ++a)
+                for (std::size_t b = a + 1; b < 4; ++b)
+                    if (static_cast<int>(a) != face && static_cast<int>(b) != face && crossed(a, b)) ends.push_back(on_edge(a, b));
+            if (ends.size() != 2) continue; // the plane through a corner of the face: no segment
+            if ((ends[1].second - ends[0].second).cross(centre - ends[0].second).dot(m_n) < 0.0) std::swap(ends[0], ends[1]);
+            const int s = static_cast<int>(m_segments.size());
+            m_segments.push_back({ends[0].first, ends[1].first, ends[0].second, ends[1].second, t, face});
+            m_leaving.emplace(ends[0].first, s);
+            m_on_face[{t, face}] = s;
+        }
+    }
+}
+
+int Closer::crossing(int a, int b)
+{
+    const VertexEdge key = std::minmax(a, b);
+    if (const auto it = m_crossing_of.find(key); it != m_crossing_of.end()) return it->second;
+    const SurfacePoint va = m_points[static_cast<std::size_t>(key.first)]; // copies: m_points grows below
+    const SurfacePoint vb = m_points[static_cast<std::size_t>(key.second)];
+    const double fa = m_plane.at(va.rest_m), fb = m_plane.at(vb.rest_m);
+    Crossing c;
+    c.x = va.rest_m + fa / (fa - fb) * (vb.rest_m - va.rest_m);
+    c.label = va.label;
+    std::tie(c.tet, c.bary) = walk_to(m_model.mesh(), m_neighbours, va.tet, c.x);
+    c.inside = in_crack(static_cast<std::int64_t>(c.tet));
+    m_crossings.push_back(c);
+    return m_crossing_of[key] = static_cast<int>(m_crossings.size()) - 1;
+}
+
+const std::array<int, 2>& Closer::ids(int crossing)
+{
+    Crossing& c = m_crossings[static_cast<std::size_t>(crossing)];
+    if (c.id[0] >= 0) return c.id;
+    if (c.inside) {
+        for (int side = 0; side < 2; ++side) c.id[static_cast<std::size_t>(side)] = add_point(c.tet, c.bary, side, c.x, c.label);
+    } else {
+        c.id[0] = c.id[1] = add_point(c.tet, c.bary, m_closure.side_of(c.tet, c.bary), c.x, c.label);
+    }
+    return c.id;
+}
+
+int Closer::front(int inside, int outside)
+{
+    // Walk from the crossing in the crack towards the other, tetrahedron by tetrahedron, to the
+    // face where the segment leaves the crack.
+    const Eigen::Vector3d from = m_crossings[static_cast<std::size_t>(inside)].x, to = m_crossings[static_cast<std::size_t>(outside)].x;
+    std::size_t t = m_crossings[static_cast<std::size_t>(inside)].tet;
+    double entered = 0.0;
+    for (int step = 0; step < 64; ++step) {
+        const std::array<double, 4> b0 = barycentric(m_model.mesh(), t, from), b1 = barycentric(m_model.mesh(), t, to);
+        double leaves = INFINITY;
+        int face = -1;
+        for (int c = 0; c < 4; ++c) {
+            const double slope = b1[static_cast<std::size_t>(c)] - b0[static_cast<std::size_t>(c)];
+            if (!(slope < 0.0)) continue;
+            const double at = -b0[static_cast<std::size_t>(c)] / slope;
+            if (at >= entered - 1e-9 && at < leaves) {
+                leaves = at;
+                face = c;
+            }
+        }
+        if (face < 0) return -1;
+        const std::int32_t across = m_neighbours[t][static_cast<std::size_t>(face)];
+        if (in_crack(across)) {
+            t = static_cast<std::size_t>(across);
+            entered = leaves;
+            continue;
+        }
+        const auto segment = m_on_face.find({t, face});
+        if (segment == m_on_face.end()) return -1;
+        Front f;
+        if (leaves >= 1.0 - 1e-9) { // the crack ends on the triangle's edge: at the
+                                    // other crossing
+            f.x = to;
+            f.id = ids(outside)[0];
+        } else {
+            // Off the other end by at least a thousandth, so the front point and the split crossing
+            // are not one place (a zero-length edge would stall the triangulation).
+            f.x = from + std::max(leaves, 1e-3) * (to - from);
+            f.id = shared_point(t, face, f.x, m_crossings[static_cast<std::size_t>(inside)].label);
+        }
+        f.segment = segment->second;
+        const Segment& s = m_segments[static_cast<std::size_t>(f.segment)];
+        f.along = (f.x - s.x_from).dot(s.x_to - s.x_from) / (s.x_to - s.x_from).squaredNorm();
+        m_fronts.push_back(f);
+        return static_cast<int>(m_fronts.size()) - 1;
+    }
+    return -1;
+}
+
+int Closer::corner_point(int segment)
+{
+    const Segment& s = m_segments[static_cast<std::size_t>(segment)];
+    if (const auto it = m_corner_points.find(s.to); it != m_corner_points.end()) return it->second;
+    return m_corner_points[s.to] = shared_point(s.tet, s.face, s.x_to, 0);
+}
+
+void Closer::split(std::vector<Eigen::Vector3i>& triangles)
+{
+    // The triangles the plane crosses, and their crossings.
+    std::vector<std::array<bool, 3>> positive(triangles.size());
+    std::vector<std::array<int, 2>> cross(triangles.size(), {-1, -1});
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const Eigen::Vector3i& t = triangles[i];
+        for (int a = 0; a < 3; ++a) positive[i][static_cast<std::size_t>(a)] = m_plane.at(m_points[static_cast<std::size_t>(t[a])].rest_m) >= 0.0;
+        if (positive[i][0] == positive[i][1] && positive[i][1] == positive[i][2]) continue;
+        for (int a = 0, k = 0; a < 3; ++a)
+            if (positive[i][static_cast<std::size_t>(a)] != positive[i][static_cast<std::size_t>((a + 1) % 3)])
+                cross[i][static_cast<std::size_t>(k++)] = crossing(t[a], t[(a + 1) % 3]);
+    }
+    // A loop of crossings that enters the crack anywhere is split all round (outside the crack each
+    // piece keeps the crossing's one point): a triangle split beside one left whole would leave a
+    // vertex in the middle of its edge.
+    std::vector<int> group(m_crossings.size());
+    for (std::size_t c = 0; c < group.size(); ++c) group[c] = static_cast<int>(c);
+    std::function<int(int)> root = [&](int c) {
+        return group[static_cast<std::size_t>(c)] == c ? c : group[static_cast<std::size_t>(c)] = root(group[static_cast<std::size_t>(c)]);
+    };
+    for (const std::array<int, 2>& c : cross)
+        if (c[0] >= 0) group[static_cast<std::size_t>(root(c[0]))] = root(c[1]);
+    std::vector<bool> reaches_crack(m_crossings.size(), false);
+    for (std::size_t c = 0; c < m_crossings.size(); ++c)
+        if (m_crossings[c].inside) reaches_crack[static_cast<std::size_t>(root(static_cast<int>(c)))] = true;
+
+    std::vector<Eigen::Vector3i> kept;
+    kept.reserve(triangles.size());
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const Eigen::Vector3i& t = triangles[i];
+        if (cross[i][0] < 0 || !reaches_crack[static_cast<std::size_t>(root(cross[i][0]))]) {
+            kept.push_back(t);
+            continue;
+        }
+        const bool in0 = m_crossings[static_cast<std::size_t>(cross[i][0])].inside, in1 = m_crossings[static_cast<std::size_t>(cross[i][1])].inside;
+        int f = -1;
+        if (in0 != in1) {
+            f = in0 ? front(cross[i][0], cross[i][1]) : front(cross[i][1], cross[i][0]);
+            if (f < 0)
+                ++counts.open_chains; // the crack's edge could not be found here: split
+                                      // without it, counted
+        }
+        if (in0 && in1) {
+            // S's boundary in this triangle, material on its left: along n x (the outward normal).
+            const Eigen::Vector3d r0 = m_points[static_cast<std::size_t>(t[0])].rest_m;
+            const Eigen::Vector3d normal =
+                (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
+            int start = cross[i][0], end = cross[i][1];
+            if ((m_crossings[static_cast<std::size_t>(end)].x - m_crossings[static_cast<std::size_t>(start)].x).dot(m_n.cross(normal)) < 0.0)
+                std::swap(start, end);
+            m_next[start] = end;
+        } else if (f >= 0) {
+            const Eigen::Vector3d r0 = m_points[static_cast<std::size_t>(t[0])].rest_m;
+            const Eigen::Vector3d normal =
+                (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
+            const int inside = in0 ? cross[i][0] : cross[i][1], outside = in0 ? cross[i][1] : cross[i][0];
+            const bool leaving =
+                (m_crossings[static_cast<std::size_t>(outside)].x - m_crossings[static_cast<std::size_t>(inside)].x).dot(m_n.cross(normal)) > 0.0;
+            if (leaving) {
+                m_next[inside] = front_node(f);
+            } else {
+                m_fronts[static_cast<std::size_t>(f)].entering = true;
+                m_next[front_node(f)] = inside;
+            }
+        }
+        // Each side's piece, in the triangle's order: its corners and the crossings (the crack's
+        // front point between them), fanned from a corner (off the plane's line).
+        const bool front_inserted = f >= 0 && m_fronts[static_cast<std::size_t>(f)].id != ids(in0 ? cross[i][1] : cross[i][0])[0];
+        for (int side = 0; side < 2; ++side) {
+            std::vector<int> piece;
+            std::vector<bool> on_plane;
+            for (int a = 0, k = 0; a < 3; ++a) {
+                const int b = (a + 1) % 3;
+                if (positive[i][static_cast<std::size_t>(a)] == (side == 1)) {
+                    piece.push_back(t[a]);
+                    on_plane.push_back(false);
+                }
+                if (positive[i][static_cast<std::size_t>(a)] != positive[i][static_cast<std::size_t>(b)]) {
+                    piece.push_back(ids(cross[i][static_cast<std::size_t>(k++)])[static_cast<std::size_t>(side)]);
+                    on_plane.push_back(true);
+                }
+            }
+            if (front_inserted) { // between the two crossings, which are neighbours
+                                  // round the piece
+                std::size_t after = 0;
+                while (!(on_plane[after] && on_plane[(after + 1) % piece.size()])) ++after;
+                piece.insert(piece.begin() + static_cast<std::ptrdiff_t>(after + 1), m_fronts[static_cast<std::size_t>(f)].id);
+                on_plane.insert(on_plane.begin() + static_cast<std::ptrdiff_t>(after + 1), true);
+            }
+            const auto corner = static_cast<std::size_t>(std::find(on_plane.begin(), on_plane.end(), false) - on_plane.begin());
+            const std::size_t m = piece.size();
+            for (std::size_t k = 1; k + 1 < m; ++k) kept.emplace_back(piece[corner], piece[(corner + k) % m], piece[(corner + k + 1) % m]);
+        }
+    }
+    triangles = std::move(kept);
+}
+
+void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles)
+{
+    std::vector<Eigen::Vector2d> flat;
+    flat.reserve(x.size());
+    for (const Eigen::Vector3d& p : x) flat.emplace_back(m_u.dot(p), m_w.dot(p));
+    // Corners on the front are one point for both sides. A triangle with only such corners would
+    // be the same on both sides, glued to itself: it is left out (the crack does not open there).
+    // A diagonal between two of them with split corners on both its sides would glue the two
+    // faces along it: the triangulation avoids those, and any left are split at their middle.
+    std::vector<bool> shared(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) shared[k] = ids[k][0] == ids[k][1];
+    std::vector<std::array<int, 3>> faces;
+    for (const std::array<int, 3>& f : triangulate_polygon(flat, shared))
+        if (!shared[static_cast<std::size_t>(f[0])] || !shared[static_cast<std::size_t>(f[1])] || !shared[static_cast<std::size_t>(f[2])]) faces.push_back(f);
+    std::map<std::pair<int, int>, std::vector<std::size_t>> glued; // shared-shared edge -> the faces using it
+    for (std::size_t k = 0; k < faces.size(); ++k)
+        for (int e = 0; e < 3; ++e) {
+            const int a = faces[k][static_cast<std::size_t>(e)], b = faces[k][static_cast<std::size_t>((e + 1) % 3)];
+            if (shared[static_cast<std::size_t>(a)] && shared[static_cast<std::size_t>(b)]) glued[std::minmax(a, b)].push_back(k);
+        }
+    for (const auto& [edge, users] : glued) {
+        if (users.size() != 2) continue; // a front edge: one face, split corner opposite
+        const Eigen::Vector3d middle = 0.5 * (x[static_cast<std::size_t>(edge.first)] + x[static_cast<std::size_t>(edge.second)]);
+        // Walk to it from a split corner of a face beside it (in a cut tetrahedron).
+        std::size_t start = 0;
+        for (int c : faces[users[0]])
+            if (!shared[static_cast<std::size_t>(c)]) start = m_points[static_cast<std::size_t>(ids[static_cast<std::size_t>(c)][0])].tet;
+        const auto [tet, bary] = walk_to(m_model.mesh(), m_neighbours, start, middle);
+        if (!in_crack(static_cast<std::int64_t>(tet))) continue;
+        const int m = static_cast<int>(ids.size());
+        ids.push_back({add_point(tet, bary, 0, middle, 0), add_point(tet, bary, 1, middle, 0)});
+        x.push_back(middle);
+        for (std::size_t k : users) {
+            std::array<int, 3> f = faces[k];
+            int e = 0;
+            while (std::pair<int, int>(std::minmax(f[static_cast<std::size_t>(e)], f[static_cast<std::size_t>((e + 1) % 3)])) != edge) ++e;
+            const int a = f[static_cast<std::size_t>(e)], b = f[static_cast<std::size_t>((e + 1) % 3)], c = f[static_cast<std::size_t>((e + 2) % 3)];
+            faces[k] = {a, m, c};
+            faces.push_back({m, b, c});
+        }
+    }
+    // Counter-clockwise in (u, w) faces +n: out of the negative side (0).
+    for (const std::array<int, 3>& f : faces) {
+        auto id = [&](int k, int side) { return ids[static_cast<std::size_t>(f[static_cast<std::size_t>(k)])][static_cast<std::size_t>(side)]; };
+        triangles.emplace_back(id(0, 0), id(1, 0), id(2, 0));
+        triangles.emplace_back(id(0, 1), id(2, 1), id(1, 1));
+    }
+}
+
+void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
+{
+    auto add_node = [&](int node, std::vector<std::array<int, 2>>& ids, std::vector<Eigen::Vector3d>& x) {
+        if (node >= 0) {
+            ids.push_back(this->ids(node));
+            x.push_back(m_crossings[static_cast<std::size_t>(node)].x);
+        } else {
+            const Front& f = m_fronts[static_cast<std::size_t>(-node - 1)];
+            ids.push_back({f.id, f.id});
+            x.push_back(f.x);
+        }
+    };
+    // The runs of S's boundary inside R, each from an entering front to a leaving one.
+    std::vector<std::vector<int>> chains;
+    std::map<int, bool> visited;
+    for (std::size_t f = 0; f < m_fronts.size(); ++f) {
+        if (!m_fronts[f].entering) continue;
+        std::vector<int> chain{front_node(static_cast<int>(f))};
+        for (auto it = m_next.find(chain.back()); it != m_next.end() && chain.size() <= m_next.size(); it = m_next.find(chain.back())) {
+            chain.push_back(it->second);
+            visited[it->second] = true;
+            if (it->second < 0) break;
+        }
+        if (chain.back() >= 0 || chain.size() < 2) {
+            ++counts.open_chains;
+            continue;
+        }
+        m_fronts[f].chain = m_fronts[static_cast<std::size_t>(-chain.back() - 1)].chain = static_cast<int>(chains.size());
+        chains.push_back(std::move(chain));
+    }
+    // Loops of S's boundary wholly inside R: a cut through the object there.
+    for (const auto& [start, unused] : m_next) {
+        if (start < 0 || visited[start]) continue;
+        std::vector<int> loop{start};
+        visited[start] = true;
+        bool closed = false;
+        for (auto it = m_next.find(start); it != m_next.end() && it->second >= 0; it = m_next.find(loop.back())) {
+            if (it->second == start) {
+                closed = true;
+                break;
+            }
+            if (visited[it->second]) break;
+            visited[it->second] = true;
+            loop.push_back(it->second);
+        }
+        if (!closed || loop.size() < 3) {
+            ++counts.open_chains;
+            continue;
+        }
+        std::vector<std::array<int, 2>> ids;
+        std::vector<Eigen::Vector3d> x;
+        for (int node : loop) add_node(node, ids, x);
+        emit(ids, x, triangles);
+        ++counts.faces;
+    }
+    // Faces with a front: a chain, then R's boundary from where it leaves the crack to the next
+    // entering front along it, that front's chain, and so on round to the first.
+    std::vector<bool> used(chains.size(), false);
+    for (std::size_t first = 0; first < chains.size(); ++first) {
+        if (used[first]) continue;
+        std::vector<std::array<int, 2>> ids;
+        std::vector<Eigen::Vector3d> x;
+        std::size_t c = first;
+        bool closed = false;
+        for (std::size_t guard = 0; guard <= chains.size(); ++guard) {
+            used[c] = true;
+            for (int node : chains[c]) add_node(node, ids, x);
+            const Front& out = m_fronts[static_cast<std::size_t>(-chains[c].back() - 1)];
+            int segment = out.segment;
+            double after = out.along;
+            int next = -1;
+            for (std::size_t steps = 0; steps <= m_segments.size() && next < 0; ++steps) {
+                double nearest = INFINITY;
+                for (const Front& f : m_fronts)
+                    if (f.entering && f.chain >= 0 && f.segment == segment && f.along > after && f.along < nearest) {
+                        nearest = f.along;
+                        next = f.chain;
+                    }
+                if (next >= 0) break;
+                const int corner = corner_point(segment);
+                ids.push_back({corner, corner});
+                x.push_back(m_segments[static_cast<std::size_t>(segment)].x_to);
+                const auto leaving = m_leaving.find(m_segments[static_cast<std::size_t>(segment)].to);
+                if (leaving == m_leaving.end()) break;
+                segment = leaving->second;
+                after = -INFINITY;
+            }
+            if (next < 0) break;
+            if (static_cast<std::size_t>(next) == first) {
+                closed = true;
+                break;
+            }
+            if (used[static_cast<std::size_t>(next)]) break;
+            c = static_cast<std::size_t>(next);
+        }
+        if (!closed || ids.size() < 3) {
+            ++counts.open_chains;
+            continue;
+        }
+        emit(ids, x, triangles);
+        ++counts.faces;
+        ++counts.slit_faces;
+    }
+}
+
+} // namespace
+
+CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh())) {}
+
+int CutClosure::side_of(std::size_t tet, const std::array<double, 4>& bary) const
+{
+    const XfemElement& el = m_model.elements()[tet];
+    if (el.cut < 0) return 0;
+    double phi = 0.0;
+    for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * el.phi[c];
+    return phi >= 0.0 ? 1 : 0;
+}
+
+ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const
+{
+    Closer closer(m_model, m_neighbours, *this, cut, points);
+    closer.split(triangles);
+    closer.fill(triangles);
+    return closer.counts;
+}
+
+} // namespace vox::isxfem
