@@ -44,6 +44,33 @@ struct Segment {
     int face = 0; ///< the corner opposite
 };
 
+/// A crack face's boundary: each corner's point per side and its rest position.
+struct Loop {
+    std::vector<std::array<int, 2>> ids;
+    std::vector<Eigen::Vector3d> x;
+    bool slit = false; ///< closed along a front
+};
+
+/// Whether segments ab and cd cross at a point inside both (touching ends do not count).
+bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& d)
+{
+    auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+        const double z = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+        return (z > 0.0) - (z < 0.0);
+    };
+    return side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0;
+}
+
+bool inside_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon)
+{
+    bool in = false;
+    for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
+        if ((polygon[i].y() > p.y()) != (polygon[j].y() > p.y()) &&
+            p.x() < polygon[j].x() + (p.y() - polygon[j].y()) / (polygon[i].y() - polygon[j].y()) * (polygon[i].x() - polygon[j].x()))
+            in = !in;
+    return in;
+}
+
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
@@ -86,6 +113,10 @@ private:
     int corner_point(int segment);
     /// Chain nodes: crossings by index, fronts as -(index + 1).
     static int front_node(int f) { return -(f + 1); }
+    [[nodiscard]] Eigen::Vector2d flat(const Eigen::Vector3d& x) const { return {m_u.dot(x), m_w.dot(x)}; }
+    /// Faces with their holes joined in: each clockwise loop (a hole: the material is on the
+    /// left of every loop) is bridged to the counter-clockwise one around it.
+    std::vector<Loop> with_holes(std::vector<Loop> loops);
     /// Triangulates a crack face given round its boundary (each corner's point per side) on both sides.
     void emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles);
 
@@ -332,9 +363,9 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
 
 void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles)
 {
-    std::vector<Eigen::Vector2d> flat;
-    flat.reserve(x.size());
-    for (const Eigen::Vector3d& p : x) flat.emplace_back(m_u.dot(p), m_w.dot(p));
+    std::vector<Eigen::Vector2d> in_plane;
+    in_plane.reserve(x.size());
+    for (const Eigen::Vector3d& p : x) in_plane.push_back(flat(p));
     // Corners on the front are one point for both sides. A triangle with only such corners would
     // be the same on both sides, glued to itself: it is left out (the crack does not open there).
     // A diagonal between two of them with split corners on both its sides would glue the two
@@ -342,7 +373,7 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
     std::vector<bool> shared(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) shared[k] = ids[k][0] == ids[k][1];
     std::vector<std::array<int, 3>> faces;
-    for (const std::array<int, 3>& f : triangulate_polygon(flat, shared))
+    for (const std::array<int, 3>& f : triangulate_polygon(in_plane, shared))
         if (!shared[static_cast<std::size_t>(f[0])] || !shared[static_cast<std::size_t>(f[1])] || !shared[static_cast<std::size_t>(f[2])]) faces.push_back(f);
     std::map<std::pair<int, int>, std::vector<std::size_t>> glued; // shared-shared edge -> the faces using it
     for (std::size_t k = 0; k < faces.size(); ++k)
@@ -409,7 +440,8 @@ void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
         m_fronts[f].chain = m_fronts[static_cast<std::size_t>(-chain.back() - 1)].chain = static_cast<int>(chains.size());
         chains.push_back(std::move(chain));
     }
-    // Loops of S's boundary wholly inside R: a cut through the object there.
+    std::vector<Loop> loops;
+    // Loops of S's boundary wholly inside R: a cut through the object there (or a hole in a face).
     for (const auto& [start, unused] : m_next) {
         if (start < 0 || visited[start]) continue;
         std::vector<int> loop{start};
@@ -428,11 +460,9 @@ void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
             ++counts.open_chains;
             continue;
         }
-        std::vector<std::array<int, 2>> ids;
-        std::vector<Eigen::Vector3d> x;
-        for (int node : loop) add_node(node, ids, x);
-        emit(ids, x, triangles);
-        ++counts.faces;
+        Loop face;
+        for (int node : loop) add_node(node, face.ids, face.x);
+        loops.push_back(std::move(face));
     }
     // Faces with a front: a chain, then R's boundary from where it leaves the crack to the next
     // entering front along it, that front's chain, and so on round to the first.
@@ -478,10 +508,90 @@ void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
             ++counts.open_chains;
             continue;
         }
-        emit(ids, x, triangles);
-        ++counts.faces;
-        ++counts.slit_faces;
+        loops.push_back({std::move(ids), std::move(x), true});
     }
+    for (Loop& face : with_holes(std::move(loops))) {
+        emit(std::move(face.ids), std::move(face.x), triangles);
+        ++counts.faces;
+        counts.slit_faces += face.slit ? 1 : 0;
+    }
+}
+
+std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
+{
+    std::vector<std::vector<Eigen::Vector2d>> flat_loops;
+    std::vector<double> area;
+    for (const Loop& loop : loops) {
+        std::vector<Eigen::Vector2d> f;
+        for (const Eigen::Vector3d& p : loop.x) f.push_back(flat(p));
+        double a = 0.0;
+        for (std::size_t i = 0; i < f.size(); ++i) a += 0.5 * (f[i].x() * f[(i + 1) % f.size()].y() - f[(i + 1) % f.size()].x() * f[i].y());
+        flat_loops.push_back(std::move(f));
+        area.push_back(a);
+    }
+    // Each hole goes to the smallest face around it.
+    std::vector<std::vector<std::size_t>> holes(loops.size());
+    for (std::size_t h = 0; h < loops.size(); ++h) {
+        if (area[h] >= 0.0) continue;
+        std::size_t around = loops.size();
+        for (std::size_t o = 0; o < loops.size(); ++o)
+            if (area[o] > 0.0 && inside_polygon(flat_loops[h].front(), flat_loops[o]) && (around == loops.size() || area[o] < area[around])) around = o;
+        if (around == loops.size())
+            ++counts.open_chains; // a hole in nothing: left out
+        else
+            holes[around].push_back(h);
+    }
+    std::vector<Loop> out;
+    for (std::size_t o = 0; o < loops.size(); ++o) {
+        if (area[o] <= 0.0) continue;
+        Loop face = std::move(loops[o]);
+        std::vector<Eigen::Vector2d> f = flat_loops[o];
+        // Rightmost holes first; each bridged from its rightmost corner to the nearest corner of
+        // the face seen without crossing an edge of the face or of any of its holes.
+        std::sort(holes[o].begin(), holes[o].end(), [&](std::size_t a, std::size_t b) {
+            auto right = [&](std::size_t h) { return std::max_element(flat_loops[h].begin(), flat_loops[h].end(), [](auto& p, auto& q) { return p.x() < q.x(); })->x(); };
+            return right(a) > right(b);
+        });
+        for (std::size_t h : holes[o]) {
+            const std::vector<Eigen::Vector2d>& hf = flat_loops[h];
+            const auto m = static_cast<std::size_t>(std::max_element(hf.begin(), hf.end(), [](auto& p, auto& q) { return p.x() < q.x(); }) - hf.begin());
+            std::vector<std::size_t> order(f.size());
+            for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+            std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return (f[a] - hf[m]).squaredNorm() < (f[b] - hf[m]).squaredNorm(); });
+            auto clear = [&](std::size_t v) {
+                auto blocked_by = [&](const std::vector<Eigen::Vector2d>& poly) {
+                    for (std::size_t i = 0; i < poly.size(); ++i)
+                        if (crosses(hf[m], f[v], poly[i], poly[(i + 1) % poly.size()])) return true;
+                    return false;
+                };
+                if (blocked_by(f)) return false;
+                for (std::size_t other : holes[o])
+                    if (blocked_by(flat_loops[other])) return false;
+                return true;
+            };
+            const auto v = std::find_if(order.begin(), order.end(), clear);
+            if (v == order.end()) {
+                ++counts.open_chains; // no bridge found: the hole is left out
+                continue;
+            }
+            // face[..v], hole[m..] round to hole[m], face[v..]
+            Loop merged;
+            std::vector<Eigen::Vector2d> merged_flat;
+            auto take = [&](const Loop& from, const std::vector<Eigen::Vector2d>& from_flat, std::size_t i) {
+                merged.ids.push_back(from.ids[i]);
+                merged.x.push_back(from.x[i]);
+                merged_flat.push_back(from_flat[i]);
+            };
+            for (std::size_t i = 0; i <= *v; ++i) take(face, f, i);
+            for (std::size_t k = 0; k <= hf.size(); ++k) take(loops[h], hf, (m + k) % hf.size());
+            for (std::size_t i = *v; i < f.size(); ++i) take(face, f, i);
+            merged.slit = face.slit;
+            face = std::move(merged);
+            f = std::move(merged_flat);
+        }
+        out.push_back(std::move(face));
+    }
+    return out;
 }
 
 } // namespace

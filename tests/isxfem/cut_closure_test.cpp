@@ -63,16 +63,24 @@ struct Closed {
 };
 
 /// A 6 x 4 x 4 lattice of 1 m cubes with the box surface [0.05, 5.95] x [0.05, 3.95]^2 embedded
-/// (triangles of about `step`), cut by the plane x = 3.1 where `inside` holds, then closed. With
+/// (triangles of about `step`; with `cavity`, a void inside it too), cut by the plane x = 3.1 where `inside` holds, then closed. With
 /// the default step the surface's vertices lie on y = 2 and z = 2, where the cubes' faces are: the
 /// crack's front runs along the surface's edges and meets the surface at its vertices.
-Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39)
+Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false)
 {
     XfemModel model(cube_lattice({6, 4, 4}, 1.0), {TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
                     std::vector<std::uint32_t>(6 * 96, 0), 0.1);
     std::vector<Eigen::Vector3d> x;
     Closed out;
     box_surface({0.05, 0.05, 0.05}, {5.95, 3.95, 3.95}, step, x, out.triangles);
+    if (cavity) { // a void [2.5, 3.7] x [1.3, 2.7]^2 inside: its surface faces into it
+        std::vector<Eigen::Vector3i> inner;
+        const auto first = static_cast<int>(x.size());
+        std::vector<Eigen::Vector3d> inner_x;
+        box_surface({2.5, 1.3, 1.3}, {3.7, 2.7, 2.7}, 0.3, inner_x, inner);
+        x.insert(x.end(), inner_x.begin(), inner_x.end());
+        for (const Eigen::Vector3i& t : inner) out.triangles.emplace_back(t[0] + first, t[2] + first, t[1] + first);
+    }
     const auto neighbours = face_neighbours(model.mesh());
     const CutReport report = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}, inside);
     EXPECT_GT(report.cut_tets, 0u);
@@ -181,5 +189,30 @@ TEST(CutClosure, ASlitInsideACornerOnlyOpensTwoFaces)
         const auto [volume, crack] = volume_and_crack_area(c);
         EXPECT_NEAR(volume, 5.9 * 3.9 * 3.9, 1e-9) << step;
         EXPECT_NEAR(crack, 2.0 * (2.0 - 0.05) * (3.95 - 2.0), step == 0.37 ? 1e-9 : 1e-3) << step;
+    }
+}
+
+TEST(CutClosure, ACavityLeavesAHoleInTheFaces)
+{
+    const double cavity_volume = 1.2 * 1.4 * 1.4;
+    { // through: each face is the cross-section less the cavity's
+        const Closed c = cut_box({}, 0.37, true);
+        EXPECT_EQ(c.counts.faces, 1u);
+        EXPECT_EQ(c.counts.open_chains, 0u);
+        expect_closed(c);
+        EXPECT_EQ(pieces(c), 2);
+        const auto [volume, crack] = volume_and_crack_area(c);
+        EXPECT_NEAR(volume, 5.9 * 3.9 * 3.9 - cavity_volume, 1e-9);
+        EXPECT_NEAR(crack, 2.0 * (3.9 * 3.9 - 1.4 * 1.4), 1e-9);
+    }
+    { // a slit down to z = 2, through the cavity's upper part: its front runs into the void
+        const Closed c = cut_box([](const Eigen::Vector3d& p) { return p.z() > 1.9; }, 0.37, true);
+        EXPECT_EQ(c.counts.slit_faces, 1u);
+        EXPECT_EQ(c.counts.open_chains, 0u);
+        expect_closed(c);
+        EXPECT_EQ(pieces(c), 1);
+        const auto [volume, crack] = volume_and_crack_area(c);
+        EXPECT_NEAR(volume, 5.9 * 3.9 * 3.9 - cavity_volume, 1e-9);
+        EXPECT_NEAR(crack, 2.0 * (3.9 * (3.95 - 2.0) - 1.4 * (2.7 - 2.0)), 1e-9);
     }
 }
