@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 
 namespace vox::fem {
@@ -34,7 +35,13 @@ struct SupernodalFactor::Cholmod {
 SupernodalFactor::SupernodalFactor() : m_cholmod(std::make_unique<Cholmod>()) {}
 SupernodalFactor::~SupernodalFactor() = default;
 
-bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pattern)
+std::size_t SupernodalFactor::solve_threads()
+{
+    return static_cast<std::size_t>(std::min<long>(tbb::this_task_arena::max_concurrency(),
+                                                   static_cast<long>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+}
+
+bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pattern, std::size_t solve_threads)
 {
     cholmod_sparse view{};
     view.nrow = view.ncol = static_cast<std::size_t>(a.rows());
@@ -50,6 +57,11 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     view.packed = a.isCompressed() ? 1 : 0;
     if (!view.packed) throw std::logic_error("SupernodalFactor: the matrix must be compressed");
     cholmod_common& c = m_cholmod->common;
+    // Serial OpenBLAS (0.3.7 on) is safe to call from two threads at once only when built with
+    // USE_LOCKING, and factors may be taken in the background, by several solvers each: one
+    // factorisation at a time in the process.
+    static std::mutex blas;
+    std::unique_lock lock(blas);
     const bool analyse = new_pattern || !m_cholmod->factor;
     if (analyse) {
         if (m_cholmod->factor) cholmod_free_factor(&m_cholmod->factor, &c);
@@ -59,6 +71,7 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     }
     cholmod_factorize(&view, m_cholmod->factor, &c);
     const cholmod_factor* l = m_cholmod->factor;
+    lock.unlock();
     if (c.status == CHOLMOD_NOT_POSDEF || !l->is_super || !l->is_ll) return false;
     // The float copy, and the pivots (the squared diagonal of L) for the singularity check.
     auto copy = [](const void* p, std::size_t n, std::vector<int>& out) {
@@ -82,11 +95,7 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
         }
     }
     m_b.resize(l->n);
-    if (analyse) { // the tree is the analysis's
-        const auto threads = static_cast<std::size_t>(std::min<long>(tbb::this_task_arena::max_concurrency(),
-                                                                     static_cast<long>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
-        schedule(std::min<std::size_t>(threads, 8));
-    }
+    if (analyse) schedule(std::min<std::size_t>(solve_threads, 8)); // the tree is the analysis's
     return smallest > 1e-10 * largest;
 }
 

@@ -27,8 +27,13 @@ public:
 
     /// Factors the symmetric matrix `a` (its lower triangle is read), analysing its pattern first
     /// when `new_pattern`. False when it is not numerically positive definite (a pivot below
-    /// 1e-10 of the largest: a singular system, an object nothing holds).
-    bool factor(const Eigen::SparseMatrix<double>& a, bool new_pattern);
+    /// 1e-10 of the largest: a singular system, an object nothing holds). The solves are scheduled
+    /// for `solve_threads` threads: a factor taken on one thread for solves on another passes the
+    /// other's solve_threads(). Runs on the calling thread alone (no TBB algorithms; CHOLMOD and
+    /// BLAS are not to be called from two threads at once).
+    bool factor(const Eigen::SparseMatrix<double>& a, bool new_pattern, std::size_t solve_threads = SupernodalFactor::solve_threads());
+    /// Threads the calling thread's solves may use: its task arena's, within TBB's global limit.
+    [[nodiscard]] static std::size_t solve_threads();
     /// x = A^-1 x, in single precision.
     void solve(Eigen::VectorXd& x) const;
     /// Entries of the factor (its supernodes' dense blocks).
