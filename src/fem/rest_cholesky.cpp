@@ -34,8 +34,8 @@ const SystemMatrix& assembled(const SystemMatrix* a)
 
 } // namespace
 
-RestCholesky::RestCholesky(const Eigen::Matrix3d& frame, int refactor_iterations, bool background)
-    : m_frame(frame), m_refactor_iterations(refactor_iterations), m_background(background)
+RestCholesky::RestCholesky(const Eigen::Matrix3d& frame, int refactor_iterations, double background_flops)
+    : m_frame(frame), m_refactor_iterations(refactor_iterations), m_background_flops(background_flops)
 {
 }
 
@@ -67,10 +67,10 @@ bool RestCholesky::same_holds(const std::vector<unsigned char>& held, const std:
 
 bool RestCholesky::must_refactor(const std::vector<unsigned char>& fixed, std::size_t blocks) const
 {
-    const bool usable = m_current->taken && !m_failed;
+    const bool usable = m_current->taken && !m_failed && m_current->factor.factor_flops() >= m_background_flops;
     // Grown without blocks_changed(): nothing says what changed.
     const bool unexplained = blocks > m_covered_blocks && !m_patch_dirty;
-    return (m_stale && (!m_background || !usable)) || m_invalid || !same_holds(m_current->fixed, fixed) ||
+    return (m_stale && !usable) || m_invalid || !same_holds(m_current->fixed, fixed) ||
            blocks < m_current->rotation.size() || unexplained;
 }
 

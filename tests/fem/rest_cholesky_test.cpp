@@ -129,7 +129,7 @@ TEST(RestCholesky, AppliesTheWarpedInverse)
 TEST(RestCholesky, RefactorsWhenTheExcessIterationsPayForIt)
 {
     Fixture f;
-    RestCholesky p(Eigen::Matrix3d::Identity(), 25, false); // every factor in the frame: counted as taken
+    RestCholesky p(Eigen::Matrix3d::Identity(), 25, INFINITY); // every factor in the frame: counted as taken
     p.update(&f.a, f.fixed, f.rest);
     const double cost = p.refactor_cost_iterations();
     ASSERT_GT(cost, 2.0);
@@ -216,7 +216,7 @@ TEST(RestCholesky, WarpsAJumpBlockWithTheTwoSidesOfItsCrack)
 TEST(RestCholesky, FactorsInTheBackgroundAndSwapsAtTheIterationCount)
 {
     Fixture f;
-    RestCholesky p(Eigen::Matrix3d::Identity());
+    RestCholesky p(Eigen::Matrix3d::Identity(), 25, 0.0); // however small, in the background
     p.update(&f.a, f.fixed, f.rest); // the first factor is taken in the frame
     const double cost = p.refactor_cost_iterations();
     ASSERT_GT(cost, 2.0);
@@ -265,7 +265,7 @@ TEST(RestCholesky, PatchesTheBackgroundFactorForCutsMadeWhileItWasTaken)
     const auto blocks = [](const SystemMatrix& a) { return static_cast<std::size_t>(a.rows() / 3); };
     const std::vector<unsigned char> fixed(static_cast<std::size_t>(cut.small.rows()), 0), grown_fixed(static_cast<std::size_t>(cut.grown.rows()), 0);
     const std::vector<Eigen::Quaterniond> rest(blocks(cut.small), Eigen::Quaterniond::Identity()), grown_rest(blocks(cut.grown), Eigen::Quaterniond::Identity());
-    RestCholesky p(Eigen::Matrix3d::Identity());
+    RestCholesky p(Eigen::Matrix3d::Identity(), 25, 0.0); // however small, in the background
     p.update(&soft.small, fixed, rest);
     wear_out(p);
     p.update(&cut.small, fixed, rest); // launched, on a stiffer matrix
@@ -306,7 +306,7 @@ TEST(RestCholesky, PatchesTheBackgroundFactorForCutsMadeWhileItWasTaken)
 TEST(RestCholesky, DiscardsABackgroundFactorWhenOtherDofsAreHeld)
 {
     Fixture f;
-    RestCholesky p(Eigen::Matrix3d::Identity());
+    RestCholesky p(Eigen::Matrix3d::Identity(), 25, 0.0); // however small, in the background
     p.update(&f.a, f.fixed, f.rest);
     wear_out(p);
     p.update(&f.a, f.fixed, f.rest);
