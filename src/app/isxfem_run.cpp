@@ -51,8 +51,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                          {"linear_solver", std::string("CG, ") + sim.solver().preconditioner_name() + " preconditioner"}, {"frames", nlohmann::json::array()}};
     double total_ms = 0.0, max_ms = 0.0, cut_total_ms = 0.0;
     int converged = 0;
-    std::size_t cut_tets = 0, partial = 0;
-    std::set<std::size_t> left_whole; // frames where a second cut crossed tetrahedra already cut
+    std::size_t cut_tets = 0, partial = 0, recut = 0, crossed = 0;
+    std::set<std::size_t> left_whole; // frames where a cut crossed tetrahedra already cut twice
     isxfem::XfemStepStats last;
     Progress progress("simulating", static_cast<std::uint64_t>(frames));
     const auto& rest = sim.model().mesh().nodes;
@@ -64,12 +64,18 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
         cut_total_ms += cut_ms;
         cut_tets += frame_cut.cut_tets;
         partial = frame_cut.partial_tets;
+        recut += frame_cut.recut_tets;
+        if (frame_cut.crossed_tets > 0 && crossed == 0)
+            log::warn("frame {}: two cuts cross inside {} tetrahedra; the added enrichments cannot move their four pieces apart "
+                      "independently, so the pieces stay coupled there (counted per frame in stats.json: crossed_tets)",
+                      f, frame_cut.crossed_tets);
+        crossed += frame_cut.crossed_tets;
         if (frame_cut.already_cut > 0) {
-            // One cut per tetrahedron so far: a second cut through one leaves it as it was. Said
-            // once, counted per frame in stats.json.
+            // Two cuts per tetrahedron at most: a third leaves it as it was. Said once, counted
+            // per frame in stats.json.
             if (left_whole.empty())
-                log::warn("frame {}: {} tetrahedra already cut were crossed by another cut and left as they were (Is-XFEM "
-                          "takes one cut per tetrahedron so far; their pieces stay joined along the new cut)",
+                log::warn("frame {}: {} tetrahedra already cut twice were crossed by another cut and left as they were (Is-XFEM "
+                          "takes two cuts per tetrahedron; their pieces stay joined along the new cut)",
                           f, frame_cut.already_cut);
             left_whole.insert(static_cast<std::size_t>(f));
         }
@@ -101,6 +107,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"max_displacement_mm", max_displacement * 1e3},
                                    {"cut_tets", frame_cut.cut_tets},
                                    {"partly_crossed_tets", frame_cut.partial_tets},
+                                   {"recut_tets", frame_cut.recut_tets},
+                                   {"crossed_tets", frame_cut.crossed_tets},
                                    {"recut_tets_left", frame_cut.already_cut},
                                    {"dofs", sim.solver().dof_count()},
                                    {"regularised_blocks", sim.solver().regularised_blocks()},
@@ -115,6 +123,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
         {{"cut_tets", cut_tets},
          {"cuts", sim.model().cut_count()},
          {"partly_crossed_tets_last_frame", partial},
+         {"recut_tets", recut},
+         {"crossed_tets", crossed},
          {"frames_with_recut_tets_left", left_whole.size()},
          {"total_cut_ms", cut_total_ms},
          {"final_dofs", sim.solver().dof_count()},

@@ -172,7 +172,7 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
     out.vertices = &m_closed_vertices;
     const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
     const std::vector<Eigen::Vector3i>& triangles = m_closed_triangles;
-    // Only the vertices of tetrahedra whose deformed box (both sides of a cut one) meets the reach
+    // Only the vertices of tetrahedra whose deformed box (every region of a cut one) meets the reach
     // are placed: a large surface is mostly far from the tool.
     const auto& x = m_solver->state();
     std::vector<unsigned char> tet_near(m_model->elements().size(), 0);
@@ -183,9 +183,13 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
         double jump = 0.0;
         for (std::size_t c = 0; c < 4; ++c) {
             box.extend(1e3 * x[el.node[c]]);
-            if (el.cut < 0) continue;
-            for (double side : {0.0, 1.0}) box.extend(1e3 * (x[el.node[c]] + (side - el.node_side[c]) * x[el.enriched[c]]));
-            jump += 1e3 * x[el.enriched[c]].norm();
+            for (unsigned pattern = 0; el.is_cut() && pattern < (1u << el.cuts.size()); ++pattern) { // each region's corner
+                Eigen::Vector3d p = x[el.node[c]];
+                for (std::size_t j = 0; j < el.cuts.size(); ++j)
+                    p += (static_cast<double>((pattern >> j) & 1u) - el.cuts[j].node_side[c]) * x[el.cuts[j].enriched[c]];
+                box.extend(1e3 * p);
+            }
+            for (const isxfem::ElementCut& cut : el.cuts) jump += 1e3 * x[cut.enriched[c]].norm();
         }
         // For k > 0 a side's field is the linear one plus k gamma-weighted jumps, at most k sum |a|.
         const Eigen::Vector3d pad = Eigen::Vector3d::Constant(m_model->k() * jump);

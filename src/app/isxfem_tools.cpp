@@ -94,6 +94,8 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         out.cut.new_blocks += r.new_blocks;
         out.cut.partial_tets += r.partial_tets;
         out.cut.already_cut += r.already_cut;
+        out.cut.recut_tets += r.recut_tets;
+        out.cut.crossed_tets += r.crossed_tets;
         t.cut = r.cut_tets > 0;
     }
     // A cut this frame may have cut a loaded point's tetrahedron: the point acts on its own side.

@@ -21,6 +21,7 @@ struct Crossing {
     std::size_t tet = 0; ///< holding it
     std::array<double, 4> bary{};
     bool inside = false;           ///< in the crack: one point per side
+    unsigned region = 0;           ///< its region (XfemElement::region_at) apart from this cut's side
     std::array<int, 2> id{-1, -1}; ///< its point on each side (the same twice outside the crack), once placed
     std::int32_t label = 0;
 };
@@ -89,7 +90,18 @@ public:
     ClosureCounts counts;
 
 private:
-    [[nodiscard]] bool in_crack(std::int64_t tet) const { return tet >= 0 && m_model.elements()[static_cast<std::size_t>(tet)].cut == m_cut; }
+    [[nodiscard]] bool in_crack(std::int64_t tet) const
+    {
+        return tet >= 0 && m_model.elements()[static_cast<std::size_t>(tet)].cut_index(m_cut) >= 0;
+    }
+    /// The region on side `side` of this cut of the point `bary` of a tetrahedron it cut (its side
+    /// of the tetrahedron's other cut as it is).
+    [[nodiscard]] int region_on(std::size_t tet, const std::array<double, 4>& bary, int side) const
+    {
+        const XfemElement& el = m_model.elements()[tet];
+        const unsigned bit = 1u << el.cut_index(m_cut);
+        return static_cast<int>(side ? el.region_at(bary) | bit : el.region_at(bary) & ~bit);
+    }
     int add_point(std::size_t tet, const std::array<double, 4>& bary, int side, const Eigen::Vector3d& x, std::int32_t label)
     {
         m_points.push_back({tet, bary, side, x, label});
@@ -143,16 +155,18 @@ void Closer::build_boundary()
     const auto& elements = m_model.elements();
     const auto& nodes = m_model.mesh().nodes;
     for (std::size_t t = 0; t < elements.size(); ++t) {
+        const int index = elements[t].cut_index(m_cut);
+        if (index < 0) continue;
         const XfemElement& el = elements[t];
-        if (el.cut != m_cut) continue;
+        const std::array<double, 4>& phi = el.cuts[static_cast<std::size_t>(index)].phi;
         // The plane's crossing of a tetrahedron edge, from its lower node: the same bits in every
         // tetrahedron around the edge.
         auto on_edge = [&](std::size_t a, std::size_t b) {
             if (el.node[a] > el.node[b]) std::swap(a, b);
-            const double f = el.phi[a] / (el.phi[a] - el.phi[b]);
+            const double f = phi[a] / (phi[a] - phi[b]);
             return std::pair{NodeEdge{el.node[a], el.node[b]}, Eigen::Vector3d(nodes[el.node[a]] + f * (nodes[el.node[b]] - nodes[el.node[a]]))};
         };
-        auto crossed = [&](std::size_t a, std::size_t b) { return (el.phi[a] < 0.0) != (el.phi[b] < 0.0); };
+        auto crossed = [&](std::size_t a, std::size_t b) { return (phi[a] < 0.0) != (phi[b] < 0.0); };
         Eigen::Vector3d centre = Eigen::Vector3d::Zero();
         int count = 0;
         for (std::size_t a = 0; a < 4; ++a)
@@ -191,6 +205,25 @@ int Closer::crossing(int a, int b)
     c.label = va.label;
     std::tie(c.tet, c.bary) = walk_to(m_model.mesh(), m_neighbours, va.tet, c.x);
     c.inside = in_crack(static_cast<std::int64_t>(c.tet));
+    // Its region; on another cut's plane (an edge of that cut's crack faces) the side of that cut
+    // is the edge's ends' (the face's side), not what rounding says.
+    const XfemElement& el = m_model.elements()[c.tet];
+    c.region = el.region_at(c.bary);
+    for (std::size_t i = 0; i < el.cuts.size(); ++i) {
+        double phi = 0.0, size = 0.0;
+        for (std::size_t k = 0; k < 4; ++k) {
+            phi += c.bary[k] * el.cuts[i].phi[k];
+            size = std::max(size, std::abs(el.cuts[i].phi[k]));
+        }
+        if (std::abs(phi) > 1e-9 * size) continue;
+        for (const SurfacePoint* end : {&va, &vb}) {
+            const int at = m_model.elements()[end->tet].cut_index(el.cuts[i].id);
+            if (at < 0) continue;
+            const unsigned bit = (static_cast<unsigned>(end->side) >> at) & 1u;
+            c.region = (c.region & ~(1u << i)) | (bit << i);
+            break;
+        }
+    }
     m_crossings.push_back(c);
     return m_crossing_of[key] = static_cast<int>(m_crossings.size()) - 1;
 }
@@ -200,9 +233,11 @@ const std::array<int, 2>& Closer::ids(int crossing)
     Crossing& c = m_crossings[static_cast<std::size_t>(crossing)];
     if (c.id[0] >= 0) return c.id;
     if (c.inside) {
-        for (int side = 0; side < 2; ++side) c.id[static_cast<std::size_t>(side)] = add_point(c.tet, c.bary, side, c.x, c.label);
+        const unsigned bit = 1u << m_model.elements()[c.tet].cut_index(m_cut);
+        c.id[0] = add_point(c.tet, c.bary, static_cast<int>(c.region & ~bit), c.x, c.label);
+        c.id[1] = add_point(c.tet, c.bary, static_cast<int>(c.region | bit), c.x, c.label);
     } else {
-        c.id[0] = c.id[1] = add_point(c.tet, c.bary, m_closure.side_of(c.tet, c.bary), c.x, c.label);
+        c.id[0] = c.id[1] = add_point(c.tet, c.bary, static_cast<int>(c.region), c.x, c.label);
     }
     return c.id;
 }
@@ -391,7 +426,7 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
         const auto [tet, bary] = walk_to(m_model.mesh(), m_neighbours, start, middle);
         if (!in_crack(static_cast<std::int64_t>(tet))) continue;
         const int m = static_cast<int>(ids.size());
-        ids.push_back({add_point(tet, bary, 0, middle, 0), add_point(tet, bary, 1, middle, 0)});
+        ids.push_back({add_point(tet, bary, region_on(tet, bary, 0), middle, 0), add_point(tet, bary, region_on(tet, bary, 1), middle, 0)});
         x.push_back(middle);
         for (std::size_t k : users) {
             std::array<int, 3> f = faces[k];
@@ -600,11 +635,7 @@ CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(fa
 
 int CutClosure::side_of(std::size_t tet, const std::array<double, 4>& bary) const
 {
-    const XfemElement& el = m_model.elements()[tet];
-    if (el.cut < 0) return 0;
-    double phi = 0.0;
-    for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * el.phi[c];
-    return phi >= 0.0 ? 1 : 0;
+    return static_cast<int>(m_model.elements()[tet].region_at(bary));
 }
 
 ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const

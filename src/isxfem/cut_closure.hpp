@@ -24,11 +24,12 @@
 namespace vox::isxfem {
 
 /// A material point of an embedded surface: a tetrahedron, barycentric coordinates there and the
-/// side of the tetrahedron's cut it lies on (0 when uncut), with its rest position.
+/// region of the tetrahedron it lies in (XfemElement::region_at: its side of each cut, 0 when
+/// uncut), with its rest position.
 struct SurfacePoint {
     std::size_t tet = 0;
     std::array<double, 4> bary{};
-    int side = 0;
+    int side = 0; ///< the region
     Eigen::Vector3d rest_m = Eigen::Vector3d::Zero();
     std::int32_t label = 0;
 };
@@ -47,7 +48,7 @@ public:
     /// sides; new points are appended.
     ClosureCounts close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const;
 
-    /// The side (of its cut; 0 when uncut) of the material point `bary` in tetrahedron `tet`.
+    /// The region (XfemElement::region_at; 0 when uncut) of the material point `bary` in tetrahedron `tet`.
     [[nodiscard]] int side_of(std::size_t tet, const std::array<double, 4>& bary) const;
 
 private:

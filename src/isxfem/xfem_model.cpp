@@ -24,7 +24,7 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
         e.geometry = tet_geometry(m_mesh.corners(t));
         const TetMaterial& m = m_materials[e.material];
         e.stiffness = tet_stiffness(e.geometry, m.lame);
-        e.mass.topLeftCorner<12, 12>() = tet_mass(e.geometry, m.density);
+        e.mass = tet_mass(e.geometry, m.density);
         for (std::uint32_t n : e.node) m_support[n] += e.geometry.volume;
     }
 }
@@ -37,7 +37,7 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
     std::unordered_map<std::uint32_t, std::uint32_t> fresh;
     std::unordered_map<std::uint32_t, std::uint32_t>& block_of_node = extend >= 0 ? m_cut_blocks[static_cast<std::size_t>(extend)] : fresh;
     // Which tetrahedra the cut separates whole, then their cut matrices on all threads (the
-    // moment-fitted quadrature is most of a cut's time), then their enriched blocks in order.
+    // quadrature is most of a cut's time), then their enriched blocks in order.
     std::vector<std::uint32_t> candidates;
     std::vector<std::array<double, 4>> candidate_phi;
     for (std::size_t t = 0; t < m_elements.size(); ++t) {
@@ -48,9 +48,9 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
             phi[c] = plane.at(m_mesh.nodes[e.node[c]]);
             (phi[c] < 0.0 ? negative : positive) = true;
         }
-        if (!negative || !positive) continue;
-        if (e.cut >= 0) {
-            if (e.cut != id) ++report.already_cut; // another cut's: left as it was (one cut per tetrahedron)
+        if (!negative || !positive || e.cut_index(id) >= 0) continue;
+        if (e.cuts.size() >= k_max_cuts) {
+            ++report.already_cut; // cut as often as it can be: left as it was
             continue;
         }
         // A closed boundary: every edge the plane crosses is crossed inside the region.
@@ -68,27 +68,47 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         candidates.push_back(static_cast<std::uint32_t>(t));
         candidate_phi.push_back(phi);
     }
-    std::vector<CutTet> matrices(candidates.size());
+    // A first cut by moment fitting (cut_tet); a second by the regions both cuts leave.
+    std::vector<MultiCutTet> matrices(candidates.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
             const XfemElement& e = m_elements[candidates[i]];
             const TetMaterial& m = m_materials[e.material];
-            matrices[i] = cut_tet(m_mesh.corners(candidates[i]), candidate_phi[i], m_k, m.lame, m.density, m_fitting);
+            const auto corners = m_mesh.corners(candidates[i]);
+            if (e.cuts.empty()) {
+                const CutTet c = cut_tet(corners, candidate_phi[i], m_k, m.lame, m.density, m_fitting);
+                for (unsigned side = 0; side < 2; ++side)
+                    if (c.side_volume[side] > 0.0) matrices[i].regions.push_back({side, c.side_volume[side], c.side_stiffness[side]});
+                matrices[i].mass = c.mass;
+                matrices[i].node_side = {c.node_side};
+            } else {
+                std::vector<std::array<double, 4>> phi;
+                for (const ElementCut& earlier : e.cuts) phi.push_back(earlier.phi);
+                phi.push_back(candidate_phi[i]);
+                matrices[i] = multi_cut_tet(corners, phi, m_k, m.lame, m.density);
+            }
         }
     });
     for (std::size_t i = 0; i < candidates.size(); ++i) {
         XfemElement& e = m_elements[candidates[i]];
-        const CutTet& c = matrices[i];
-        if (std::min(c.side_volume[0], c.side_volume[1]) <= 0.0) {
+        MultiCutTet& c = matrices[i];
+        // The new cut's sides within the element: both must hold material.
+        const std::size_t bit = e.cuts.size();
+        std::array<double, 2> side_volume{};
+        for (const Region& r : c.regions) side_volume[(r.pattern >> bit) & 1u] += r.volume;
+        if (std::min(side_volume[0], side_volume[1]) <= 0.0) {
             ++report.partial_tets; // the plane only touches it (through nodes): nothing to separate
             continue;
         }
-        e.cut = id;
-        e.phi = candidate_phi[i];
-        e.node_side = c.node_side;
-        e.side_volume = c.side_volume;
-        e.side_stiffness = c.side_stiffness;
-        e.mass = c.mass;
+        if (!e.cuts.empty()) {
+            ++report.recut_tets;
+            e.crossed = c.regions.size() == (1u << (bit + 1));
+            report.crossed_tets += e.crossed ? 1 : 0;
+        }
+        ElementCut cut;
+        cut.id = id;
+        cut.phi = candidate_phi[i];
+        cut.node_side = c.node_side.back();
         for (std::size_t n = 0; n < 4; ++n) {
             const auto [it, added] = block_of_node.try_emplace(e.node[n], static_cast<std::uint32_t>(block_count()));
             if (added) {
@@ -96,9 +116,12 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
                 m_enriched_across.push_back(0.0);
                 ++report.new_blocks;
             }
-            e.enriched[n] = it->second;
-            m_enriched_across[it->second - node_count()] += c.side_volume[1u - c.node_side[n]];
+            cut.enriched[n] = it->second;
+            m_enriched_across[it->second - node_count()] += side_volume[1u - cut.node_side[n]];
         }
+        e.cuts.push_back(cut);
+        e.regions = std::move(c.regions);
+        e.mass = std::move(c.mass);
         ++report.cut_tets;
     }
     if (report.cut_tets > 0) {

@@ -6,8 +6,13 @@
 // Each node of a tetrahedron cut by cut j gets a block of three enriched dofs for j; dof blocks
 // are numbered after the nodes' own, so the system grows and nothing is remeshed.
 //
-// One cut per tetrahedron for now: a second cut through an already cut tetrahedron is not applied
-// there; the report counts those tetrahedra so the caller can show them.
+// Up to two cuts per tetrahedron, their enrichments added (Koschier et al. 2017). Each point of a
+// tetrahedron lies in a region, its side of each of the tetrahedron's cuts (a bit each), and the
+// field there is the nodes' plus each cut's enrichment on its side. Two cuts that do not cross
+// inside a tetrahedron leave three regions, which the added enrichments separate whole; two that
+// cross leave four, and three linear fields cannot move four pieces independently: those
+// tetrahedra keep their pieces coupled, and the report counts them (`crossed_tets`) so the
+// caller can say so. A third cut through a tetrahedron is not applied there (counted too).
 
 #include "isxfem/moment_fitting.hpp"
 #include "isxfem/plane_cut_system.hpp"
@@ -25,30 +30,68 @@ struct TetMaterial {
     double density = 1000.0; ///< kg/m^3
 };
 
+/// The most cuts a tetrahedron takes (its dof blocks: 4 per node set, 4 + 4 k_max_cuts in all).
+constexpr std::size_t k_max_cuts = 2;
+constexpr std::size_t k_max_blocks = 4 + 4 * k_max_cuts;
+
+/// A cut through an element: its id, its level function and the sides of the element's nodes
+/// (H_i = 1 where phi >= 0), and the dof blocks of the nodes' enrichment for it.
+struct ElementCut {
+    int id = -1;
+    std::array<double, 4> phi{};
+    std::array<unsigned char, 4> node_side{};
+    std::array<std::uint32_t, 4> enriched{};
+};
+
 /// One tetrahedron of the model, with its matrices at rest.
 struct XfemElement {
     std::array<std::uint32_t, 4> node{};
     TetGeometry geometry;
     std::uint32_t material = 0;
-    int cut = -1;                              ///< the cut through it, or -1
-    std::array<std::uint32_t, 4> enriched{};   ///< dof blocks of its nodes' enrichment (when cut)
-    std::array<double, 4> phi{};               ///< the cut's level function at its nodes
-    std::array<unsigned char, 4> node_side{};  ///< H_i
-    std::array<double, 2> side_volume{};       ///< m^3
-    Matrix12d stiffness = Matrix12d::Zero();   ///< whole: K at rest
-    std::array<Matrix24d, 2> side_stiffness{}; ///< cut: K of each side (negative, positive)
-    Matrix24d mass = Matrix24d::Zero();        ///< cut: 24 x 24; whole: the top-left 12 x 12
-    /// Dof blocks of the element's shape functions: its 4 nodes, then (cut) their enrichment.
-    [[nodiscard]] std::size_t block_count() const { return cut >= 0 ? 8 : 4; }
-    [[nodiscard]] std::uint32_t block(std::size_t a) const { return a < 4 ? node[a] : enriched[a - 4]; }
+    std::vector<ElementCut> cuts;            ///< in the order they came (at most k_max_cuts)
+    std::vector<Region> regions;             ///< cut: its non-empty regions
+    bool crossed = false;                    ///< two cuts cross inside: four pieces, not all separable
+    Matrix12d stiffness = Matrix12d::Zero(); ///< whole: K at rest
+    Eigen::MatrixXd mass;                    ///< consistent mass over its dofs, kg
+    [[nodiscard]] bool is_cut() const { return !cuts.empty(); }
+    /// The place of cut `id` among its cuts, or -1.
+    [[nodiscard]] int cut_index(int id) const
+    {
+        for (std::size_t j = 0; j < cuts.size(); ++j)
+            if (cuts[j].id == id) return static_cast<int>(j);
+        return -1;
+    }
+    /// The region of the point with barycentric coordinates `bary` (0 when uncut).
+    [[nodiscard]] unsigned region_at(const std::array<double, 4>& bary) const
+    {
+        unsigned pattern = 0;
+        for (std::size_t j = 0; j < cuts.size(); ++j) {
+            double phi = 0.0;
+            for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * cuts[j].phi[c];
+            if (phi >= 0.0) pattern |= 1u << j;
+        }
+        return pattern;
+    }
+    /// The region node c lies in.
+    [[nodiscard]] unsigned node_region(std::size_t c) const
+    {
+        unsigned pattern = 0;
+        for (std::size_t j = 0; j < cuts.size(); ++j) pattern |= static_cast<unsigned>(cuts[j].node_side[c]) << j;
+        return pattern;
+    }
+    /// Dof blocks of the element's shape functions: its 4 nodes, then each cut's enrichment of them.
+    [[nodiscard]] std::size_t block_count() const { return 4 + 4 * cuts.size(); }
+    [[nodiscard]] std::uint32_t block(std::size_t a) const { return a < 4 ? node[a] : cuts[(a - 4) / 4].enriched[(a - 4) % 4]; }
 };
 
 struct CutReport {
     int cut = -1;                   ///< the cut's id (-1: nothing was cut)
-    std::size_t cut_tets = 0;       ///< newly cut
+    std::size_t cut_tets = 0;       ///< newly cut (by this cut)
+    std::size_t recut_tets = 0;     ///< of them, cut before by another cut: now twice
+    std::size_t crossed_tets = 0;   ///< of those, where the two cuts cross inside: pieces left coupled
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
-    std::size_t already_cut = 0;    ///< crossed but cut before by another cut: left as they were
+    std::size_t already_cut = 0;    ///< crossed but cut k_max_cuts times before: left as they were
 };
 
 class XfemModel {

@@ -29,12 +29,17 @@ Eigen::Matrix3d gradient_of(const std::array<Eigen::Vector3d, 4>& v, const TetGe
     return out;
 }
 
-/// The linear field of side `side` of a cut element: nodal positions x_i + (h - H_i) a_i (exact for
-/// k = 0, the linear part for k > 0), whose gradient gives the side's rotation.
-std::array<Eigen::Vector3d, 4> side_field(const XfemElement& el, const std::vector<Eigen::Vector3d>& x, std::size_t side)
+/// The linear field of region `pattern` of a cut element: nodal positions x_i + sum over its cuts
+/// of (h_j - H_ji) a_ji (exact for k = 0, the linear part for k > 0), whose gradient gives the
+/// region's rotation.
+std::array<Eigen::Vector3d, 4> region_field(const XfemElement& el, const std::vector<Eigen::Vector3d>& x, unsigned pattern)
 {
     std::array<Eigen::Vector3d, 4> p{};
-    for (std::size_t c = 0; c < 4; ++c) p[c] = x[el.node[c]] + (static_cast<double>(side) - el.node_side[c]) * x[el.enriched[c]];
+    for (std::size_t c = 0; c < 4; ++c) {
+        p[c] = x[el.node[c]];
+        for (std::size_t j = 0; j < el.cuts.size(); ++j)
+            p[c] += (static_cast<double>((pattern >> j) & 1u) - el.cuts[j].node_side[c]) * x[el.cuts[j].enriched[c]];
+    }
     return p;
 }
 
@@ -64,20 +69,26 @@ std::vector<std::uint32_t> XfemOperator::model_changed()
     const std::size_t blocks = m_model.block_count();
     const auto old_blocks = static_cast<std::uint32_t>(m_block_mass.rows());
     std::vector<std::uint32_t> changed;
-    m_rotation.resize(elements.size(), {Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity()});
-    m_r.resize(elements.size(), {Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()});
+    const Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+    const Eigen::Matrix3d i3 = Eigen::Matrix3d::Identity();
+    m_rotation.resize(elements.size(), {q, q, q, q});
+    m_r.resize(elements.size(), {i3, i3, i3, i3});
     m_turned_gradient.resize(elements.size());
-    m_was_cut.resize(elements.size(), 0);
+    m_cut_count.resize(elements.size(), 0);
     m_slot_start.assign(elements.size() + 1, 0);
     std::vector<std::uint32_t> count(blocks + 1, 0);
     for (std::size_t e = 0; e < elements.size(); ++e) {
         const XfemElement& el = elements[e];
-        if (el.cut >= 0 && !m_was_cut[e]) { // newly cut: both sides start from its rotation
-            m_rotation[e][1] = m_rotation[e][0];
-            m_r[e][1] = m_r[e][0];
-            m_was_cut[e] = 1;
-            for (std::uint32_t b : el.enriched)
-                if (b < old_blocks) changed.push_back(b);
+        if (el.cuts.size() > m_cut_count[e]) { // newly cut: its new regions start from the rotation of the one they split
+            const unsigned before = 1u << m_cut_count[e];
+            for (unsigned p = before; p < (1u << el.cuts.size()); ++p) {
+                m_rotation[e][p] = m_rotation[e][p % before];
+                m_r[e][p] = m_r[e][p % before];
+            }
+            m_cut_count[e] = static_cast<unsigned char>(el.cuts.size());
+            for (const ElementCut& cut : el.cuts)
+                for (std::uint32_t b : cut.enriched)
+                    if (b < old_blocks) changed.push_back(b);
         }
         const std::size_t n = el.block_count();
         m_slot_start[e + 1] = m_slot_start[e] + static_cast<std::uint32_t>(3 * n);
@@ -167,7 +178,7 @@ void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vect
     parallel(elements.size(), [&](std::size_t e) {
         const XfemElement& el = elements[e];
         double* force = &m_slots[m_slot_start[e]];
-        if (el.cut < 0) {
+        if (!el.is_cut()) {
             // F = I + grad(x - X): from displacements, so an element at rest has exactly no strain.
             std::array<Eigen::Vector3d, 4> displacement{};
             for (std::size_t c = 0; c < 4; ++c) displacement[c] = x[el.node[c]] - rest[el.node[c]];
@@ -179,19 +190,25 @@ void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vect
             m_turned_gradient[e].noalias() = r * el.geometry.gradient.transpose();
             return;
         }
-        Eigen::Map<Eigen::Matrix<double, 24, 1>> f(force);
+        // Every region's rotation (empty ones too: a block's rotation may ask for them), then
+        // each region's stiffness in its own frame.
+        for (unsigned p = 0; p < (1u << el.cuts.size()); ++p) {
+            fem::extract_rotation(gradient_of(region_field(el, x, p), el.geometry), m_rotation[e][p]);
+            m_r[e][p] = m_rotation[e][p].toRotationMatrix();
+        }
+        const auto n = static_cast<Eigen::Index>(3 * el.block_count());
+        Eigen::Map<Eigen::VectorXd> f(force, n);
         f.setZero();
-        for (std::size_t side = 0; side < 2; ++side) {
-            fem::extract_rotation(gradient_of(side_field(el, x, side), el.geometry), m_rotation[e][side]);
-            const Eigen::Matrix3d r = m_r[e][side] = m_rotation[e][side].toRotationMatrix();
-            Eigen::Matrix<double, 24, 1> u;
+        Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * k_max_blocks, 1> u(n);
+        for (const Region& region : el.regions) {
+            const Eigen::Matrix3d& r = m_r[e][region.pattern];
             for (std::size_t c = 0; c < 4; ++c) {
-                const auto i = static_cast<Eigen::Index>(3 * c);
-                u.segment<3>(i) = r.transpose() * (x[el.node[c]] - x[el.node[0]]) - (rest[el.node[c]] - rest[el.node[0]]);
-                u.segment<3>(12 + i) = r.transpose() * x[el.enriched[c]];
+                u.segment<3>(static_cast<Eigen::Index>(3 * c)) = r.transpose() * (x[el.node[c]] - x[el.node[0]]) - (rest[el.node[c]] - rest[el.node[0]]);
+                for (std::size_t j = 0; j < el.cuts.size(); ++j)
+                    u.segment<3>(static_cast<Eigen::Index>(12 + 12 * j + 3 * c)) = r.transpose() * x[el.cuts[j].enriched[c]];
             }
-            const Eigen::Matrix<double, 24, 1> local = el.side_stiffness[side] * u;
-            for (Eigen::Index b = 0; b < 8; ++b) f.segment<3>(3 * b) += r * local.segment<3>(3 * b);
+            const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * k_max_blocks, 1> local = region.stiffness * u;
+            for (Eigen::Index b = 0; b < n / 3; ++b) f.segment<3>(3 * b) += r * local.segment<3>(3 * b);
         }
     });
     parallel(m_model.block_count(), [&](std::size_t b) {
@@ -212,9 +229,10 @@ void XfemOperator::block_rotations(std::vector<Eigen::Quaterniond>& out) const
         for (std::uint32_t t = m_touch_start[b]; t < m_touch_start[b + 1]; ++t) {
             const XfemElement& el = elements[m_touch[t][0]];
             const std::uint32_t corner = m_touch[t][1];
-            std::size_t side = 0;
-            if (el.cut >= 0) side = corner < 4 ? el.node_side[corner] : 1u - el.node_side[corner - 4];
-            fem::accumulate_rotation(sum, m_rotation[m_touch[t][0]][side]);
+            // A node turns with its own region; a jump across cut j with the region across it.
+            unsigned pattern = el.node_region(corner < 4 ? corner : (corner - 4) % 4);
+            if (corner >= 4) pattern ^= 1u << ((corner - 4) / 4);
+            fem::accumulate_rotation(sum, m_rotation[m_touch[t][0]][pattern]);
         }
         out[b] = sum.squaredNorm() > 0.0 ? Eigen::Quaterniond(sum.normalized()) : Eigen::Quaterniond::Identity();
     });
@@ -240,7 +258,7 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
         const auto a = static_cast<Eigen::Index>(m_touch[t][1]);
         const XfemElement& el = elements[e];
         const std::uint32_t* ranks = &m_rank[m_rank_start[t]];
-        if (el.cut < 0) {
+        if (!el.is_cut()) {
             const double lambda = scale_k * m_lame_volume[e][0], mu = scale_k * m_lame_volume[e][1];
             const Eigen::Matrix<double, 3, 4>& turned = m_turned_gradient[e];
             const Eigen::Vector3d ga = turned.col(a);
@@ -252,10 +270,10 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
             }
             continue;
         }
-        for (std::size_t side = 0; side < 2; ++side) {
-            const Eigen::Matrix3d& r = m_r[e][side];
-            for (Eigen::Index b = 0; b < 8; ++b)
-                add(ranks[b], scale_k * r * el.side_stiffness[side].block<3, 3>(3 * a, 3 * b) * r.transpose());
+        for (const Region& region : el.regions) {
+            const Eigen::Matrix3d& r = m_r[e][region.pattern];
+            for (Eigen::Index b = 0; b < static_cast<Eigen::Index>(el.block_count()); ++b)
+                add(ranks[b], scale_k * r * region.stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose());
         }
     }
     // Held dofs: identity rows and columns.
@@ -293,7 +311,7 @@ double XfemOperator::add_to_diagonal(const std::vector<std::uint32_t>& blocks, d
     return shift;
 }
 
-void XfemOperator::add_point_stiffness(std::size_t e, const std::array<double, 8>& w, const Eigen::Matrix3d& m)
+void XfemOperator::add_point_stiffness(std::size_t e, const std::array<double, k_max_blocks>& w, const Eigen::Matrix3d& m)
 {
     const XfemElement& el = m_model.elements()[e];
     for (std::size_t a = 0; a < el.block_count(); ++a) {

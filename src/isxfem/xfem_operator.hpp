@@ -8,8 +8,8 @@
 //   V [lambda g'_a g'_b^T + mu (g'_b g'_a^T + (g_a . g_b) I)],   g' = R g,
 // two outer products, while an element-wise product costs about 130 flops per tetrahedron per
 // CG iteration against about 80 for its share of the assembled rows (measured: 1.3 against
-// 0.35 ms a product on 9,720 tetrahedra). A cut tetrahedron adds each side's 24 x 24 stiffness
-// turned by that side's rotation.
+// 0.35 ms a product on 9,720 tetrahedra). A cut tetrahedron adds each region's stiffness turned
+// by that region's rotation.
 //
 // Every loop runs on all threads without two threads adding to one entry: elements write their
 // forces to their own slots, which each dof block then gathers, and the matrix is filled row block
@@ -53,7 +53,7 @@ public:
     /// Adds w_a w_b m to the 3 x 3 blocks of the matrix between element e's dof blocks a and b
     /// (its local numbering: nodes, then enriched): the stiffness m of a point load acting through
     /// the weights w. Held dofs keep their identity rows and columns; until the next update().
-    void add_point_stiffness(std::size_t e, const std::array<double, 8>& w, const Eigen::Matrix3d& m);
+    void add_point_stiffness(std::size_t e, const std::array<double, k_max_blocks>& w, const Eigen::Matrix3d& m);
 
     /// out = A p, the matrix of the last update().
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
@@ -64,12 +64,13 @@ public:
     /// The elastic forces R K (R^T x - X) of the last update(), N.
     [[nodiscard]] const Eigen::VectorXd& internal_force() const { return m_force; }
     [[nodiscard]] Eigen::VectorXd diagonal() const { return m_matrix.diagonal(); }
-    /// Per element its rotation, and per side for a cut one (side 0: phi < 0).
-    [[nodiscard]] const std::array<Eigen::Quaterniond, 2>& rotation(std::size_t e) const { return m_rotation[e]; }
+    /// Per element its rotation, and per region for a cut one (XfemElement::region_at; with one
+    /// cut, region 0 is phi < 0).
+    [[nodiscard]] const std::array<Eigen::Quaterniond, 1u << k_max_cuts>& rotation(std::size_t e) const { return m_rotation[e]; }
 
-    /// Per dof block the mean rotation of what turns it: a node's whole tetrahedra and its own side
-    /// of the cut ones; an enriched block (the jump across the crack) the other side of its cut
-    /// ones. What a warped preconditioner follows (fem::JumpBlock).
+    /// Per dof block the mean rotation of what turns it: a node's whole tetrahedra and its own region
+    /// of the cut ones; an enriched block (the jump across a crack) the region across that crack
+    /// from its node. What a warped preconditioner follows (fem::JumpBlock).
     void block_rotations(std::vector<Eigen::Quaterniond>& out) const;
 
 private:
@@ -77,12 +78,12 @@ private:
     void fill_row(std::size_t block, double scale_m, double scale_k);
 
     const XfemModel& m_model;
-    std::vector<std::array<Eigen::Quaterniond, 2>> m_rotation;
-    std::vector<std::array<Eigen::Matrix3d, 2>> m_r; ///< the same as matrices
+    std::vector<std::array<Eigen::Quaterniond, 1u << k_max_cuts>> m_rotation; ///< per element, per region
+    std::vector<std::array<Eigen::Matrix3d, 1u << k_max_cuts>> m_r;           ///< the same as matrices
     std::vector<Eigen::Matrix<double, 3, 4>> m_turned_gradient; ///< per whole element: R g_c by corner
-    std::vector<unsigned char> m_was_cut;
+    std::vector<unsigned char> m_cut_count; ///< per element: the cuts its rotations know of
     std::vector<std::array<double, 2>> m_lame_volume; ///< per element: V lambda, V mu
-    std::vector<std::uint32_t> m_slot_start;          ///< per element: first of its 12 or 24 force values in m_slots
+    std::vector<std::uint32_t> m_slot_start;          ///< per element: first of its 3 per dof block force values in m_slots
     std::vector<double> m_slots;
     /// Per block: its elements, as (element, corner) pairs, and where each of that element's
     /// blocks sits in the block's row of the block pattern.

@@ -68,11 +68,11 @@ void XfemSolver::model_changed()
     m_jumps.clear();
     std::vector<unsigned char> seen(blocks, 0);
     for (const XfemElement& el : elements)
-        if (el.cut >= 0)
+        for (const ElementCut& cut : el.cuts)
             for (std::size_t c = 0; c < 4; ++c)
-                if (!seen[el.enriched[c]]) {
-                    seen[el.enriched[c]] = 1;
-                    m_jumps.push_back({el.enriched[c], el.node[c], el.node_side[c] ? -1.0 : 1.0});
+                if (!seen[cut.enriched[c]]) {
+                    seen[cut.enriched[c]] = 1;
+                    m_jumps.push_back({cut.enriched[c], el.node[c], cut.node_side[c] ? -1.0 : 1.0});
                 }
     if (m_preconditioner) {
         m_preconditioner->set_jump_blocks(m_jumps);
@@ -130,7 +130,7 @@ XfemStepStats XfemSolver::step()
     // f(x') ~ f - S (x' - x) adds dt f to the right-hand side and dt^2 w_a w_b S to the matrix.
     for (const PointLoad& l : m_loads) {
         const XfemElement& el = m_model.elements()[l.tet];
-        const std::array<double, 8> w = weights(l.tet, l.bary, l.side);
+        const std::array<double, k_max_blocks> w = weights(l.tet, l.bary, l.side);
         for (std::size_t a = 0; a < el.block_count(); ++a) rhs.segment<3>(3 * static_cast<Eigen::Index>(el.block(a))) += dt * w[a] * l.force_n;
         m_operator.add_point_stiffness(l.tet, w, dt * dt * l.stiffness_n_per_m);
     }
@@ -155,23 +155,26 @@ XfemStepStats XfemSolver::step()
     return s;
 }
 
-std::array<double, 8> XfemSolver::weights(std::size_t t, const std::array<double, 4>& n, int side) const
+std::array<double, k_max_blocks> XfemSolver::weights(std::size_t t, const std::array<double, 4>& n, int region) const
 {
     const XfemElement& el = m_model.elements()[t];
-    std::array<double, 8> w{};
+    std::array<double, k_max_blocks> w{};
     for (std::size_t c = 0; c < 4; ++c) w[c] = n[c];
-    if (el.cut < 0) return w;
-    double gamma = 0.0;
-    for (std::size_t c = 0; c < 4; ++c) gamma += n[c] * el.node_side[c];
     const double k = m_model.k();
-    for (std::size_t c = 0; c < 4; ++c) w[4 + c] = (side - (k * gamma + (1.0 - k) * el.node_side[c])) * n[c]; // psi_c N_c
+    for (std::size_t j = 0; j < el.cuts.size(); ++j) {
+        const ElementCut& cut = el.cuts[j];
+        double gamma = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) gamma += n[c] * cut.node_side[c];
+        const double h = (static_cast<unsigned>(region) >> j) & 1u;
+        for (std::size_t c = 0; c < 4; ++c) w[4 + 4 * j + c] = (h - (k * gamma + (1.0 - k) * cut.node_side[c])) * n[c]; // psi_jc N_c
+    }
     return w;
 }
 
-Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>& n, int side) const
+Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>& n, int region) const
 {
     const XfemElement& el = m_model.elements()[t];
-    const std::array<double, 8> w = weights(t, n, side);
+    const std::array<double, k_max_blocks> w = weights(t, n, region);
     Eigen::Vector3d p = Eigen::Vector3d::Zero();
     for (std::size_t a = 0; a < el.block_count(); ++a) p += w[a] * m_x[el.block(a)];
     return p;

@@ -45,8 +45,9 @@ struct XfemOptions {
     void validate() const;
 };
 
-/// A force at a material point (tool contact): tetrahedron, barycentric coordinates and side (of
-/// its cut, 0 when uncut), the force at the current positions and its stiffness -d force / d x.
+/// A force at a material point (tool contact): tetrahedron, barycentric coordinates and region
+/// (XfemElement::region_at: its side of each cut, 0 when uncut), the force at the current positions
+/// and its stiffness -d force / d x.
 struct PointLoad {
     std::size_t tet = 0;
     std::array<double, 4> bary{};
@@ -92,13 +93,14 @@ public:
     /// Forces at material points for the following steps (replacing the last ones), taken
     /// implicitly with their stiffness. Throws std::out_of_range for a tetrahedron that is not there.
     void set_point_loads(std::vector<PointLoad> loads);
-    /// The weights of the dof blocks of tetrahedron t (its nodes, then when cut their enriched
-    /// blocks: psi_c N_c) at the point with barycentric coordinates `n` on side `side`: the point
-    /// moves by sum_a w_a x_a, and a force f there acts on block a as w_a f.
-    [[nodiscard]] std::array<double, 8> weights(std::size_t t, const std::array<double, 4>& n, int side) const;
-    /// World position of the material point with barycentric coordinates `n` in tetrahedron t,
-    /// on side `side` (0: phi < 0, 1: phi >= 0) when the tetrahedron is cut.
-    [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int side) const;
+    /// The weights of the dof blocks of tetrahedron t (its nodes, then per cut their enriched
+    /// blocks: psi_jc N_c) at the point with barycentric coordinates `n` in region `region`
+    /// (XfemElement::region_at): the point moves by sum_a w_a x_a, and a force f there acts on
+    /// block a as w_a f.
+    [[nodiscard]] std::array<double, k_max_blocks> weights(std::size_t t, const std::array<double, 4>& n, int region) const;
+    /// World position of the material point with barycentric coordinates `n` in tetrahedron t, in
+    /// region `region` when the tetrahedron is cut (one cut: 0 where phi < 0, 1 where phi >= 0).
+    [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int region) const;
     [[nodiscard]] double kinetic_energy() const;
     [[nodiscard]] Eigen::Vector3d momentum() const;
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }

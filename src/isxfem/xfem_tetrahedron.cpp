@@ -1,5 +1,8 @@
 #include "isxfem/xfem_tetrahedron.hpp"
 
+#include "isxfem/cut_tetrahedron.hpp"
+#include "isxfem/simplex_rule.hpp"
+
 #include <Eigen/LU>
 
 #include <cmath>
@@ -13,6 +16,30 @@ namespace {
 Eigen::Matrix3d elastic_block(const Eigen::Vector3d& ga, const Eigen::Vector3d& gb, const grid::Lame& lame)
 {
     return lame.lambda * ga * gb.transpose() + lame.mu * (gb * ga.transpose() + ga.dot(gb) * Eigen::Matrix3d::Identity());
+}
+
+/// The parts of `pieces` (reference coordinates) on one side of the linear function with values
+/// `phi` at the reference vertices.
+std::vector<Piece> clip(const std::vector<Piece>& pieces, const std::array<double, 4>& phi, bool positive)
+{
+    std::vector<Piece> out;
+    for (const Piece& p : pieces) {
+        std::array<double, 4> at{}; // phi at the piece's corners
+        for (int k = 0; k < 4; ++k) {
+            const Eigen::Vector3d xi = k == 0 ? p.corner : Eigen::Vector3d(p.corner + p.edges.col(k - 1));
+            const std::array<double, 4> n{1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
+            for (std::size_t l = 0; l < 4; ++l) at[static_cast<std::size_t>(k)] += n[l] * phi[l];
+        }
+        const CutSides sides = split_reference_tetrahedron(at);
+        for (const Piece& s : positive ? sides.positive : sides.negative) {
+            Piece q;
+            q.corner = p.corner + p.edges * s.corner;
+            q.edges = p.edges * s.edges;
+            q.volume = 6.0 * p.volume * s.volume;
+            if (q.volume > 0.0) out.push_back(q);
+        }
+    }
+    return out;
 }
 
 } // namespace
@@ -89,6 +116,64 @@ CutTet cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::array<double,
         }
     }
     out.stiffness = out.side_stiffness[0] + out.side_stiffness[1];
+    return out;
+}
+
+MultiCutTet multi_cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::vector<std::array<double, 4>>& phi, double k,
+                          const grid::Lame& lame, double density)
+{
+    if (!(k >= 0.0 && k <= 1.0)) throw std::invalid_argument("multi_cut_tet: k must be in [0, 1]");
+    const TetGeometry g = tet_geometry(x);
+    const std::size_t cuts = phi.size(), blocks = 4 + 4 * cuts;
+    const auto n_dofs = static_cast<Eigen::Index>(3 * blocks);
+    MultiCutTet out;
+    out.mass = Eigen::MatrixXd::Zero(n_dofs, n_dofs);
+    out.node_side.resize(cuts);
+    std::vector<Eigen::Vector3d> grad_gamma(cuts, Eigen::Vector3d::Zero());
+    for (std::size_t j = 0; j < cuts; ++j)
+        for (std::size_t c = 0; c < 4; ++c) {
+            out.node_side[j][c] = phi[j][c] >= 0.0 ? 1 : 0;
+            if (out.node_side[j][c]) grad_gamma[j] += g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
+        }
+    const SimplexRule rule = grundmann_moeller_tetrahedron(2); // degree 5: the mass's integrands are of degree 4
+    std::vector<double> value(blocks);
+    std::vector<Eigen::Vector3d> grad(blocks);
+    for (unsigned pattern = 0; pattern < (1u << cuts); ++pattern) {
+        std::vector<Piece> pieces{whole_tetrahedron()};
+        for (std::size_t j = 0; j < cuts && !pieces.empty(); ++j) pieces = clip(pieces, phi[j], (pattern >> j) & 1u);
+        Region region;
+        region.pattern = pattern;
+        for (const Piece& p : pieces) region.volume += 6.0 * g.volume * p.volume;
+        if (!(region.volume > 0.0)) continue;
+        region.stiffness = Eigen::MatrixXd::Zero(n_dofs, n_dofs);
+        for (const Piece& p : pieces)
+            for (std::size_t q = 0; q < rule.points.size(); ++q) {
+                const double weight = 6.0 * g.volume * 6.0 * p.volume * rule.weights[q];
+                const Eigen::Vector3d xi = p.corner + p.edges * rule.points[q];
+                const std::array<double, 4> n{1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
+                for (std::size_t c = 0; c < 4; ++c) {
+                    value[c] = n[c];
+                    grad[c] = g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
+                }
+                for (std::size_t j = 0; j < cuts; ++j) {
+                    double gamma = 0.0;
+                    for (std::size_t m = 0; m < 4; ++m) gamma += out.node_side[j][m] * n[m];
+                    const double h = (pattern >> j) & 1u;
+                    for (std::size_t c = 0; c < 4; ++c) {
+                        const double psi = h - (k * gamma + (1.0 - k) * out.node_side[j][c]);
+                        value[4 + 4 * j + c] = psi * n[c];
+                        grad[4 + 4 * j + c] = psi * grad[c] - k * n[c] * grad_gamma[j];
+                    }
+                }
+                for (std::size_t a = 0; a < blocks; ++a)
+                    for (std::size_t b = 0; b < blocks; ++b) {
+                        const auto ia = static_cast<Eigen::Index>(3 * a), ib = static_cast<Eigen::Index>(3 * b);
+                        region.stiffness.block<3, 3>(ia, ib) += weight * elastic_block(grad[a], grad[b], lame);
+                        out.mass.block<3, 3>(ia, ib).diagonal().array() += weight * density * value[a] * value[b];
+                    }
+            }
+        out.regions.push_back(std::move(region));
+    }
     return out;
 }
 

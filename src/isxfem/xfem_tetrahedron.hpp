@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <vector>
 
 namespace vox::isxfem {
 
@@ -53,5 +54,28 @@ struct CutTet {
 /// `phi`: the cut's level function at the four nodes (linear in the tetrahedron); `k` in [0, 1].
 CutTet cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::array<double, 4>& phi, double k, const grid::Lame& lame,
                double density, const MomentFitting& fitting);
+
+/// A non-empty region of a tetrahedron cut by several planes: its side of each cut (bit j for cut
+/// j), its volume and its stiffness at rest over the element's dofs.
+struct Region {
+    unsigned pattern = 0;
+    double volume = 0.0; ///< m^3
+    Eigen::MatrixXd stiffness;
+};
+
+/// A tetrahedron cut by several planes, the cuts' enrichments added: matrices over [u_0 .. u_3,
+/// then per cut j its a_0 .. a_3].
+struct MultiCutTet {
+    std::vector<Region> regions;                         ///< the non-empty ones
+    Eigen::MatrixXd mass;                                ///< kg
+    std::vector<std::array<unsigned char, 4>> node_side; ///< per cut, H_i
+};
+
+/// `phi`: per cut its level function at the four nodes. Each region is clipped out of the
+/// tetrahedron plane by plane (split_reference_tetrahedron) and its integrands, polynomials of
+/// degree 4 at most, integrated exactly on its pieces by a Grundmann-Moeller rule of degree 5
+/// (each region directly, so a small one is as accurate as a large one).
+MultiCutTet multi_cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::vector<std::array<double, 4>>& phi, double k,
+                          const grid::Lame& lame, double density);
 
 } // namespace vox::isxfem

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <set>
 
 using namespace vox::isxfem;
@@ -57,6 +58,7 @@ void box_surface(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double st
 }
 
 struct Closed {
+    std::shared_ptr<XfemModel> model;
     std::vector<SurfacePoint> points;
     std::vector<Eigen::Vector3i> triangles;
     ClosureCounts counts;
@@ -66,12 +68,14 @@ struct Closed {
 /// (triangles of about `step`; with `cavity`, a void inside it too), cut by the plane x = 3.1 where `inside` holds, then closed. With
 /// the default step the surface's vertices lie on y = 2 and z = 2, where the cubes' faces are: the
 /// crack's front runs along the surface's edges and meets the surface at its vertices.
-Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false)
+Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false,
+               const PlaneCut* second = nullptr)
 {
-    XfemModel model(cube_lattice({6, 4, 4}, 1.0), {TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
-                    std::vector<std::uint32_t>(6 * 96, 0), 0.1);
-    std::vector<Eigen::Vector3d> x;
     Closed out;
+    out.model = std::make_shared<XfemModel>(cube_lattice({6, 4, 4}, 1.0), std::vector<TetMaterial>{TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
+                                            std::vector<std::uint32_t>(6 * 96, 0), 0.1);
+    XfemModel& model = *out.model;
+    std::vector<Eigen::Vector3d> x;
     box_surface({0.05, 0.05, 0.05}, {5.95, 3.95, 3.95}, step, x, out.triangles);
     if (cavity) { // a void [2.5, 3.7] x [1.3, 2.7]^2 inside: its surface faces into it
         std::vector<Eigen::Vector3i> inner;
@@ -84,12 +88,21 @@ Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double
     const auto neighbours = face_neighbours(model.mesh());
     const CutReport report = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}, inside);
     EXPECT_GT(report.cut_tets, 0u);
+    CutReport again;
+    if (second) again = model.cut(*second);
     const CutClosure closure(model);
     for (const Eigen::Vector3d& p : x) {
         const auto [tet, bary] = walk_to(model.mesh(), neighbours, 0, p);
         out.points.push_back({tet, bary, closure.side_of(tet, bary), p, 0});
     }
     out.counts = closure.close(report.cut, out.points, out.triangles);
+    if (second) {
+        EXPECT_GT(again.crossed_tets, 0u);
+        const ClosureCounts more = closure.close(again.cut, out.points, out.triangles);
+        out.counts.faces += more.faces;
+        out.counts.slit_faces += more.slit_faces;
+        out.counts.open_chains += more.open_chains;
+    }
     return out;
 }
 
@@ -111,8 +124,9 @@ void expect_closed(const Closed& c)
     EXPECT_GT(once_each_way, 0);
 }
 
-/// Volume enclosed (divergence theorem) and area of the triangles lying in the plane x = 3.1.
-std::pair<double, double> volume_and_crack_area(const Closed& c)
+/// Volume enclosed (divergence theorem) and area of the triangles lying in the plane x = 3.1 (or
+/// y = `y` when given).
+std::pair<double, double> volume_and_crack_area(const Closed& c, double y = NAN)
 {
     double volume = 0.0, crack = 0.0;
     for (const Eigen::Vector3i& t : c.triangles) {
@@ -120,9 +134,40 @@ std::pair<double, double> volume_and_crack_area(const Closed& c)
         const Eigen::Vector3d& b = c.points[static_cast<std::size_t>(t[1])].rest_m;
         const Eigen::Vector3d& d = c.points[static_cast<std::size_t>(t[2])].rest_m;
         volume += a.dot(b.cross(d)) / 6.0;
-        if (std::abs(a.x() - 3.1) < 1e-9 && std::abs(b.x() - 3.1) < 1e-9 && std::abs(d.x() - 3.1) < 1e-9) crack += 0.5 * (b - a).cross(d - a).norm();
+        const bool on_x = std::abs(a.x() - 3.1) < 1e-9 && std::abs(b.x() - 3.1) < 1e-9 && std::abs(d.x() - 3.1) < 1e-9;
+        const bool on_y = std::abs(a.y() - y) < 1e-9 && std::abs(b.y() - y) < 1e-9 && std::abs(d.y() - y) < 1e-9;
+        if (std::isnan(y) ? on_x : on_y) crack += 0.5 * (b - a).cross(d - a).norm();
     }
     return {volume, crack};
+}
+
+/// Every piece of the surface lies on one side of each cut: where a point's tetrahedron was cut,
+/// its region says which; elsewhere its rest position (off the plane) does.
+void expect_pieces_on_one_side(const Closed& c)
+{
+    std::vector<int> parent(c.points.size());
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+    std::function<int(int)> root = [&](int i) { return parent[static_cast<std::size_t>(i)] == i ? i : parent[static_cast<std::size_t>(i)] = root(parent[static_cast<std::size_t>(i)]); };
+    for (const Eigen::Vector3i& t : c.triangles)
+        for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(t[k]))] = root(t[0]);
+    for (int cut = 0; cut < c.model->cut_count(); ++cut) {
+        std::map<int, int> side_of_piece;
+        int disagreements = 0;
+        for (std::size_t i = 0; i < c.points.size(); ++i) {
+            const SurfacePoint& p = c.points[i];
+            const XfemElement& el = c.model->elements()[p.tet];
+            const int at = el.cut_index(cut);
+            int side = -1;
+            if (at >= 0)
+                side = (p.side >> at) & 1;
+            else if (std::abs(c.model->cut_plane(cut).at(p.rest_m)) > 1e-9)
+                side = c.model->cut_plane(cut).at(p.rest_m) > 0.0;
+            if (side < 0) continue;
+            const auto [it, fresh] = side_of_piece.try_emplace(root(static_cast<int>(i)), side);
+            if (!fresh && it->second != side) ++disagreements;
+        }
+        EXPECT_EQ(disagreements, 0) << "cut " << cut;
+    }
 }
 
 /// Connected pieces when the two sides of the crack are told apart (a vertex on the crack is one
@@ -151,6 +196,7 @@ TEST(CutClosure, ACutThroughTheObjectLeavesTwoClosedPieces)
     EXPECT_EQ(c.counts.open_chains, 0u);
     expect_closed(c);
     EXPECT_EQ(pieces(c), 2);
+    expect_pieces_on_one_side(c);
     const auto [volume, crack] = volume_and_crack_area(c);
     EXPECT_NEAR(volume, 5.9 * 3.9 * 3.9, 1e-9);
     EXPECT_NEAR(crack, 2.0 * 3.9 * 3.9,
@@ -215,4 +261,21 @@ TEST(CutClosure, ACavityLeavesAHoleInTheFaces)
         EXPECT_NEAR(volume, 5.9 * 3.9 * 3.9 - cavity_volume, 1e-9);
         EXPECT_NEAR(crack, 2.0 * (3.9 * (3.95 - 2.0) - 1.4 * (2.7 - 2.0)), 1e-9);
     }
+}
+
+TEST(CutClosure, TwoCrossingCutsLeaveFourClosedPieces)
+{
+    // Across at x = 3.1, then lengthwise at y = 2.1: the second splits the first's faces too, and
+    // its own faces run over them (each side of the first cut its own loop).
+    const PlaneCut lengthwise{Eigen::Vector3d::UnitY(), 2.1};
+    const Closed c = cut_box({}, 0.37, false, &lengthwise);
+    EXPECT_EQ(c.counts.faces, 3u); // one across, two lengthwise (one each side of the first)
+    EXPECT_EQ(c.counts.open_chains, 0u);
+    expect_closed(c);
+    EXPECT_EQ(pieces(c), 4);
+    expect_pieces_on_one_side(c);
+    const double across = volume_and_crack_area(c).second, along = volume_and_crack_area(c, 2.1).second;
+    EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
+    EXPECT_NEAR(across, 2.0 * 3.9 * 3.9, 1e-9);
+    EXPECT_NEAR(along, 2.0 * 5.9 * 3.9, 1e-9);
 }

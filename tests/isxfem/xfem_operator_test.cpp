@@ -1,7 +1,8 @@
 // The step's system, assembled from the tetrahedra's gradients row block by row block on all
 // threads, against a plain dense assembly of every element's own matrices (XfemElement::stiffness,
-// side_stiffness, mass) turned by the operator's rotations; the rotations against the polar factor
-// from an SVD; the forces, products and held dofs likewise.
+// its regions' stiffness, mass) turned by the operator's rotations, on a bar cut once and on one
+// cut again lengthwise (tetrahedra cut twice, some where the cuts cross); the rotations against
+// the polar factor from an SVD; the forces, products and held dofs likewise.
 
 #include "isxfem/xfem_operator.hpp"
 
@@ -21,9 +22,9 @@ struct Deformed {
     std::vector<unsigned char> fixed;
 };
 
-/// A 4 x 2 x 2 bar cut across, turned by 0.7 rad, stretched and shaken; its enriched blocks open
-/// the cut by a few millimetres; the nodes at x = 0 held.
-Deformed deformed_bar()
+/// A 4 x 2 x 2 bar cut across (and with `twice` lengthwise too), turned by 0.7 rad, stretched and
+/// shaken; its enriched blocks open the cuts by a few millimetres; the nodes at x = 0 held.
+Deformed deformed_bar(bool twice = false)
 {
     TetMesh bar = cube_lattice({4, 2, 2}, 0.01);
     const std::size_t tets = bar.tets.size();
@@ -32,6 +33,11 @@ Deformed deformed_bar()
                {},
                {}};
     d.model.cut(PlaneCut{Eigen::Vector3d(1.0, 0.2, 0.1).normalized(), 0.021});
+    if (twice) {
+        const CutReport r = d.model.cut(PlaneCut{Eigen::Vector3d(0.1, 1.0, 0.2).normalized(), 0.0105});
+        EXPECT_GT(r.recut_tets, 0u);
+        EXPECT_GT(r.crossed_tets, 0u);
+    }
     std::mt19937 random(7);
     std::uniform_real_distribution<double> shake(-1e-3, 1e-3);
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
@@ -54,87 +60,92 @@ Deformed deformed_bar()
 
 TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
 {
-    Deformed d = deformed_bar();
-    const XfemModel& model = d.model;
-    ASSERT_GT(model.block_count(), model.node_count());
-    XfemOperator op(model);
-    const double scale_m = 1.05, scale_k = 1.2e-4;
-    op.update(d.x, d.fixed, scale_m, scale_k);
-    const Eigen::MatrixXd first(op.matrix());
-    const Eigen::VectorXd first_force = op.internal_force();
-    op.update(d.x, d.fixed, scale_m, scale_k); // a second, warm-started update changes nothing
-    EXPECT_LT((Eigen::MatrixXd(op.matrix()) - first).cwiseAbs().maxCoeff(), 1e-12 * first.cwiseAbs().maxCoeff());
-    EXPECT_LT((op.internal_force() - first_force).norm(), 1e-10 * first_force.norm());
+    for (const bool twice : {false, true}) {
+        SCOPED_TRACE(twice ? "cut twice" : "cut once");
+        Deformed d = deformed_bar(twice);
+        const XfemModel& model = d.model;
+        ASSERT_GT(model.block_count(), model.node_count());
+        XfemOperator op(model);
+        const double scale_m = 1.05, scale_k = 1.2e-4;
+        op.update(d.x, d.fixed, scale_m, scale_k);
+        const Eigen::MatrixXd first(op.matrix());
+        const Eigen::VectorXd first_force = op.internal_force();
+        op.update(d.x, d.fixed, scale_m, scale_k); // a second, warm-started update changes nothing
+        EXPECT_LT((Eigen::MatrixXd(op.matrix()) - first).cwiseAbs().maxCoeff(), 1e-12 * first.cwiseAbs().maxCoeff());
+        EXPECT_LT((op.internal_force() - first_force).norm(), 1e-10 * first_force.norm());
 
-    const auto n = static_cast<Eigen::Index>(3 * model.block_count());
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n), mass = Eigen::MatrixXd::Zero(n, n);
-    Eigen::VectorXd force = Eigen::VectorXd::Zero(n);
-    int whole = 0;
-    for (std::size_t e = 0; e < model.elements().size(); ++e) {
-        const XfemElement& el = model.elements()[e];
-        const auto blocks = static_cast<Eigen::Index>(el.block_count());
-        for (std::size_t side = 0; side < (el.cut >= 0 ? 2u : 1u); ++side) {
-            const Eigen::Matrix3d r = op.rotation(e)[side].toRotationMatrix();
-            const Eigen::MatrixXd k = el.cut >= 0 ? Eigen::MatrixXd(el.side_stiffness[side]) : Eigen::MatrixXd(el.stiffness);
-            Eigen::VectorXd u(3 * blocks);
-            for (Eigen::Index i = 0; i < blocks; ++i) {
-                const auto b = el.block(static_cast<std::size_t>(i));
-                u.segment<3>(3 * i) = i < 4 ? Eigen::Vector3d(r.transpose() * d.x[b] - model.mesh().nodes[b]) : Eigen::Vector3d(r.transpose() * d.x[b]);
-            }
-            const Eigen::VectorXd local = k * u;
-            for (Eigen::Index i = 0; i < blocks; ++i) {
-                const auto bi = 3 * static_cast<Eigen::Index>(el.block(static_cast<std::size_t>(i)));
-                force.segment<3>(bi) += r * local.segment<3>(3 * i);
-                for (Eigen::Index j = 0; j < blocks; ++j) {
-                    const auto bj = 3 * static_cast<Eigen::Index>(el.block(static_cast<std::size_t>(j)));
-                    a.block<3, 3>(bi, bj) += scale_k * r * k.block<3, 3>(3 * i, 3 * j) * r.transpose();
-                    if (side == 0) mass.block<3, 3>(bi, bj) += el.mass.block<3, 3>(3 * i, 3 * j);
+        const auto n = static_cast<Eigen::Index>(3 * model.block_count());
+        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n), mass = Eigen::MatrixXd::Zero(n, n);
+        Eigen::VectorXd force = Eigen::VectorXd::Zero(n);
+        int whole = 0;
+        for (std::size_t e = 0; e < model.elements().size(); ++e) {
+            const XfemElement& el = model.elements()[e];
+            const auto blocks = static_cast<Eigen::Index>(el.block_count());
+            for (std::size_t region = 0; region < std::max<std::size_t>(el.regions.size(), 1); ++region) {
+                const unsigned pattern = el.is_cut() ? el.regions[region].pattern : 0u;
+                const Eigen::Matrix3d r = op.rotation(e)[pattern].toRotationMatrix();
+                const Eigen::MatrixXd k = el.is_cut() ? el.regions[region].stiffness : Eigen::MatrixXd(el.stiffness);
+                Eigen::VectorXd u(3 * blocks);
+                for (Eigen::Index i = 0; i < blocks; ++i) {
+                    const auto b = el.block(static_cast<std::size_t>(i));
+                    u.segment<3>(3 * i) =
+                        i < 4 ? Eigen::Vector3d(r.transpose() * d.x[b] - model.mesh().nodes[b]) : Eigen::Vector3d(r.transpose() * d.x[b]);
+                }
+                const Eigen::VectorXd local = k * u;
+                for (Eigen::Index i = 0; i < blocks; ++i) {
+                    const auto bi = 3 * static_cast<Eigen::Index>(el.block(static_cast<std::size_t>(i)));
+                    force.segment<3>(bi) += r * local.segment<3>(3 * i);
+                    for (Eigen::Index j = 0; j < blocks; ++j) {
+                        const auto bj = 3 * static_cast<Eigen::Index>(el.block(static_cast<std::size_t>(j)));
+                        a.block<3, 3>(bi, bj) += scale_k * r * k.block<3, 3>(3 * i, 3 * j) * r.transpose();
+                        if (region == 0) mass.block<3, 3>(bi, bj) += el.mass.block<3, 3>(3 * i, 3 * j);
+                    }
                 }
             }
-        }
-        if (el.cut < 0 && whole++ < 20) { // the rotation is the polar factor of F
-            Eigen::Matrix3d dx, dX;
-            for (int c = 0; c < 3; ++c) {
-                dx.col(c) = d.x[el.node[static_cast<std::size_t>(c + 1)]] - d.x[el.node[0]];
-                dX.col(c) = model.mesh().nodes[el.node[static_cast<std::size_t>(c + 1)]] - model.mesh().nodes[el.node[0]];
+            if (!el.is_cut() && whole++ < 20) { // the rotation is the polar factor of F
+                Eigen::Matrix3d dx, dX;
+                for (int c = 0; c < 3; ++c) {
+                    dx.col(c) = d.x[el.node[static_cast<std::size_t>(c + 1)]] - d.x[el.node[0]];
+                    dX.col(c) = model.mesh().nodes[el.node[static_cast<std::size_t>(c + 1)]] - model.mesh().nodes[el.node[0]];
+                }
+                const Eigen::JacobiSVD<Eigen::Matrix3d> svd(dx * dX.inverse(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+                EXPECT_LT((op.rotation(e)[0].toRotationMatrix() - svd.matrixU() * svd.matrixV().transpose()).norm(), 1e-11);
             }
-            const Eigen::JacobiSVD<Eigen::Matrix3d> svd(dx * dX.inverse(), Eigen::ComputeFullU | Eigen::ComputeFullV);
-            EXPECT_LT((op.rotation(e)[0].toRotationMatrix() - svd.matrixU() * svd.matrixV().transpose()).norm(), 1e-11);
         }
-    }
-    a += scale_m * mass;
-    for (Eigen::Index i = 0; i < n; ++i)
-        if (d.fixed[static_cast<std::size_t>(i)]) {
-            a.row(i).setZero();
-            a.col(i).setZero();
-            a(i, i) = 1.0;
-        }
-    const Eigen::MatrixXd assembled(op.matrix());
-    EXPECT_LT((assembled - a).cwiseAbs().maxCoeff(), 1e-12 * a.cwiseAbs().maxCoeff());
-    EXPECT_LT((op.internal_force() - force).norm(), 1e-10 * force.norm());
-    EXPECT_LT((op.diagonal() - a.diagonal()).norm(), 1e-12 * a.diagonal().norm());
-    const Eigen::VectorXd p = Eigen::VectorXd::Random(n);
-    Eigen::VectorXd ap, mp;
-    op.multiply(p, ap);
-    op.mass_multiply(p, mp);
-    EXPECT_LT((ap - a * p).norm(), 1e-12 * (a * p).norm());
-    EXPECT_LT((mp - mass * p).norm(), 1e-12 * (mass * p).norm());
+        a += scale_m * mass;
+        for (Eigen::Index i = 0; i < n; ++i)
+            if (d.fixed[static_cast<std::size_t>(i)]) {
+                a.row(i).setZero();
+                a.col(i).setZero();
+                a(i, i) = 1.0;
+            }
+        const Eigen::MatrixXd assembled(op.matrix());
+        EXPECT_LT((assembled - a).cwiseAbs().maxCoeff(), 1e-12 * a.cwiseAbs().maxCoeff());
+        EXPECT_LT((op.internal_force() - force).norm(), 1e-10 * force.norm());
+        EXPECT_LT((op.diagonal() - a.diagonal()).norm(), 1e-12 * a.diagonal().norm());
+        const Eigen::VectorXd p = Eigen::VectorXd::Random(n);
+        Eigen::VectorXd ap, mp;
+        op.multiply(p, ap);
+        op.mass_multiply(p, mp);
+        EXPECT_LT((ap - a * p).norm(), 1e-12 * (a * p).norm());
+        EXPECT_LT((mp - mass * p).norm(), 1e-12 * (mass * p).norm());
 
-    // The regularisation adds the same to the free diagonal entries of the blocks it is given.
-    const auto jump = static_cast<std::uint32_t>(model.node_count());
-    const Eigen::VectorXd before = op.diagonal();
-    const double shift = op.add_to_diagonal({jump}, 1e-3);
-    double mean = 0.0;
-    int count = 0;
-    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(3 * model.node_count()); ++i)
-        if (!d.fixed[static_cast<std::size_t>(i)]) {
-            mean += before[i];
-            ++count;
-        }
-    EXPECT_NEAR(shift, 1e-3 * mean / count, 1e-12 * shift);
-    const Eigen::VectorXd added = op.diagonal() - before;
-    for (Eigen::Index i = 0; i < n; ++i)
-        EXPECT_NEAR(added[i], i / 3 == jump && !d.fixed[static_cast<std::size_t>(i)] ? shift : 0.0, 1e-12 * before.cwiseAbs().maxCoeff()) << i;
+        // The regularisation adds the same to the free diagonal entries of the blocks it is given.
+        const auto jump = static_cast<std::uint32_t>(model.node_count());
+        const Eigen::VectorXd before = op.diagonal();
+        const double shift = op.add_to_diagonal({jump}, 1e-3);
+        double mean = 0.0;
+        int count = 0;
+        for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(3 * model.node_count()); ++i)
+            if (!d.fixed[static_cast<std::size_t>(i)]) {
+                mean += before[i];
+                ++count;
+            }
+        EXPECT_NEAR(shift, 1e-3 * mean / count, 1e-12 * shift);
+        const Eigen::VectorXd added = op.diagonal() - before;
+        for (Eigen::Index i = 0; i < n; ++i)
+            EXPECT_NEAR(added[i], i / 3 == jump && !d.fixed[static_cast<std::size_t>(i)] ? shift : 0.0, 1e-12 * before.cwiseAbs().maxCoeff()) << i;
+    }
 }
 
 TEST(XfemOperator, AtRestHasNoForceAndTheRotationsStayIdentity)

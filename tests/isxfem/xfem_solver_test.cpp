@@ -1,8 +1,9 @@
 // The Is-XFEM solver: a free bar keeps its momentum; a bar held at one end and cut through falls in
 // two, the far piece as a body in free fall (implicit Euler's own free fall, to 10 %), the held
 // piece staying, for k = 0 and k = 0.1; uncut, the same bar only sags; a cut made at rest moves
-// nothing; only cuts that separate a tetrahedron whole are kept; after a cut the warped factor is
-// kept and patched, and stays a sound preconditioner.
+// nothing; only cuts that separate a tetrahedron whole are kept; two cuts through one slab cut it
+// in three (the slice falls too); cuts crossing inside a tetrahedron are counted; after a cut the
+// warped factor is kept and patched, and stays a sound preconditioner.
 
 #include "isxfem/xfem_solver.hpp"
 
@@ -111,9 +112,85 @@ TEST(XfemSolver, ACutAtRestMovesNothingAndPartialCutsAreLeft)
     const XfemStepStats s = solver.step(); // no gravity, at rest: nothing moves
     EXPECT_EQ(s.cg_iterations, 0);
     EXPECT_EQ(solver.kinetic_energy(), 0.0);
-    // A second cut through the same tetrahedra leaves them as they are, and says so.
+    // A second cut through the same tetrahedra cuts them again (parallel: nothing crossed); a
+    // third leaves them as they are, and says so.
     const CutReport again = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0441});
-    EXPECT_EQ(again.already_cut, r.cut_tets);
+    EXPECT_EQ(again.recut_tets, r.cut_tets);
+    EXPECT_EQ(again.crossed_tets, 0u);
+    const CutReport third = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0445});
+    EXPECT_EQ(third.already_cut, r.cut_tets);
+}
+
+TEST(XfemSolver, TwoCutsThroughOneSlabCutItInThree)
+{
+    // Both planes cross the same slab of tetrahedra, 2.5 mm apart: its tetrahedra hold three
+    // regions each, which the two enrichments separate whole. The thin slice between the planes
+    // falls free as well as the far piece; the held piece stays.
+    XfemModel model = bar_model(0.1);
+    const CutReport first = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0437});
+    const CutReport second = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0462});
+    EXPECT_EQ(second.cut_tets, first.cut_tets);
+    EXPECT_EQ(second.recut_tets, first.cut_tets);
+    EXPECT_EQ(second.crossed_tets, 0u);
+    for (const XfemElement& el : model.elements()) {
+        if (el.cuts.size() == 2) {
+            EXPECT_EQ(el.regions.size(), 3u) << "two parallel planes leave three regions";
+        }
+    }
+    XfemOptions o;
+    o.cg_tolerance = 1e-8;
+    XfemSolver solver(model, o);
+    solver.set_gravity({0, 0, -9.81});
+    for (std::size_t n = 0; n < model.node_count(); ++n)
+        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    // A material point in the slice: x = 45 mm, in a tetrahedron cut twice.
+    std::size_t slice_tet = model.elements().size();
+    std::array<double, 4> bary{};
+    for (std::size_t t = 0; t < model.elements().size() && slice_tet == model.elements().size(); ++t) {
+        if (model.elements()[t].cuts.size() != 2) continue;
+        const std::array<double, 4> b = barycentric(model.mesh(), t, Eigen::Vector3d(0.045, 0.005, 0.005));
+        if (*std::min_element(b.begin(), b.end()) >= 0.0) {
+            slice_tet = t;
+            bary = b;
+        }
+    }
+    ASSERT_LT(slice_tet, model.elements().size());
+    const int slice = static_cast<int>(model.elements()[slice_tet].region_at(bary));
+    EXPECT_EQ(slice, 1); // past the first plane, before the second
+    const double slice0 = solver.position(slice_tet, bary, slice).z(), far0 = mean_z(model, solver, 0.055, 1.0),
+                 near0 = mean_z(model, solver, 0.0, 0.025);
+    const int steps = 10;
+    for (int s = 0; s < steps; ++s) ASSERT_TRUE(solver.step().converged) << "step " << s;
+    const double free_fall = 0.5 * 9.81 * 1e-4 * steps * (steps + 1);
+    EXPECT_NEAR(slice0 - solver.position(slice_tet, bary, slice).z(), free_fall, 0.1 * free_fall);
+    EXPECT_NEAR(far0 - mean_z(model, solver, 0.055, 1.0), free_fall, 0.1 * free_fall);
+    EXPECT_LT(near0 - mean_z(model, solver, 0.0, 0.025), 0.005);
+}
+
+TEST(XfemSolver, CutsThatCrossInsideATetrahedronAreCounted)
+{
+    // Across, then lengthwise through the bar's middle: the slab's tetrahedra the second plane
+    // crosses hold four regions, which three linear fields cannot move apart independently.
+    XfemModel model = bar_model(0.1);
+    model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0437});
+    const CutReport lengthwise = model.cut(PlaneCut{Eigen::Vector3d(0.0, 0.1, 1.0).normalized(), 0.0101});
+    EXPECT_GT(lengthwise.recut_tets, 0u);
+    EXPECT_GT(lengthwise.crossed_tets, 0u);
+    std::size_t crossed = 0;
+    for (const XfemElement& el : model.elements()) {
+        crossed += el.crossed ? 1 : 0;
+        if (el.crossed) {
+            EXPECT_EQ(el.regions.size(), 4u);
+        }
+    }
+    EXPECT_EQ(crossed, lengthwise.crossed_tets);
+    XfemOptions o;
+    o.cg_tolerance = 1e-8;
+    XfemSolver solver(model, o);
+    solver.set_gravity({0, 0, -9.81});
+    for (std::size_t n = 0; n < model.node_count(); ++n)
+        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    for (int s = 0; s < 5; ++s) ASSERT_TRUE(solver.step().converged) << "step " << s;
 }
 
 TEST(XfemSolver, ACutContinuedLaterIsOneCrack)
