@@ -4,6 +4,9 @@
 //  - a cut one: its standard block is the whole tetrahedron's (the two sides add up); each side
 //    translating alone costs nothing for every k; each side turning alone costs nothing for
 //    k = 0 only (for k > 0 the enrichment cannot represent it: the spurious energy is measured);
+//  - cut twice (regions clipped plane by plane, integrated directly): one cut gives what moment
+//    fitting gives; the regions' volumes and the standard blocks add up to the whole; each of
+//    the three pieces two parallel cuts leave translates alone at no cost;
 //  - the lattice is conforming and fills its box;
 //  - a bar cut through falls apart into two pieces: 12 zero-energy modes for k = 0 (two rigid
 //    bodies), 9 for k > 0 (the relative rotation is held), 6 uncut.
@@ -18,6 +21,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <cmath>
 #include <map>
 #include <random>
 
@@ -123,6 +127,76 @@ TEST(XfemTetrahedron, SidesAddUpAndSidesMoveApart)
             else
                 EXPECT_GT(turn_energy, 1e-4 * k * k * stretch_energy); // held: the enrichment cannot turn a piece
         }
+}
+
+TEST(XfemTetrahedron, RegionsOfOneCutMatchMomentFitting)
+{
+    const MomentFitting fitting;
+    std::mt19937 rng(21);
+    for (bool two_two : {false, true}) {
+        const auto x = random_tet(rng);
+        const auto phi = cut_levels(x, two_two);
+        const CutTet fitted = cut_tet(x, phi, 0.1, k_lame, k_density, fitting);
+        const MultiCutTet direct = multi_cut_tet(x, {phi}, 0.1, k_lame, k_density);
+        ASSERT_EQ(direct.regions.size(), 2u);
+        for (const Region& r : direct.regions) {
+            EXPECT_NEAR(r.volume, fitted.side_volume[r.pattern], 1e-13 * tet_geometry(x).volume);
+            EXPECT_LT((r.stiffness - fitted.side_stiffness[r.pattern]).norm(), 1e-10 * fitted.stiffness.norm()) << "region " << r.pattern;
+        }
+        EXPECT_LT((direct.mass - fitted.mass).norm(), 1e-10 * fitted.mass.norm());
+    }
+}
+
+TEST(XfemTetrahedron, TwoCutsLeaveRegionsThatAddUpAndMoveApart)
+{
+    std::mt19937 rng(5);
+    const auto x = random_tet(rng);
+    const TetGeometry g = tet_geometry(x);
+    const Eigen::Vector3d n = (x[1] - x[0]).normalized();
+    // Two parallel planes through the tetrahedron (a third and two thirds of the way along n
+    // between its extreme corners): three regions.
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Eigen::Vector3d& p : x) {
+        lo = std::min(lo, n.dot(p));
+        hi = std::max(hi, n.dot(p));
+    }
+    std::vector<std::array<double, 4>> phi(2);
+    for (std::size_t j = 0; j < 2; ++j)
+        for (std::size_t c = 0; c < 4; ++c) phi[j][c] = n.dot(x[c]) - (lo + (j + 1.0) / 3.0 * (hi - lo));
+    for (double k : {0.0, 0.1}) {
+        SCOPED_TRACE("k = " + std::to_string(k));
+        const MultiCutTet m = multi_cut_tet(x, phi, k, k_lame, k_density);
+        ASSERT_EQ(m.regions.size(), 3u); // past the second plane means past the first: no region 2 (10b)
+        Eigen::MatrixXd total = Eigen::MatrixXd::Zero(36, 36);
+        double volume = 0.0;
+        for (const Region& r : m.regions) {
+            total += r.stiffness;
+            volume += r.volume;
+            EXPECT_NE(r.pattern, 2u);
+        }
+        EXPECT_NEAR(volume, g.volume, 1e-14 * g.volume);
+        EXPECT_LT((total.topLeftCorner(12, 12) - tet_stiffness(g, k_lame)).norm(), 1e-10 * tet_stiffness(g, k_lame).norm());
+        EXPECT_LT((m.mass.topLeftCorner(12, 12) - tet_mass(g, k_density)).norm(), 1e-10 * tet_mass(g, k_density).norm());
+        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(total).eigenvalues().minCoeff(), -1e-10 * total.norm());
+        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(m.mass).eigenvalues().minCoeff(), -1e-10 * m.mass.norm());
+        // Each piece translating alone by t, the others still. With T_q the target of region q,
+        // a_0 = T_1 - T_0 and a_1 = T_3 - T_1 at every node, u_c = T_0 + H_0c a_0 + H_1c a_1: the
+        // field is then T_0 + sum_j h_j a_j in each region, for any k (the gamma terms of a
+        // constant jump cancel).
+        const Eigen::Vector3d t(1e-3, -2e-3, 5e-4);
+        for (unsigned piece : {0u, 1u, 3u}) {
+            auto target = [&](unsigned q) { return q == piece ? t : Eigen::Vector3d::Zero(); };
+            const Eigen::Vector3d a0 = target(1) - target(0), a1 = target(3) - target(1);
+            Eigen::VectorXd v(36);
+            for (std::size_t c = 0; c < 4; ++c) {
+                const auto i3 = static_cast<Eigen::Index>(3 * c);
+                v.segment<3>(i3) = target(0) + m.node_side[0][c] * a0 + m.node_side[1][c] * a1;
+                v.segment<3>(12 + i3) = a0;
+                v.segment<3>(24 + i3) = a1;
+            }
+            EXPECT_LT(v.dot(total * v), 1e-12 * total.norm() * v.squaredNorm()) << "piece " << piece;
+        }
+    }
 }
 
 TEST(TetMesh, CubeLatticeIsConformingAndFillsItsBox)
