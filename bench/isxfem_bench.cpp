@@ -76,7 +76,7 @@ void run(bool factor, int frames)
     const double p95 = sorted[static_cast<std::size_t>(0.95 * static_cast<double>(sorted.size() - 1))];
     char note[200] = "";
     if (warped)
-        std::snprintf(note, sizeof note, "%d factorisations (%d in the background, %d frames waited for one); solves in %zu parallel groups, serial top %.0f %%",
+        std::snprintf(note, sizeof note, "%d factorisations (%d in the background; frames that waited for one: %d); solves in %zu parallel groups, serial top %.0f %%",
                       warped->factorizations(), warped->background_factorizations(), warped->frames_waited(), warped->factor().parallel_groups(),
                       100.0 * warped->factor().top_share());
     if (!solver.fallback_note().empty()) std::snprintf(note, sizeof note, "%s", solver.fallback_note().c_str());
