@@ -41,6 +41,7 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
     IsxfemToolFrame out;
     out.tools.resize(m_scene.tools.size());
     std::vector<isxfem::PointLoad> loads;
+    std::vector<std::size_t> cuts_known; // per load: how many cuts of its tetrahedron its region knew
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
         const io::ToolSpec& spec = m_scene.tools[k];
         io::ToolPose from = io::tool_pose(m_scene, k, (frame - 1) * dt), to = io::tool_pose(m_scene, k, frame * dt);
@@ -66,6 +67,7 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
             sim.touch(placed, {spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, m_last_pose[k].shape ? &m_last_pose[k] : nullptr);
         m_last_pose[k] = placed;
         loads.insert(loads.end(), touch.loads.begin(), touch.loads.end());
+        for (const isxfem::PointLoad& l : touch.loads) cuts_known.push_back(sim.model().elements()[l.tet].cuts.size());
         t.force_n = touch.contact.force_on_tool_n;
         t.torque_n_mm = touch.contact.torque_on_tool_n_mm;
         t.pressure_pa = touch.contact.pressure_pa;
@@ -98,9 +100,15 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         out.cut.crossed_tets += r.crossed_tets;
         t.cut = r.cut_tets > 0;
     }
-    // A cut this frame may have cut a loaded point's tetrahedron: the point acts on its own side.
+    // A cut this frame may have cut a loaded point's tetrahedron: the point acts on its own side of
+    // the new cut, and keeps its sides of the earlier ones (cuts are appended; a point on an earlier
+    // crack's face knows its side, which rounding at the plane would not).
     if (out.cut.cut_tets > 0)
-        for (isxfem::PointLoad& l : loads) l.side = sim.side_of(l.tet, l.bary);
+        for (std::size_t i = 0; i < loads.size(); ++i) {
+            const unsigned known = (1u << cuts_known[i]) - 1u;
+            const unsigned now = static_cast<unsigned>(sim.side_of(loads[i].tet, loads[i].bary));
+            loads[i].side = static_cast<int>((static_cast<unsigned>(loads[i].side) & known) | (now & ~known));
+        }
     sim.solver().set_point_loads(std::move(loads));
     return out;
 }

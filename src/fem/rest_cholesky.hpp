@@ -72,7 +72,11 @@ public:
     RestCholesky(const RestCholesky&) = delete;
     RestCholesky& operator=(const RestCholesky&) = delete;
 
-    [[nodiscard]] bool needs_matrix() const override { return m_stale || m_invalid; }
+    /// Also when a background factor is due to be swapped in: it may be discarded and taken again.
+    [[nodiscard]] bool needs_matrix() const override
+    {
+        return m_stale || m_invalid || (m_running.valid() && static_cast<double>(m_running_iterations) >= m_running_cost);
+    }
     void update(const SystemMatrix* a, const std::vector<unsigned char>& fixed,
                 const std::vector<Eigen::Quaterniond>& node_rotation) override;
     void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const override;

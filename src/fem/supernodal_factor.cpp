@@ -64,6 +64,7 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     std::unique_lock lock(blas);
     const bool analyse = new_pattern || !m_cholmod->factor;
     if (analyse) {
+        m_schedule_stale = true; // planned below, once a factor of this analysis holds
         if (m_cholmod->factor) cholmod_free_factor(&m_cholmod->factor, &c);
         m_cholmod->factor = cholmod_analyze(&view, &c);
         if (!m_cholmod->factor) throw std::runtime_error("SupernodalFactor: CHOLMOD could not analyse the matrix");
@@ -95,7 +96,10 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
         }
     }
     m_b.resize(l->n);
-    if (analyse) schedule(std::min<std::size_t>(solve_threads, 8)); // the tree is the analysis's
+    if (m_schedule_stale) { // the tree is the analysis's (a failed first factor of it leaves this to the next)
+        schedule(std::min<std::size_t>(solve_threads, 8));
+        m_schedule_stale = false;
+    }
     return smallest > 1e-10 * largest;
 }
 

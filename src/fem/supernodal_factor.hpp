@@ -60,6 +60,7 @@ private:
     std::vector<int> m_top_rows;            ///< the top's rows (factor order), and each row's place in them:
     std::vector<int> m_top_place;           ///< -1 below the top
     double m_top_share = 1.0;
+    bool m_schedule_stale = true; ///< an analysis whose tree the solves are not planned for yet
     mutable std::vector<float> m_b;
     mutable std::vector<std::vector<float>> m_tmp, m_delta; ///< per group: scratch, updates to the top's rows
 };

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <map>
 
 namespace vox::isxfem {
@@ -94,35 +95,62 @@ private:
     {
         return tet >= 0 && m_model.elements()[static_cast<std::size_t>(tet)].cut_index(m_cut) >= 0;
     }
-    /// The region on side `side` of this cut of the point `bary` of a tetrahedron it cut (its side
-    /// of the tetrahedron's other cut as it is).
-    [[nodiscard]] int region_on(std::size_t tet, const std::array<double, 4>& bary, int side) const
-    {
-        const XfemElement& el = m_model.elements()[tet];
-        const unsigned bit = 1u << el.cut_index(m_cut);
-        return static_cast<int>(side ? el.region_at(bary) | bit : el.region_at(bary) & ~bit);
-    }
     int add_point(std::size_t tet, const std::array<double, 4>& bary, int side, const Eigen::Vector3d& x, std::int32_t label)
     {
         m_points.push_back({tet, bary, side, x, label});
         return static_cast<int>(m_points.size()) - 1;
     }
-    /// A point not split by this cut, held by the tetrahedron across a segment's face (not cut by
-    /// it) so both sides place it alike; in the cut one, side 0, where that face is the mesh's.
-    int shared_point(std::size_t cut_tet, int face, const Eigen::Vector3d& x, std::int32_t label)
+    /// The region of the point `bary` of tetrahedron `tet`, except that where the point lies on
+    /// the plane of one of its cuts (an edge or corner of that cut's crack faces) the side of that
+    /// cut is taken from the first of `near` (tetrahedron and region of points beside it on the
+    /// same face) that knows the cut, not from rounding.
+    [[nodiscard]] unsigned region_near(std::size_t tet, const std::array<double, 4>& bary,
+                                       std::initializer_list<std::pair<std::size_t, unsigned>> near) const
+    {
+        const XfemElement& el = m_model.elements()[tet];
+        unsigned region = el.region_at(bary);
+        for (std::size_t i = 0; i < el.cuts.size(); ++i) {
+            double phi = 0.0, size = 0.0;
+            for (std::size_t k = 0; k < 4; ++k) {
+                phi += bary[k] * el.cuts[i].phi[k];
+                size = std::max(size, std::abs(el.cuts[i].phi[k]));
+            }
+            if (std::abs(phi) > 1e-9 * size) continue;
+            for (const auto& [other, other_region] : near) {
+                const int at = m_model.elements()[other].cut_index(el.cuts[i].id);
+                if (at < 0) continue;
+                region = (region & ~(1u << i)) | (((other_region >> at) & 1u) << i);
+                break;
+            }
+        }
+        return region;
+    }
+    /// Where a point not split by this cut goes: the tetrahedron across a segment's face (not cut
+    /// by it), so both sides place it alike; the cut one, on side 0, where that face is the mesh's.
+    /// `near`: a point beside it on the same face of any other cut (region_near).
+    struct Placement {
+        std::size_t tet = 0;
+        std::array<double, 4> bary{};
+        unsigned region = 0;
+    };
+    [[nodiscard]] Placement shared_place(std::size_t cut_tet, int face, const Eigen::Vector3d& x, std::pair<std::size_t, unsigned> near) const
     {
         const std::int32_t across = m_neighbours[cut_tet][static_cast<std::size_t>(face)];
-        if (across < 0) return add_point(cut_tet, clamped(barycentric(m_model.mesh(), cut_tet, x)), 0, x, label);
-        const auto t = static_cast<std::size_t>(across);
-        const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), t, x));
-        return add_point(t, bary, m_closure.side_of(t, bary), x, label);
+        Placement p;
+        p.tet = across < 0 ? cut_tet : static_cast<std::size_t>(across);
+        p.bary = clamped(barycentric(m_model.mesh(), p.tet, x));
+        p.region = region_near(p.tet, p.bary, {near});
+        if (across < 0) p.region &= ~(1u << m_model.elements()[p.tet].cut_index(m_cut));
+        return p;
     }
     void build_boundary();
     int crossing(int a, int b);
     /// The crossing's points, placed on first use.
     const std::array<int, 2>& ids(int crossing);
     int front(int inside, int outside);
-    int corner_point(int segment);
+    /// The end of R's boundary segment as a point of the face being walked (`near`: a point of that
+    /// face); one per face side of any other cut through it.
+    int corner_point(int segment, std::pair<std::size_t, unsigned> near);
     /// Chain nodes: crossings by index, fronts as -(index + 1).
     static int front_node(int f) { return -(f + 1); }
     [[nodiscard]] Eigen::Vector2d flat(const Eigen::Vector3d& x) const { return {m_u.dot(x), m_w.dot(x)}; }
@@ -147,7 +175,7 @@ private:
     std::vector<Segment> m_segments;
     std::multimap<NodeEdge, int> m_leaving;               ///< R's boundary: its segments by start
     std::map<std::pair<std::size_t, int>, int> m_on_face; ///< (tet, face) -> its segment
-    std::map<NodeEdge, int> m_corner_points;              ///< R's boundary vertices placed so far
+    std::map<std::pair<NodeEdge, unsigned>, int> m_corner_points; ///< R's boundary vertices placed so far, by region
 };
 
 void Closer::build_boundary()
@@ -205,25 +233,9 @@ int Closer::crossing(int a, int b)
     c.label = va.label;
     std::tie(c.tet, c.bary) = walk_to(m_model.mesh(), m_neighbours, va.tet, c.x);
     c.inside = in_crack(static_cast<std::int64_t>(c.tet));
-    // Its region; on another cut's plane (an edge of that cut's crack faces) the side of that cut
-    // is the edge's ends' (the face's side), not what rounding says.
-    const XfemElement& el = m_model.elements()[c.tet];
-    c.region = el.region_at(c.bary);
-    for (std::size_t i = 0; i < el.cuts.size(); ++i) {
-        double phi = 0.0, size = 0.0;
-        for (std::size_t k = 0; k < 4; ++k) {
-            phi += c.bary[k] * el.cuts[i].phi[k];
-            size = std::max(size, std::abs(el.cuts[i].phi[k]));
-        }
-        if (std::abs(phi) > 1e-9 * size) continue;
-        for (const SurfacePoint* end : {&va, &vb}) {
-            const int at = m_model.elements()[end->tet].cut_index(el.cuts[i].id);
-            if (at < 0) continue;
-            const unsigned bit = (static_cast<unsigned>(end->side) >> at) & 1u;
-            c.region = (c.region & ~(1u << i)) | (bit << i);
-            break;
-        }
-    }
+    // On another cut's plane (an edge of that cut's crack faces) its side of that cut is the
+    // edge's ends' (the face's side), not what rounding says.
+    c.region = region_near(c.tet, c.bary, {{va.tet, static_cast<unsigned>(va.side)}, {vb.tet, static_cast<unsigned>(vb.side)}});
     m_crossings.push_back(c);
     return m_crossing_of[key] = static_cast<int>(m_crossings.size()) - 1;
 }
@@ -280,7 +292,9 @@ int Closer::front(int inside, int outside)
             // Off the other end by at least a thousandth, so the front point and the split crossing
             // are not one place (a zero-length edge would stall the triangulation).
             f.x = from + std::max(leaves, 1e-3) * (to - from);
-            f.id = shared_point(t, face, f.x, m_crossings[static_cast<std::size_t>(inside)].label);
+            const Crossing& beside = m_crossings[static_cast<std::size_t>(inside)];
+            const Placement p = shared_place(t, face, f.x, {beside.tet, beside.region});
+            f.id = add_point(p.tet, p.bary, static_cast<int>(p.region), f.x, beside.label);
         }
         f.segment = segment->second;
         const Segment& s = m_segments[static_cast<std::size_t>(f.segment)];
@@ -291,11 +305,12 @@ int Closer::front(int inside, int outside)
     return -1;
 }
 
-int Closer::corner_point(int segment)
+int Closer::corner_point(int segment, std::pair<std::size_t, unsigned> near)
 {
     const Segment& s = m_segments[static_cast<std::size_t>(segment)];
-    if (const auto it = m_corner_points.find(s.to); it != m_corner_points.end()) return it->second;
-    return m_corner_points[s.to] = shared_point(s.tet, s.face, s.x_to, 0);
+    const Placement p = shared_place(s.tet, s.face, s.x_to, near);
+    if (const auto it = m_corner_points.find({s.to, p.region}); it != m_corner_points.end()) return it->second;
+    return m_corner_points[{s.to, p.region}] = add_point(p.tet, p.bary, static_cast<int>(p.region), s.x_to, 0);
 }
 
 void Closer::split(std::vector<Eigen::Vector3i>& triangles)
@@ -419,14 +434,17 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
     for (const auto& [edge, users] : glued) {
         if (users.size() != 2) continue; // a front edge: one face, split corner opposite
         const Eigen::Vector3d middle = 0.5 * (x[static_cast<std::size_t>(edge.first)] + x[static_cast<std::size_t>(edge.second)]);
-        // Walk to it from a split corner of a face beside it (in a cut tetrahedron).
-        std::size_t start = 0;
+        // Walk to it from a split corner of a face beside it (in a cut tetrahedron), whose sides of
+        // other cuts it shares.
+        SurfacePoint beside;
         for (int c : faces[users[0]])
-            if (!shared[static_cast<std::size_t>(c)]) start = m_points[static_cast<std::size_t>(ids[static_cast<std::size_t>(c)][0])].tet;
-        const auto [tet, bary] = walk_to(m_model.mesh(), m_neighbours, start, middle);
+            if (!shared[static_cast<std::size_t>(c)]) beside = m_points[static_cast<std::size_t>(ids[static_cast<std::size_t>(c)][0])];
+        const auto [tet, bary] = walk_to(m_model.mesh(), m_neighbours, beside.tet, middle);
         if (!in_crack(static_cast<std::int64_t>(tet))) continue;
+        const unsigned region = region_near(tet, bary, {{beside.tet, static_cast<unsigned>(beside.side)}});
+        const unsigned bit = 1u << m_model.elements()[tet].cut_index(m_cut);
         const int m = static_cast<int>(ids.size());
-        ids.push_back({add_point(tet, bary, region_on(tet, bary, 0), middle, 0), add_point(tet, bary, region_on(tet, bary, 1), middle, 0)});
+        ids.push_back({add_point(tet, bary, static_cast<int>(region & ~bit), middle, 0), add_point(tet, bary, static_cast<int>(region | bit), middle, 0)});
         x.push_back(middle);
         for (std::size_t k : users) {
             std::array<int, 3> f = faces[k];
@@ -517,13 +535,16 @@ void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
             int next = -1;
             for (std::size_t steps = 0; steps <= m_segments.size() && next < 0; ++steps) {
                 double nearest = INFINITY;
+                // Strictly past where it left: a front entering at that very point belongs to the
+                // piece across another cut through it (two crack faces on each other at rest).
                 for (const Front& f : m_fronts)
                     if (f.entering && f.chain >= 0 && f.segment == segment && f.along > after && f.along < nearest) {
                         nearest = f.along;
                         next = f.chain;
                     }
                 if (next >= 0) break;
-                const int corner = corner_point(segment);
+                const SurfacePoint& left_at = m_points[static_cast<std::size_t>(out.id)];
+                const int corner = corner_point(segment, {left_at.tet, static_cast<unsigned>(left_at.side)});
                 ids.push_back({corner, corner});
                 x.push_back(m_segments[static_cast<std::size_t>(segment)].x_to);
                 const auto leaving = m_leaving.find(m_segments[static_cast<std::size_t>(segment)].to);

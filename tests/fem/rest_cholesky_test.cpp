@@ -246,7 +246,7 @@ TEST(RestCholesky, FactorsInTheBackgroundAndSwapsAtTheIterationCount)
     EXPECT_EQ(p.background_factorizations(), 1);
     EXPECT_FALSE(p.failed());
     // Taken at the turned state: no warp left, and the same as a factor taken in the frame.
-    RestCholesky synchronous(Eigen::Matrix3d::Identity(), 25, false);
+    RestCholesky synchronous(Eigen::Matrix3d::Identity(), 25, INFINITY);
     synchronous.update(&stiffer, f.fixed, turned);
     Eigen::VectorXd z, expected;
     p.apply(r, z);
@@ -283,7 +283,7 @@ TEST(RestCholesky, PatchesTheBackgroundFactorForCutsMadeWhileItWasTaken)
     EXPECT_GT(p.patch_dofs(), 0u);
 
     // As if the factor had been taken in the frame at the launch and the cut patched after it.
-    RestCholesky synchronous(Eigen::Matrix3d::Identity(), 25, false);
+    RestCholesky synchronous(Eigen::Matrix3d::Identity(), 25, INFINITY);
     synchronous.update(&cut.small, fixed, rest);
     synchronous.blocks_changed(cut.changed);
     synchronous.update(&cut.grown, grown_fixed, grown_rest);

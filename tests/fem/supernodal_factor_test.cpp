@@ -35,6 +35,14 @@ TEST(SupernodalFactor, RefusesASingularMatrix)
 {
     vox::fem::SupernodalFactor f;
     EXPECT_FALSE(f.factor(grid_laplacian(6, 0.0), true)); // constants are in its null space
+    // The same pattern with values that factor: the analysis is kept, and the solves are planned
+    // for it now.
+    const Eigen::SparseMatrix<double> a = grid_laplacian(6, 0.5);
+    ASSERT_TRUE(f.factor(a, false));
+    const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
+    Eigen::VectorXd x = b;
+    f.solve(x);
+    EXPECT_LT((a * x - b).norm() / b.norm(), 1e-4);
 }
 
 TEST(SupernodalFactor, SolvesOnSeveralThreadsAsOnOne)

@@ -69,7 +69,7 @@ struct Closed {
 /// the default step the surface's vertices lie on y = 2 and z = 2, where the cubes' faces are: the
 /// crack's front runs along the surface's edges and meets the surface at its vertices.
 Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false,
-               const PlaneCut* second = nullptr)
+               const PlaneCut* second = nullptr, const std::function<bool(const Eigen::Vector3d&)>& second_inside = {})
 {
     Closed out;
     out.model = std::make_shared<XfemModel>(cube_lattice({6, 4, 4}, 1.0), std::vector<TetMaterial>{TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
@@ -89,7 +89,7 @@ Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double
     const CutReport report = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}, inside);
     EXPECT_GT(report.cut_tets, 0u);
     CutReport again;
-    if (second) again = model.cut(*second);
+    if (second) again = model.cut(*second, second_inside);
     const CutClosure closure(model);
     for (const Eigen::Vector3d& p : x) {
         const auto [tet, bary] = walk_to(model.mesh(), neighbours, 0, p);
@@ -141,16 +141,19 @@ std::pair<double, double> volume_and_crack_area(const Closed& c, double y = NAN)
     return {volume, crack};
 }
 
-/// Every piece of the surface lies on one side of each cut: where a point's tetrahedron was cut,
-/// its region says which; elsewhere its rest position (off the plane) does.
-void expect_pieces_on_one_side(const Closed& c)
+/// Every piece of the surface lies on one side of each cut through the object (all cuts, or
+/// `through`): where a point's tetrahedron was cut, its region says which; elsewhere its rest
+/// position (off the plane) does.
+void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
 {
+    if (through.empty())
+        for (int cut = 0; cut < c.model->cut_count(); ++cut) through.push_back(cut);
     std::vector<int> parent(c.points.size());
     for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
     std::function<int(int)> root = [&](int i) { return parent[static_cast<std::size_t>(i)] == i ? i : parent[static_cast<std::size_t>(i)] = root(parent[static_cast<std::size_t>(i)]); };
     for (const Eigen::Vector3i& t : c.triangles)
         for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(t[k]))] = root(t[0]);
-    for (int cut = 0; cut < c.model->cut_count(); ++cut) {
+    for (const int cut : through) {
         std::map<int, int> side_of_piece;
         int disagreements = 0;
         for (std::size_t i = 0; i < c.points.size(); ++i) {
@@ -278,4 +281,20 @@ TEST(CutClosure, TwoCrossingCutsLeaveFourClosedPieces)
     EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
     EXPECT_NEAR(across, 2.0 * 3.9 * 3.9, 1e-9);
     EXPECT_NEAR(along, 2.0 * 5.9 * 3.9, 1e-9);
+}
+
+TEST(CutClosure, ASlitAcrossAnEarlierCutKeepsEachSideOnItsPiece)
+{
+    // Through at x = 3.1, then a slit at y = 2.1 down to z = 2: the slit's front crosses both
+    // faces of the first cut, which lie on each other at rest; each front point must go with its
+    // own piece.
+    const PlaneCut lengthwise{Eigen::Vector3d::UnitY(), 2.1};
+    const Closed c = cut_box({}, 0.37, false, &lengthwise, [](const Eigen::Vector3d& p) { return p.z() > 1.9; });
+    EXPECT_EQ(c.counts.slit_faces, 2u); // one on each side of the first cut
+    EXPECT_EQ(c.counts.open_chains, 0u);
+    expect_closed(c);
+    EXPECT_EQ(pieces(c), 2);
+    expect_pieces_on_one_side(c, {0}); // the slit joins the two sides of its own cut
+    EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
+    EXPECT_NEAR(volume_and_crack_area(c, 2.1).second, 2.0 * 5.9 * (3.95 - 2.0), 1e-9);
 }
