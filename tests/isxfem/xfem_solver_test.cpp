@@ -167,6 +167,39 @@ TEST(XfemSolver, TwoCutsThroughOneSlabCutItInThree)
     EXPECT_LT(near0 - mean_z(model, solver, 0.0, 0.025), 0.005);
 }
 
+TEST(XfemSolver, ASecondCutThroughFallingTetrahedraIsPatchedIn)
+{
+    // The bar cut once and falling, then cut again through the same slab while it moves: the new
+    // regions start from the rotations of the ones they split, the warped factor is kept and
+    // patched (or taken again when that pays), and the steps go on converging in a few iterations,
+    // the far piece in free fall.
+    XfemModel model = bar_model(0.1);
+    model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0437});
+    XfemOptions o;
+    o.cg_tolerance = 1e-8;
+    XfemSolver solver(model, o);
+    auto owned = std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity());
+    const fem::RestCholesky* warped = owned.get();
+    solver.set_preconditioner(std::move(owned));
+    solver.set_gravity({0, 0, -9.81});
+    for (std::size_t n = 0; n < model.node_count(); ++n)
+        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    const double far0 = mean_z(model, solver, 0.055, 1.0);
+    for (int s = 0; s < 3; ++s) ASSERT_TRUE(solver.step().converged);
+    const CutReport again = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0462});
+    ASSERT_GT(again.recut_tets, 0u);
+    solver.model_changed();
+    const int steps = 10;
+    for (int s = 0; s < steps; ++s) {
+        const XfemStepStats st = solver.step();
+        ASSERT_TRUE(st.converged) << "step " << s;
+        EXPECT_LT(st.cg_iterations, 40) << "step " << s;
+    }
+    EXPECT_FALSE(warped->failed());
+    const double free_fall = 0.5 * 9.81 * 1e-4 * (steps + 3) * (steps + 4);
+    EXPECT_NEAR(far0 - mean_z(model, solver, 0.055, 1.0), free_fall, 0.1 * free_fall);
+}
+
 TEST(XfemSolver, CutsThatCrossInsideATetrahedronAreCounted)
 {
     // Across, then lengthwise through the bar's middle: the slab's tetrahedra the second plane
