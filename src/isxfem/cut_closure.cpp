@@ -53,26 +53,6 @@ struct Loop {
     bool slit = false; ///< closed along a front
 };
 
-/// Whether segments ab and cd cross at a point inside both (touching ends do not count).
-bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& d)
-{
-    auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
-        const double z = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
-        return (z > 0.0) - (z < 0.0);
-    };
-    return side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0;
-}
-
-bool inside_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon)
-{
-    bool in = false;
-    for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
-        if ((polygon[i].y() > p.y()) != (polygon[j].y() > p.y()) &&
-            p.x() < polygon[j].x() + (p.y() - polygon[j].y()) / (polygon[i].y() - polygon[j].y()) * (polygon[i].x() - polygon[j].x()))
-            in = !in;
-    return in;
-}
-
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
@@ -154,8 +134,8 @@ private:
     /// Chain nodes: crossings by index, fronts as -(index + 1).
     static int front_node(int f) { return -(f + 1); }
     [[nodiscard]] Eigen::Vector2d flat(const Eigen::Vector3d& x) const { return {m_u.dot(x), m_w.dot(x)}; }
-    /// Faces with their holes joined in: each clockwise loop (a hole: the material is on the
-    /// left of every loop) is bridged to the counter-clockwise one around it.
+    /// Faces with their holes joined in (faces_with_holes: the material is on the left of every
+    /// loop, so a hole runs clockwise); holes that cannot be placed count as open.
     std::vector<Loop> with_holes(std::vector<Loop> loops);
     /// Triangulates a crack face given round its boundary (each corner's point per side) on both sides.
     void emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles);
@@ -575,77 +555,20 @@ void Closer::fill(std::vector<Eigen::Vector3i>& triangles)
 
 std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
 {
-    std::vector<std::vector<Eigen::Vector2d>> flat_loops;
-    std::vector<double> area;
+    std::vector<std::vector<Eigen::Vector2d>> in_plane;
     for (const Loop& loop : loops) {
-        std::vector<Eigen::Vector2d> f;
-        for (const Eigen::Vector3d& p : loop.x) f.push_back(flat(p));
-        double a = 0.0;
-        for (std::size_t i = 0; i < f.size(); ++i) a += 0.5 * (f[i].x() * f[(i + 1) % f.size()].y() - f[(i + 1) % f.size()].x() * f[i].y());
-        flat_loops.push_back(std::move(f));
-        area.push_back(a);
-    }
-    // Each hole goes to the smallest face around it.
-    std::vector<std::vector<std::size_t>> holes(loops.size());
-    for (std::size_t h = 0; h < loops.size(); ++h) {
-        if (area[h] >= 0.0) continue;
-        std::size_t around = loops.size();
-        for (std::size_t o = 0; o < loops.size(); ++o)
-            if (area[o] > 0.0 && inside_polygon(flat_loops[h].front(), flat_loops[o]) && (around == loops.size() || area[o] < area[around])) around = o;
-        if (around == loops.size())
-            ++counts.open_chains; // a hole in nothing: left out
-        else
-            holes[around].push_back(h);
+        in_plane.emplace_back();
+        for (const Eigen::Vector3d& p : loop.x) in_plane.back().push_back(flat(p));
     }
     std::vector<Loop> out;
-    for (std::size_t o = 0; o < loops.size(); ++o) {
-        if (area[o] <= 0.0) continue;
-        Loop face = std::move(loops[o]);
-        std::vector<Eigen::Vector2d> f = flat_loops[o];
-        // Rightmost holes first; each bridged from its rightmost corner to the nearest corner of
-        // the face seen without crossing an edge of the face or of any of its holes.
-        std::sort(holes[o].begin(), holes[o].end(), [&](std::size_t a, std::size_t b) {
-            auto right = [&](std::size_t h) { return std::max_element(flat_loops[h].begin(), flat_loops[h].end(), [](auto& p, auto& q) { return p.x() < q.x(); })->x(); };
-            return right(a) > right(b);
-        });
-        for (std::size_t h : holes[o]) {
-            const std::vector<Eigen::Vector2d>& hf = flat_loops[h];
-            const auto m = static_cast<std::size_t>(std::max_element(hf.begin(), hf.end(), [](auto& p, auto& q) { return p.x() < q.x(); }) - hf.begin());
-            std::vector<std::size_t> order(f.size());
-            for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-            std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return (f[a] - hf[m]).squaredNorm() < (f[b] - hf[m]).squaredNorm(); });
-            auto clear = [&](std::size_t v) {
-                auto blocked_by = [&](const std::vector<Eigen::Vector2d>& poly) {
-                    for (std::size_t i = 0; i < poly.size(); ++i)
-                        if (crosses(hf[m], f[v], poly[i], poly[(i + 1) % poly.size()])) return true;
-                    return false;
-                };
-                if (blocked_by(f)) return false;
-                for (std::size_t other : holes[o])
-                    if (blocked_by(flat_loops[other])) return false;
-                return true;
-            };
-            const auto v = std::find_if(order.begin(), order.end(), clear);
-            if (v == order.end()) {
-                ++counts.open_chains; // no bridge found: the hole is left out
-                continue;
-            }
-            // face[..v], hole[m..] round to hole[m], face[v..]
-            Loop merged;
-            std::vector<Eigen::Vector2d> merged_flat;
-            auto take = [&](const Loop& from, const std::vector<Eigen::Vector2d>& from_flat, std::size_t i) {
-                merged.ids.push_back(from.ids[i]);
-                merged.x.push_back(from.x[i]);
-                merged_flat.push_back(from_flat[i]);
-            };
-            for (std::size_t i = 0; i <= *v; ++i) take(face, f, i);
-            for (std::size_t k = 0; k <= hf.size(); ++k) take(loops[h], hf, (m + k) % hf.size());
-            for (std::size_t i = *v; i < f.size(); ++i) take(face, f, i);
-            merged.slit = face.slit;
-            face = std::move(merged);
-            f = std::move(merged_flat);
+    for (const std::vector<LoopCorner>& face : faces_with_holes(in_plane, counts.open_chains)) {
+        Loop merged;
+        merged.slit = loops[face.front().loop].slit;
+        for (const LoopCorner& c : face) {
+            merged.ids.push_back(loops[c.loop].ids[c.corner]);
+            merged.x.push_back(loops[c.loop].x[c.corner]);
         }
-        out.push_back(std::move(face));
+        out.push_back(std::move(merged));
     }
     return out;
 }

@@ -1,5 +1,6 @@
 #pragma once
-// Triangulation of a simple polygon by ear clipping (O(n^2)), for the faces that close a cut.
+// Triangulation of a simple polygon by ear clipping (O(n^2)), and holes bridged into the polygons
+// around them, for the faces that close a cut.
 
 #include <Eigen/Core>
 
@@ -13,5 +14,17 @@ namespace vox::isxfem {
 /// find, then a fan over the rest. `apart` (optional, per vertex): diagonals joining two flagged
 /// vertices are avoided where another ear will do.
 std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector2d>& polygon, const std::vector<bool>& apart = {});
+
+/// A corner of one of several loops.
+struct LoopCorner {
+    std::size_t loop = 0, corner = 0;
+};
+
+/// Faces from closed loops in a plane: each counter-clockwise loop bounds a face, each clockwise
+/// one is a hole in the smallest face around it. Per face, its corners in order with its holes
+/// joined in, rightmost hole first, each by a bridge from its rightmost corner to the nearest
+/// corner of the face that it sees without crossing an edge, walked both ways (the bridge's ends
+/// appear twice). `left_out` counts holes in no face or with no bridge.
+std::vector<std::vector<LoopCorner>> faces_with_holes(const std::vector<std::vector<Eigen::Vector2d>>& loops, std::size_t& left_out);
 
 } // namespace vox::isxfem

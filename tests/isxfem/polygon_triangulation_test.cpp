@@ -1,6 +1,8 @@
 // Ear clipping: a convex and a non-convex (L-shaped, then comb-shaped) polygon in either
 // orientation are covered exactly (the triangles' areas add up to the polygon's) by n - 2
-// counter-clockwise triangles.
+// counter-clockwise triangles. Holes: two squares in a square and a square on its own come out as
+// two faces, the holes bridged in so that the triangulated face covers the square less its holes;
+// a hole in nothing is left out and counted.
 
 #include "isxfem/polygon_triangulation.hpp"
 
@@ -45,4 +47,31 @@ TEST(PolygonTriangulation, CoversConvexAndNonConvexPolygons)
     expect_covered({{0, 0}, {3, 0}, {3, 1}, {1, 1}, {1, 3}, {0, 3}});                        // L
     expect_covered({{0, 0}, {5, 0}, {5, 3}, {4, 3}, {4, 1}, {3, 1}, {3, 3}, {2, 3}, {2, 1}, {1, 1}, {1, 3}, {0, 3}}); // comb
     EXPECT_TRUE(triangulate_polygon({{0, 0}, {1, 0}}).empty());
+}
+
+TEST(PolygonTriangulation, BridgesHolesIntoTheFaceAroundThem)
+{
+    auto square = [](double x0, double y0, double side, bool clockwise) {
+        std::vector<Eigen::Vector2d> p{{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+        if (clockwise) std::reverse(p.begin(), p.end());
+        return p;
+    };
+    const std::vector<std::vector<Eigen::Vector2d>> loops{square(0, 0, 10, false), square(2, 2, 2, true), square(6, 5, 3, true),
+                                                          square(20, 0, 4, false), square(30, 30, 1, true)};
+    std::size_t left_out = 0;
+    const auto faces = vox::isxfem::faces_with_holes(loops, left_out);
+    EXPECT_EQ(left_out, 1u); // the hole at (30, 30) lies in no face
+    ASSERT_EQ(faces.size(), 2u);
+    EXPECT_EQ(faces[0].size(), 4u + 2u * (4u + 2u)); // each hole's corners, its bridge corner again, and the face's
+    EXPECT_EQ(faces[1].size(), 4u);
+    std::vector<Eigen::Vector2d> merged;
+    for (const auto& c : faces[0]) merged.push_back(loops[c.loop][c.corner]);
+    double covered = 0.0;
+    for (const auto& t : triangulate_polygon(merged)) {
+        const Eigen::Vector2d a = merged[static_cast<std::size_t>(t[0])], b = merged[static_cast<std::size_t>(t[1])], c = merged[static_cast<std::size_t>(t[2])];
+        const double area = 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+        EXPECT_GE(area, 0.0);
+        covered += area;
+    }
+    EXPECT_NEAR(covered, 100.0 - 4.0 - 9.0, 1e-9);
 }

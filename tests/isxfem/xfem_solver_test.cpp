@@ -30,6 +30,14 @@ XfemModel bar_model(double k)
     return XfemModel(std::move(bar), {TetMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), k);
 }
 
+/// The bar under gravity, held at its end x = 0.
+void hang(const XfemModel& model, XfemSolver& solver)
+{
+    solver.set_gravity({0, 0, -9.81});
+    for (std::size_t n = 0; n < model.node_count(); ++n)
+        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+}
+
 /// Mean z of the nodes whose rest x lies in [from, to].
 double mean_z(const XfemModel& model, const XfemSolver& solver, double from, double to)
 {
@@ -73,9 +81,7 @@ TEST(XfemSolver, ABarCutThroughFallsInTwo)
             XfemOptions o;
             o.cg_tolerance = 1e-8;
             XfemSolver solver(model, o);
-            solver.set_gravity({0, 0, -9.81});
-            for (std::size_t n = 0; n < model.node_count(); ++n)
-                if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+            hang(model, solver);
             const double far0 = mean_z(model, solver, 0.055, 1.0), near0 = mean_z(model, solver, 0.0, 0.025);
             const int steps = 10;
             for (int s = 0; s < steps; ++s) ASSERT_TRUE(solver.step().converged) << "step " << s;
@@ -140,9 +146,7 @@ TEST(XfemSolver, TwoCutsThroughOneSlabCutItInThree)
     XfemOptions o;
     o.cg_tolerance = 1e-8;
     XfemSolver solver(model, o);
-    solver.set_gravity({0, 0, -9.81});
-    for (std::size_t n = 0; n < model.node_count(); ++n)
-        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    hang(model, solver);
     // A material point in the slice: x = 45 mm, in a tetrahedron cut twice.
     std::size_t slice_tet = model.elements().size();
     std::array<double, 4> bary{};
@@ -181,9 +185,7 @@ TEST(XfemSolver, ASecondCutThroughFallingTetrahedraIsPatchedIn)
     auto owned = std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity());
     const fem::RestCholesky* warped = owned.get();
     solver.set_preconditioner(std::move(owned));
-    solver.set_gravity({0, 0, -9.81});
-    for (std::size_t n = 0; n < model.node_count(); ++n)
-        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    hang(model, solver);
     const double far0 = mean_z(model, solver, 0.055, 1.0);
     for (int s = 0; s < 3; ++s) ASSERT_TRUE(solver.step().converged);
     const CutReport again = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0462});
@@ -220,9 +222,7 @@ TEST(XfemSolver, CutsThatCrossInsideATetrahedronAreCounted)
     XfemOptions o;
     o.cg_tolerance = 1e-8;
     XfemSolver solver(model, o);
-    solver.set_gravity({0, 0, -9.81});
-    for (std::size_t n = 0; n < model.node_count(); ++n)
-        if (model.mesh().nodes[n].x() < 1e-9) solver.fix(static_cast<std::uint32_t>(n), 7);
+    hang(model, solver);
     for (int s = 0; s < 5; ++s) ASSERT_TRUE(solver.step().converged) << "step " << s;
 }
 
