@@ -1,6 +1,7 @@
 #pragma once
 // Blades and scalpels cutting an Is-XFEM simulation along their mid-plane (the tool's x-z plane).
-// While the plane stays put a stroke is one cut, and the region it covers is the tool's profile
+// While the plane stays put (within 5 degrees and 1 mm of where the stroke began: a hand wavers) a
+// stroke is one cut, and the region it covers is the tool's profile
 // swept frame by frame as it moves and turns within the plane (contact/swept_profile.hpp), so a
 // tetrahedron the blade crosses whole only over several frames is cut once it has been. The caller
 // says which frames count (from the break-in, or from the first touch when the tool marks its cut
@@ -23,8 +24,8 @@ public:
     /// The blade moved from `from` to `to` (world) over a frame: adds the frame's sweep to the
     /// stroke's, carried back to rest space by `moved_mm` (the mean displacement of the material
     /// around the blade), and with `cut` cuts where the stroke has swept. A new stroke starts when
-    /// the plane moved or tilted in the world (turning within the plane goes on with the stroke) or
-    /// after end().
+    /// the plane moved or tilted in the world past the tolerance (turning within the plane goes on
+    /// with the stroke) or after end().
     isxfem::CutReport advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to, const Eigen::Vector3d& moved_mm,
                               bool cut);
     /// The blade left: the next frame starts a new stroke.

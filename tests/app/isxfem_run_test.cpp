@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -104,6 +105,37 @@ TEST(IsxfemRun, ASlitThatStopsInsideTheBarIsClosedAlongItsFront)
     EXPECT_EQ(mesh["components"], 1);
     EXPECT_EQ(mesh["consistently_oriented"], true);
     EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 150.0);
+}
+
+TEST(IsxfemRun, AWaveringBladeCutsOnAlongItsStrokesPlane)
+{
+    // A 2 mm blade drawn across the bar (held at both ends, stiff) through its full height,
+    // tilting by +-0.5 degrees about the vertical from one frame to the next as a hand does: no
+    // single frame's sweep covers a tetrahedron, so the cut relies on the stroke adding its sweeps
+    // up in one plane. (A new plane every frame cut half the path in three cuts.)
+    const fs::path d = fresh_dir("isxfem_wavering");
+    std::ostringstream script;
+    for (int k = 0; k <= 30; ++k) {
+        const double half = (90.0 + (k % 2 ? 0.5 : -0.5)) * 3.14159265358979323846 / 360.0;
+        script << (k ? ",\n" : "") << "{\"t_s\": " << 0.01 * k << ", \"tool\": \"blade\", \"position_mm\": [50.3, " << -4.0 + 0.8 * k
+               << ", 5], \"orientation_wxyz\": [" << std::cos(half) << ", 0, 0, " << std::sin(half) << "]}";
+    }
+    std::ofstream(d / "scene.json") << R"({
+        "object": {"phantom": {"shape": "beam", "size_mm": [100, 10, 10], "voxel_mm": 1.0}, "levels": 2},
+        "materials": {"default": {"youngs_modulus_pa": 1e7, "poisson_ratio": 0.3, "density_kg_m3": 1000}},
+        "solver": {"type": "isxfem", "k": 0.1, "dt_s": 0.01, "cg_tolerance": 1e-6, "cg_max_iterations": 2000},
+        "gravity_m_s2": [0, 0, -9.81],
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [2, 11, 11]]}, {"type": "fixed", "box_mm": [[98, -1, -1], [101, 11, 11]]}],
+        "tools": [{"name": "blade", "shape": "blade", "size_mm": [2, 1, 30], "cut_pressure_pa": 1}],
+        "script": [)" << script.str() << R"(]
+    })";
+    const auto r = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 30 --out " + quote((d / "out").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(d / "out" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["summary"]["cuts"], 1);
+    EXPECT_EQ(stats["summary"]["cut_tets"], 54); // the bar's 3 x 3 cells across, six tetrahedra each
+    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
 }
 
 TEST(IsxfemRun, AFingerPushesOnTheTetrahedraAsOnTheBranchedGrid)
