@@ -85,7 +85,7 @@ std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
 
 int IsxfemSimulation::side_of(std::size_t tet, const std::array<double, 4>& bary) const
 {
-    return m_closure->side_of(tet, bary);
+    return static_cast<int>(m_model->elements()[tet].region_at(bary));
 }
 
 Eigen::Vector3d IsxfemSimulation::mean_displacement_mm(const Eigen::AlignedBox3d& box) const
@@ -128,12 +128,7 @@ void IsxfemSimulation::refresh_closed_surface() const
     }
     m_closed_triangles = m_rest.triangles;
     m_closure_counts = {};
-    for (int cut = 0; cut < m_model->cut_count(); ++cut) {
-        const isxfem::ClosureCounts c = m_closure->close(cut, m_closed_vertices, m_closed_triangles);
-        m_closure_counts.faces += c.faces;
-        m_closure_counts.slit_faces += c.slit_faces;
-        m_closure_counts.open_chains += c.open_chains;
-    }
+    for (int cut = 0; cut < m_model->cut_count(); ++cut) m_closure_counts += m_closure->close(cut, m_closed_vertices, m_closed_triangles);
     m_closed_revision = m_model->revision();
 }
 
@@ -183,12 +178,8 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
         double jump = 0.0;
         for (std::size_t c = 0; c < 4; ++c) {
             box.extend(1e3 * x[el.node[c]]);
-            for (unsigned pattern = 0; el.is_cut() && pattern < (1u << el.cuts.size()); ++pattern) { // each region's corner
-                Eigen::Vector3d p = x[el.node[c]];
-                for (std::size_t j = 0; j < el.cuts.size(); ++j)
-                    p += (static_cast<double>((pattern >> j) & 1u) - el.cuts[j].node_side[c]) * x[el.cuts[j].enriched[c]];
-                box.extend(1e3 * p);
-            }
+            for (unsigned pattern = 0; el.is_cut() && pattern < (1u << el.cuts.size()); ++pattern) // each region's corner
+                box.extend(1e3 * el.region_node(c, pattern, x));
             for (const isxfem::ElementCut& cut : el.cuts) jump += 1e3 * x[cut.enriched[c]].norm();
         }
         // For k > 0 a side's field is the linear one plus k gamma-weighted jumps, at most k sum |a|.

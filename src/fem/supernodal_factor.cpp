@@ -113,6 +113,7 @@ void SupernodalFactor::schedule(std::size_t groups)
     // Work is counted in factor entries (what a solve streams).
     std::vector<std::vector<int>> children(static_cast<std::size_t>(supernodes));
     std::vector<double> work(static_cast<std::size_t>(supernodes)), subtree(static_cast<std::size_t>(supernodes), 0.0);
+    std::vector<int> parent(static_cast<std::size_t>(supernodes), -1);
     std::vector<int> frontier; // the roots, then the subtrees left below the top
     bool postordered = true;
     for (int k = 0; k < supernodes; ++k) {
@@ -122,14 +123,13 @@ void SupernodalFactor::schedule(std::size_t groups)
             frontier.push_back(k);
             continue;
         }
-        const int parent = column_super[static_cast<std::size_t>(m_s[static_cast<std::size_t>(m_pi[k] + nc)])];
-        postordered = postordered && parent > k;
-        children[static_cast<std::size_t>(parent)].push_back(k);
+        const int p = parent[static_cast<std::size_t>(k)] = column_super[static_cast<std::size_t>(m_s[static_cast<std::size_t>(m_pi[k] + nc)])];
+        postordered = postordered && p > k;
+        children[static_cast<std::size_t>(p)].push_back(k);
     }
     for (int k = 0; k < supernodes && postordered; ++k) {
         subtree[static_cast<std::size_t>(k)] += work[static_cast<std::size_t>(k)];
-        const int nc = m_super[k + 1] - m_super[k], nr = m_pi[k + 1] - m_pi[k];
-        if (nr > nc) subtree[static_cast<std::size_t>(column_super[static_cast<std::size_t>(m_s[static_cast<std::size_t>(m_pi[k] + nc)])])] += subtree[static_cast<std::size_t>(k)];
+        if (parent[static_cast<std::size_t>(k)] >= 0) subtree[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])] += subtree[static_cast<std::size_t>(k)];
     }
     // Split the heaviest subtree (its root joins the serial top) while that shortens the
     // estimated solve, top plus the heaviest group (subtrees dealt largest first to the lightest

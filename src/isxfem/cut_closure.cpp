@@ -1,12 +1,12 @@
 #include "isxfem/cut_closure.hpp"
 
+#include "grid/union_find.hpp"
 #include "isxfem/polygon_triangulation.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <initializer_list>
 #include <map>
 
@@ -56,9 +56,8 @@ struct Loop {
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
-    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, const CutClosure& closure, int cut,
-           std::vector<SurfacePoint>& points)
-        : m_model(model), m_neighbours(neighbours), m_closure(closure), m_cut(cut), m_plane(model.cut_plane(cut)), m_points(points)
+    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, int cut, std::vector<SurfacePoint>& points)
+        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_plane(model.cut_plane(cut)), m_points(points)
     {
         m_n = m_plane.normal.normalized();
         m_u = m_n.unitOrthogonal();
@@ -90,12 +89,9 @@ private:
         const XfemElement& el = m_model.elements()[tet];
         unsigned region = el.region_at(bary);
         for (std::size_t i = 0; i < el.cuts.size(); ++i) {
-            double phi = 0.0, size = 0.0;
-            for (std::size_t k = 0; k < 4; ++k) {
-                phi += bary[k] * el.cuts[i].phi[k];
-                size = std::max(size, std::abs(el.cuts[i].phi[k]));
-            }
-            if (std::abs(phi) > 1e-9 * size) continue;
+            double size = 0.0;
+            for (const double phi : el.cuts[i].phi) size = std::max(size, std::abs(phi));
+            if (std::abs(el.level_at(i, bary)) > 1e-9 * size) continue;
             for (const auto& [other, other_region] : near) {
                 const int at = m_model.elements()[other].cut_index(el.cuts[i].id);
                 if (at < 0) continue;
@@ -142,7 +138,6 @@ private:
 
     const XfemModel& m_model;
     const std::vector<std::array<std::int32_t, 4>>& m_neighbours;
-    const CutClosure& m_closure;
     int m_cut;
     const PlaneCut& m_plane;
     std::vector<SurfacePoint>& m_points;
@@ -264,8 +259,7 @@ int Closer::front(int inside, int outside)
         const auto segment = m_on_face.find({t, face});
         if (segment == m_on_face.end()) return -1;
         Front f;
-        if (leaves >= 1.0 - 1e-9) { // the crack ends on the triangle's edge: at the
-                                    // other crossing
+        if (leaves >= 1.0 - 1e-9) { // the crack ends on the triangle's edge: at the other crossing
             f.x = to;
             f.id = ids(outside)[0];
         } else {
@@ -309,22 +303,19 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
     // A loop of crossings that enters the crack anywhere is split all round (outside the crack each
     // piece keeps the crossing's one point): a triangle split beside one left whole would leave a
     // vertex in the middle of its edge.
-    std::vector<int> group(m_crossings.size());
-    for (std::size_t c = 0; c < group.size(); ++c) group[c] = static_cast<int>(c);
-    std::function<int(int)> root = [&](int c) {
-        return group[static_cast<std::size_t>(c)] == c ? c : group[static_cast<std::size_t>(c)] = root(group[static_cast<std::size_t>(c)]);
-    };
+    grid::UnionFind loops(m_crossings.size());
+    auto root = [&](int c) { return loops.find(static_cast<std::uint32_t>(c)); };
     for (const std::array<int, 2>& c : cross)
-        if (c[0] >= 0) group[static_cast<std::size_t>(root(c[0]))] = root(c[1]);
+        if (c[0] >= 0) loops.unite(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]));
     std::vector<bool> reaches_crack(m_crossings.size(), false);
     for (std::size_t c = 0; c < m_crossings.size(); ++c)
-        if (m_crossings[c].inside) reaches_crack[static_cast<std::size_t>(root(static_cast<int>(c)))] = true;
+        if (m_crossings[c].inside) reaches_crack[root(static_cast<int>(c))] = true;
 
     std::vector<Eigen::Vector3i> kept;
     kept.reserve(triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i) {
         const Eigen::Vector3i& t = triangles[i];
-        if (cross[i][0] < 0 || !reaches_crack[static_cast<std::size_t>(root(cross[i][0]))]) {
+        if (cross[i][0] < 0 || !reaches_crack[root(cross[i][0])]) {
             kept.push_back(t);
             continue;
         }
@@ -332,27 +323,23 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
         int f = -1;
         if (in0 != in1) {
             f = in0 ? front(cross[i][0], cross[i][1]) : front(cross[i][1], cross[i][0]);
-            if (f < 0)
-                ++counts.open_chains; // the crack's edge could not be found here: split
-                                      // without it, counted
+            if (f < 0) ++counts.open_chains; // the crack's edge could not be found here: split without it, counted
         }
+        // S's boundary in this triangle runs along n x (its outward normal), material on its left.
+        const Eigen::Vector3d r0 = m_points[static_cast<std::size_t>(t[0])].rest_m;
+        const Eigen::Vector3d outward =
+            (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
+        auto runs = [&](int from, int to) {
+            return (m_crossings[static_cast<std::size_t>(to)].x - m_crossings[static_cast<std::size_t>(from)].x).dot(m_n.cross(outward)) > 0.0;
+        };
         if (in0 && in1) {
-            // S's boundary in this triangle, material on its left: along n x (the outward normal).
-            const Eigen::Vector3d r0 = m_points[static_cast<std::size_t>(t[0])].rest_m;
-            const Eigen::Vector3d normal =
-                (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
-            int start = cross[i][0], end = cross[i][1];
-            if ((m_crossings[static_cast<std::size_t>(end)].x - m_crossings[static_cast<std::size_t>(start)].x).dot(m_n.cross(normal)) < 0.0)
-                std::swap(start, end);
-            m_next[start] = end;
+            if (!runs(cross[i][1], cross[i][0]))
+                m_next[cross[i][0]] = cross[i][1];
+            else
+                m_next[cross[i][1]] = cross[i][0];
         } else if (f >= 0) {
-            const Eigen::Vector3d r0 = m_points[static_cast<std::size_t>(t[0])].rest_m;
-            const Eigen::Vector3d normal =
-                (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
             const int inside = in0 ? cross[i][0] : cross[i][1], outside = in0 ? cross[i][1] : cross[i][0];
-            const bool leaving =
-                (m_crossings[static_cast<std::size_t>(outside)].x - m_crossings[static_cast<std::size_t>(inside)].x).dot(m_n.cross(normal)) > 0.0;
-            if (leaving) {
+            if (runs(inside, outside)) { // leaving the crack at the front
                 m_next[inside] = front_node(f);
             } else {
                 m_fronts[static_cast<std::size_t>(f)].entering = true;
@@ -376,8 +363,7 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
                     on_plane.push_back(true);
                 }
             }
-            if (front_inserted) { // between the two crossings, which are neighbours
-                                  // round the piece
+            if (front_inserted) { // between the two crossings, which are neighbours round the piece
                 std::size_t after = 0;
                 while (!(on_plane[after] && on_plane[(after + 1) % piece.size()])) ++after;
                 piece.insert(piece.begin() + static_cast<std::ptrdiff_t>(after + 1), m_fronts[static_cast<std::size_t>(f)].id);
@@ -577,14 +563,9 @@ std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
 
 CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh())) {}
 
-int CutClosure::side_of(std::size_t tet, const std::array<double, 4>& bary) const
-{
-    return static_cast<int>(m_model.elements()[tet].region_at(bary));
-}
-
 ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const
 {
-    Closer closer(m_model, m_neighbours, *this, cut, points);
+    Closer closer(m_model, m_neighbours, cut, points);
     closer.split(triangles);
     closer.fill(triangles);
     return closer.counts;

@@ -38,6 +38,13 @@ struct ClosureCounts {
     std::size_t faces = 0;       ///< crack faces filled (each on both sides)
     std::size_t slit_faces = 0;  ///< of them, closed along a crack front inside the object
     std::size_t open_chains = 0; ///< crossings that could not be closed (left open, counted)
+    ClosureCounts& operator+=(const ClosureCounts& o)
+    {
+        faces += o.faces;
+        slit_faces += o.slit_faces;
+        open_chains += o.open_chains;
+        return *this;
+    }
 };
 
 class CutClosure {
@@ -47,9 +54,6 @@ public:
     /// Splits `triangles` (indices into `points`) along cut `cut` and fills its crack on both
     /// sides; new points are appended.
     ClosureCounts close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const;
-
-    /// The region (XfemElement::region_at; 0 when uncut) of the material point `bary` in tetrahedron `tet`.
-    [[nodiscard]] int side_of(std::size_t tet, const std::array<double, 4>& bary) const;
 
 private:
     const XfemModel& m_model;

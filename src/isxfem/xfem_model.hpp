@@ -61,15 +61,19 @@ struct XfemElement {
             if (cuts[j].id == id) return static_cast<int>(j);
         return -1;
     }
+    /// Cut j's level function at the point with barycentric coordinates `bary`.
+    [[nodiscard]] double level_at(std::size_t j, const std::array<double, 4>& bary) const
+    {
+        double phi = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * cuts[j].phi[c];
+        return phi;
+    }
     /// The region of the point with barycentric coordinates `bary` (0 when uncut).
     [[nodiscard]] unsigned region_at(const std::array<double, 4>& bary) const
     {
         unsigned pattern = 0;
-        for (std::size_t j = 0; j < cuts.size(); ++j) {
-            double phi = 0.0;
-            for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * cuts[j].phi[c];
-            if (phi >= 0.0) pattern |= 1u << j;
-        }
+        for (std::size_t j = 0; j < cuts.size(); ++j)
+            if (level_at(j, bary) >= 0.0) pattern |= 1u << j;
         return pattern;
     }
     /// The region node c lies in.
@@ -78,6 +82,15 @@ struct XfemElement {
         unsigned pattern = 0;
         for (std::size_t j = 0; j < cuts.size(); ++j) pattern |= static_cast<unsigned>(cuts[j].node_side[c]) << j;
         return pattern;
+    }
+    /// Node c as region `pattern` sees it, from the dof blocks' values x: x_c + sum over the cuts of
+    /// (h_j - H_jc) a_jc (the region's linear field; exact for k = 0).
+    [[nodiscard]] Eigen::Vector3d region_node(std::size_t c, unsigned pattern, const std::vector<Eigen::Vector3d>& x) const
+    {
+        Eigen::Vector3d p = x[node[c]];
+        for (std::size_t j = 0; j < cuts.size(); ++j)
+            p += (static_cast<double>((pattern >> j) & 1u) - cuts[j].node_side[c]) * x[cuts[j].enriched[c]];
+        return p;
     }
     /// Dof blocks of the element's shape functions: its 4 nodes, then each cut's enrichment of them.
     [[nodiscard]] std::size_t block_count() const { return 4 + 4 * cuts.size(); }

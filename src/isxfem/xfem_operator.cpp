@@ -29,17 +29,12 @@ Eigen::Matrix3d gradient_of(const std::array<Eigen::Vector3d, 4>& v, const TetGe
     return out;
 }
 
-/// The linear field of region `pattern` of a cut element: nodal positions x_i + sum over its cuts
-/// of (h_j - H_ji) a_ji (exact for k = 0, the linear part for k > 0), whose gradient gives the
-/// region's rotation.
+/// The linear field of region `pattern` of a cut element (exact for k = 0, the linear part for
+/// k > 0), whose gradient gives the region's rotation.
 std::array<Eigen::Vector3d, 4> region_field(const XfemElement& el, const std::vector<Eigen::Vector3d>& x, unsigned pattern)
 {
     std::array<Eigen::Vector3d, 4> p{};
-    for (std::size_t c = 0; c < 4; ++c) {
-        p[c] = x[el.node[c]];
-        for (std::size_t j = 0; j < el.cuts.size(); ++j)
-            p[c] += (static_cast<double>((pattern >> j) & 1u) - el.cuts[j].node_side[c]) * x[el.cuts[j].enriched[c]];
-    }
+    for (std::size_t c = 0; c < 4; ++c) p[c] = el.region_node(c, pattern, x);
     return p;
 }
 

@@ -18,6 +18,54 @@ Eigen::Matrix3d elastic_block(const Eigen::Vector3d& ga, const Eigen::Vector3d& 
     return lame.lambda * ga * gb.transpose() + lame.mu * (gb * ga.transpose() + ga.dot(gb) * Eigen::Matrix3d::Identity());
 }
 
+/// The element's basis at a point with barycentric coordinates n in region `pattern` (bit j: the
+/// side of cut j): N_c, then per cut psi_jc N_c, and their gradients (equation 3, added per cut).
+void basis_at(const std::array<double, 4>& n, const TetGeometry& g, const std::vector<std::array<unsigned char, 4>>& node_side,
+              const std::vector<Eigen::Vector3d>& grad_gamma, unsigned pattern, double k, std::vector<double>& value,
+              std::vector<Eigen::Vector3d>& grad)
+{
+    const std::size_t cuts = node_side.size();
+    value.resize(4 + 4 * cuts);
+    grad.resize(4 + 4 * cuts);
+    for (std::size_t c = 0; c < 4; ++c) {
+        value[c] = n[c];
+        grad[c] = g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
+    }
+    for (std::size_t j = 0; j < cuts; ++j) {
+        double gamma = 0.0;
+        for (std::size_t m = 0; m < 4; ++m) gamma += node_side[j][m] * n[m];
+        const double h = (pattern >> j) & 1u;
+        for (std::size_t c = 0; c < 4; ++c) {
+            const double psi = h - (k * gamma + (1.0 - k) * node_side[j][c]);
+            value[4 + 4 * j + c] = psi * n[c];
+            grad[4 + 4 * j + c] = psi * grad[c] - k * n[c] * grad_gamma[j];
+        }
+    }
+}
+
+/// Adds a quadrature point's stiffness and consistent-mass integrands, times `weight`.
+template <class Matrix>
+void add_point(double weight, const std::vector<double>& value, const std::vector<Eigen::Vector3d>& grad, const grid::Lame& lame,
+               double density, Matrix& stiffness, Matrix& mass)
+{
+    for (std::size_t a = 0; a < value.size(); ++a)
+        for (std::size_t b = 0; b < value.size(); ++b) {
+            const auto ia = static_cast<Eigen::Index>(3 * a), ib = static_cast<Eigen::Index>(3 * b);
+            stiffness.template block<3, 3>(ia, ib) += weight * elastic_block(grad[a], grad[b], lame);
+            mass.template block<3, 3>(ia, ib).diagonal().array() += weight * density * value[a] * value[b];
+        }
+}
+
+/// Per cut, the gradient of gamma_j = sum_m H_jm N_m.
+std::vector<Eigen::Vector3d> gamma_gradients(const TetGeometry& g, const std::vector<std::array<unsigned char, 4>>& node_side)
+{
+    std::vector<Eigen::Vector3d> out(node_side.size(), Eigen::Vector3d::Zero());
+    for (std::size_t j = 0; j < node_side.size(); ++j)
+        for (std::size_t c = 0; c < 4; ++c)
+            if (node_side[j][c]) out[j] += g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
+    return out;
+}
+
 /// The parts of `pieces` (reference coordinates) on one side of the linear function with values
 /// `phi` at the reference vertices.
 std::vector<Piece> clip(const std::vector<Piece>& pieces, const std::array<double, 4>& phi, bool positive)
@@ -85,34 +133,16 @@ CutTet cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::array<double,
     CutTet out;
     out.side_volume = {6.0 * g.volume * w.negative_volume, 6.0 * g.volume * w.positive_volume};
     for (int i = 0; i < 4; ++i) out.node_side[static_cast<std::size_t>(i)] = phi[static_cast<std::size_t>(i)] >= 0.0 ? 1 : 0;
-    Eigen::Vector3d grad_gamma = Eigen::Vector3d::Zero();
-    for (int m = 0; m < 4; ++m)
-        if (out.node_side[static_cast<std::size_t>(m)]) grad_gamma += g.gradient.row(m).transpose();
-    for (int side = 0; side < 2; ++side) {
+    const std::vector<std::array<unsigned char, 4>> node_side{out.node_side};
+    const std::vector<Eigen::Vector3d> grad_gamma = gamma_gradients(g, node_side);
+    std::vector<double> value;
+    std::vector<Eigen::Vector3d> grad;
+    for (unsigned side = 0; side < 2; ++side) {
         const Eigen::VectorXd& weights = side == 0 ? w.negative : w.positive;
-        const double h = side;
         for (std::size_t q = 0; q < fitting.points().size(); ++q) {
-            const double weight = 6.0 * g.volume * weights[static_cast<Eigen::Index>(q)];
             const Eigen::Vector3d& xi = fitting.points()[q];
-            const std::array<double, 4> n{1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
-            double gamma = 0.0;
-            for (int m = 0; m < 4; ++m) gamma += out.node_side[static_cast<std::size_t>(m)] * n[static_cast<std::size_t>(m)];
-            std::array<double, 8> value{};
-            std::array<Eigen::Vector3d, 8> grad;
-            for (int i = 0; i < 4; ++i) {
-                const double psi = h - (k * gamma + (1.0 - k) * out.node_side[static_cast<std::size_t>(i)]);
-                value[static_cast<std::size_t>(i)] = n[static_cast<std::size_t>(i)];
-                grad[static_cast<std::size_t>(i)] = g.gradient.row(i).transpose();
-                value[static_cast<std::size_t>(4 + i)] = psi * n[static_cast<std::size_t>(i)];
-                grad[static_cast<std::size_t>(4 + i)] = psi * g.gradient.row(i).transpose() - k * n[static_cast<std::size_t>(i)] * grad_gamma;
-            }
-            for (int a = 0; a < 8; ++a)
-                for (int b = 0; b < 8; ++b) {
-                    out.side_stiffness[static_cast<std::size_t>(side)].block<3, 3>(3 * a, 3 * b) +=
-                        weight * elastic_block(grad[static_cast<std::size_t>(a)], grad[static_cast<std::size_t>(b)], lame);
-                    out.mass.block<3, 3>(3 * a, 3 * b).diagonal().array() +=
-                        weight * density * value[static_cast<std::size_t>(a)] * value[static_cast<std::size_t>(b)];
-                }
+            basis_at({1.0 - xi.sum(), xi.x(), xi.y(), xi.z()}, g, node_side, grad_gamma, side, k, value, grad);
+            add_point(6.0 * g.volume * weights[static_cast<Eigen::Index>(q)], value, grad, lame, density, out.side_stiffness[side], out.mass);
         }
     }
     out.stiffness = out.side_stiffness[0] + out.side_stiffness[1];
@@ -129,15 +159,12 @@ MultiCutTet multi_cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::ve
     MultiCutTet out;
     out.mass = Eigen::MatrixXd::Zero(n_dofs, n_dofs);
     out.node_side.resize(cuts);
-    std::vector<Eigen::Vector3d> grad_gamma(cuts, Eigen::Vector3d::Zero());
     for (std::size_t j = 0; j < cuts; ++j)
-        for (std::size_t c = 0; c < 4; ++c) {
-            out.node_side[j][c] = phi[j][c] >= 0.0 ? 1 : 0;
-            if (out.node_side[j][c]) grad_gamma[j] += g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
-        }
+        for (std::size_t c = 0; c < 4; ++c) out.node_side[j][c] = phi[j][c] >= 0.0 ? 1 : 0;
+    const std::vector<Eigen::Vector3d> grad_gamma = gamma_gradients(g, out.node_side);
     const SimplexRule rule = grundmann_moeller_tetrahedron(2); // degree 5: the mass's integrands are of degree 4
-    std::vector<double> value(blocks);
-    std::vector<Eigen::Vector3d> grad(blocks);
+    std::vector<double> value;
+    std::vector<Eigen::Vector3d> grad;
     for (unsigned pattern = 0; pattern < (1u << cuts); ++pattern) {
         std::vector<Piece> pieces{whole_tetrahedron()};
         for (std::size_t j = 0; j < cuts && !pieces.empty(); ++j) pieces = clip(pieces, phi[j], (pattern >> j) & 1u);
@@ -148,29 +175,9 @@ MultiCutTet multi_cut_tet(const std::array<Eigen::Vector3d, 4>& x, const std::ve
         region.stiffness = Eigen::MatrixXd::Zero(n_dofs, n_dofs);
         for (const Piece& p : pieces)
             for (std::size_t q = 0; q < rule.points.size(); ++q) {
-                const double weight = 6.0 * g.volume * 6.0 * p.volume * rule.weights[q];
                 const Eigen::Vector3d xi = p.corner + p.edges * rule.points[q];
-                const std::array<double, 4> n{1.0 - xi.sum(), xi.x(), xi.y(), xi.z()};
-                for (std::size_t c = 0; c < 4; ++c) {
-                    value[c] = n[c];
-                    grad[c] = g.gradient.row(static_cast<Eigen::Index>(c)).transpose();
-                }
-                for (std::size_t j = 0; j < cuts; ++j) {
-                    double gamma = 0.0;
-                    for (std::size_t m = 0; m < 4; ++m) gamma += out.node_side[j][m] * n[m];
-                    const double h = (pattern >> j) & 1u;
-                    for (std::size_t c = 0; c < 4; ++c) {
-                        const double psi = h - (k * gamma + (1.0 - k) * out.node_side[j][c]);
-                        value[4 + 4 * j + c] = psi * n[c];
-                        grad[4 + 4 * j + c] = psi * grad[c] - k * n[c] * grad_gamma[j];
-                    }
-                }
-                for (std::size_t a = 0; a < blocks; ++a)
-                    for (std::size_t b = 0; b < blocks; ++b) {
-                        const auto ia = static_cast<Eigen::Index>(3 * a), ib = static_cast<Eigen::Index>(3 * b);
-                        region.stiffness.block<3, 3>(ia, ib) += weight * elastic_block(grad[a], grad[b], lame);
-                        out.mass.block<3, 3>(ia, ib).diagonal().array() += weight * density * value[a] * value[b];
-                    }
+                basis_at({1.0 - xi.sum(), xi.x(), xi.y(), xi.z()}, g, out.node_side, grad_gamma, pattern, k, value, grad);
+                add_point(6.0 * g.volume * 6.0 * p.volume * rule.weights[q], value, grad, lame, density, region.stiffness, out.mass);
             }
         out.regions.push_back(std::move(region));
     }

@@ -6,6 +6,8 @@
 
 #include "isxfem/cut_closure.hpp"
 
+#include "grid/union_find.hpp"
+
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
@@ -93,15 +95,12 @@ Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double
     const CutClosure closure(model);
     for (const Eigen::Vector3d& p : x) {
         const auto [tet, bary] = walk_to(model.mesh(), neighbours, 0, p);
-        out.points.push_back({tet, bary, closure.side_of(tet, bary), p, 0});
+        out.points.push_back({tet, bary, static_cast<int>(model.elements()[tet].region_at(bary)), p, 0});
     }
     out.counts = closure.close(report.cut, out.points, out.triangles);
     if (second) {
         EXPECT_GT(again.crossed_tets, 0u);
-        const ClosureCounts more = closure.close(again.cut, out.points, out.triangles);
-        out.counts.faces += more.faces;
-        out.counts.slit_faces += more.slit_faces;
-        out.counts.open_chains += more.open_chains;
+        out.counts += closure.close(again.cut, out.points, out.triangles);
     }
     return out;
 }
@@ -141,6 +140,15 @@ std::pair<double, double> volume_and_crack_area(const Closed& c, double y = NAN)
     return {volume, crack};
 }
 
+/// The surface's points joined by its triangles.
+vox::grid::UnionFind joined(const Closed& c)
+{
+    vox::grid::UnionFind sets(c.points.size());
+    for (const Eigen::Vector3i& t : c.triangles)
+        for (int k = 1; k < 3; ++k) sets.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[k]));
+    return sets;
+}
+
 /// Every piece of the surface lies on one side of each cut through the object (all cuts, or
 /// `through`): where a point's tetrahedron was cut, its region says which; elsewhere its rest
 /// position (off the plane) does.
@@ -148,11 +156,8 @@ void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
 {
     if (through.empty())
         for (int cut = 0; cut < c.model->cut_count(); ++cut) through.push_back(cut);
-    std::vector<int> parent(c.points.size());
-    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-    std::function<int(int)> root = [&](int i) { return parent[static_cast<std::size_t>(i)] == i ? i : parent[static_cast<std::size_t>(i)] = root(parent[static_cast<std::size_t>(i)]); };
-    for (const Eigen::Vector3i& t : c.triangles)
-        for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(t[k]))] = root(t[0]);
+    vox::grid::UnionFind pieces = joined(c);
+    auto root = [&](int i) { return static_cast<int>(pieces.find(static_cast<std::uint32_t>(i))); };
     for (const int cut : through) {
         std::map<int, int> side_of_piece;
         int disagreements = 0;
@@ -177,15 +182,9 @@ void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
 /// per side, so a through-cut leaves two).
 int pieces(const Closed& c)
 {
-    std::vector<int> parent(c.points.size());
-    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
-    std::function<int(int)> root = [&](int i) {
-        return parent[static_cast<std::size_t>(i)] == i ? i : parent[static_cast<std::size_t>(i)] = root(parent[static_cast<std::size_t>(i)]);
-    };
-    for (const Eigen::Vector3i& t : c.triangles)
-        for (int k = 1; k < 3; ++k) parent[static_cast<std::size_t>(root(t[k]))] = root(t[0]);
-    std::set<int> roots;
-    for (const Eigen::Vector3i& t : c.triangles) roots.insert(root(t[0]));
+    vox::grid::UnionFind sets = joined(c);
+    std::set<std::uint32_t> roots;
+    for (const Eigen::Vector3i& t : c.triangles) roots.insert(sets.find(static_cast<std::uint32_t>(t[0])));
     return static_cast<int>(roots.size());
 }
 
