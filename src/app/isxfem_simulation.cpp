@@ -65,10 +65,9 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     m_rest = m_surface->mesh(grid); // the used vertices in slot order, as m_vertices
 }
 
-isxfem::CutReport IsxfemSimulation::cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
-                                        const std::function<bool(const Eigen::Vector3d&)>& inside, int extend)
+isxfem::CutReport IsxfemSimulation::cut(const isxfem::CutSurface& surface, std::size_t new_from, int extend)
 {
-    const isxfem::CutReport r = m_model->cut(isxfem::PlaneCut{normal, normal.dot(point_m)}, inside, extend);
+    const isxfem::CutReport r = m_model->cut(surface, new_from, extend);
     if (r.cut_tets > 0) m_solver->model_changed();
     return r;
 }

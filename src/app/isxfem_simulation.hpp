@@ -30,10 +30,10 @@ public:
     [[nodiscard]] const isxfem::XfemSolver& solver() const { return *m_solver; }
     [[nodiscard]] std::size_t tet_count() const { return m_model->elements().size(); }
 
-    /// Cuts with the plane through `point_m` with unit `normal`, within the region `inside`;
-    /// `extend`: the id of the cut this continues (-1: a new one).
-    isxfem::CutReport cut(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
-                          const std::function<bool(const Eigen::Vector3d&)>& inside, int extend);
+    /// Cuts along a blade's swept surface (rest space, m) where it goes through tetrahedra whole;
+    /// its patches from `new_from` on are new. `extend`: the id of the cut this continues (-1: a
+    /// new one).
+    isxfem::CutReport cut(const isxfem::CutSurface& surface, std::size_t new_from, int extend);
 
     /// The deformed surface, world mm, closed along the cuts: triangles are split where a cut's
     /// crack crosses them (each piece moving with its side) and each crack is filled on both

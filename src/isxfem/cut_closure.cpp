@@ -16,7 +16,7 @@ namespace {
 using VertexEdge = std::pair<int, int>;                   ///< a surface edge, sorted
 using NodeEdge = std::pair<std::uint32_t, std::uint32_t>; ///< a tetrahedron edge, sorted
 
-/// Where the surface's triangles cross the plane: on an edge, in the crack or not.
+/// Where the surface's triangles cross the cut: on an edge, in the crack or not.
 struct Crossing {
     Eigen::Vector3d x = Eigen::Vector3d::Zero();
     std::size_t tet = 0; ///< holding it
@@ -37,7 +37,7 @@ struct Front {
     int chain = -1;        ///< the run of S's boundary inside R it starts or ends
 };
 
-/// A segment of R's boundary, R on its left (seen from the plane's normal): on the face of a cut
+/// A segment of R's boundary, R on its left (seen from the cut's normal there): on the face of a cut
 /// tetrahedron whose neighbour across it is not cut by this cut.
 struct Segment {
     NodeEdge from, to;
@@ -56,12 +56,23 @@ struct Loop {
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
-    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, int cut, std::vector<SurfacePoint>& points)
-        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_plane(model.cut_plane(cut)), m_points(points)
+    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, double longest_edge, int cut,
+           std::vector<SurfacePoint>& points)
+        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_surface(model.cut_surface(cut)), m_points(points),
+          m_longest_edge(longest_edge)
     {
-        m_n = m_plane.normal.normalized();
+        // Crack faces are triangulated seen from the cut's mean normal (a swept cut turns far less
+        // than a right angle from it: app/blade_stroke.hpp, so none of it is seen edge on).
+        m_n = m_surface.mean_normal();
         m_u = m_n.unitOrthogonal();
         m_w = m_n.cross(m_u);
+        m_reach = m_surface.bounds();
+        if (!m_surface.is_plane()) {
+            m_reach.extend(m_reach.min() - Eigen::Vector3d::Constant(longest_edge));
+            m_reach.extend(m_reach.max() + Eigen::Vector3d::Constant(longest_edge));
+            for (const CutPatch& p : m_surface.patches())
+                for (const Eigen::Vector3d& c : p.corners) m_far_origin += c / static_cast<double>(p.corners.size() * m_surface.patches().size());
+        }
         build_boundary();
     }
 
@@ -70,6 +81,15 @@ public:
     ClosureCounts counts;
 
 private:
+    /// The cut's level at a point: the model's near the cut (its tetrahedron's nodes' levels where
+    /// the cut fixed them), its mean plane's beyond the reach of its patches (where only the
+    /// surface's crossing loops run on, which any level closes; and a surface of many vertices is
+    /// not searched patch by patch).
+    [[nodiscard]] double level(std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const
+    {
+        if (!m_reach.contains(x)) return m_n.dot(x - m_far_origin);
+        return m_model.level(m_cut, tet, bary, x);
+    }
     [[nodiscard]] bool in_crack(std::int64_t tet) const
     {
         return tet >= 0 && m_model.elements()[static_cast<std::size_t>(tet)].cut_index(m_cut) >= 0;
@@ -139,9 +159,12 @@ private:
     const XfemModel& m_model;
     const std::vector<std::array<std::int32_t, 4>>& m_neighbours;
     int m_cut;
-    const PlaneCut& m_plane;
+    const CutSurface& m_surface;
     std::vector<SurfacePoint>& m_points;
     Eigen::Vector3d m_n, m_u, m_w;
+    Eigen::AlignedBox3d m_reach;                                ///< where the level is the model's
+    Eigen::Vector3d m_far_origin = Eigen::Vector3d::Zero();    ///< a point of the mean plane
+    std::vector<double> m_point_level;                          ///< per point split() started with
 
     std::map<VertexEdge, int> m_crossing_of;
     std::vector<Crossing> m_crossings;
@@ -151,6 +174,10 @@ private:
     std::multimap<NodeEdge, int> m_leaving;               ///< R's boundary: its segments by start
     std::map<std::pair<std::size_t, int>, int> m_on_face; ///< (tet, face) -> its segment
     std::map<std::pair<NodeEdge, unsigned>, int> m_corner_points; ///< R's boundary vertices placed so far, by region
+    /// A swept cut's vertices (its crossings of the cut tetrahedra's edges) and a cut tetrahedron
+    /// at each: what a crack face takes inside it to follow the cut where it bends.
+    std::map<NodeEdge, std::pair<Eigen::Vector3d, std::size_t>> m_crack_vertices;
+    double m_longest_edge = 0.0;
 };
 
 void Closer::build_boundary()
@@ -162,7 +189,7 @@ void Closer::build_boundary()
         if (index < 0) continue;
         const XfemElement& el = elements[t];
         const std::array<double, 4>& phi = el.cuts[static_cast<std::size_t>(index)].phi;
-        // The plane's crossing of a tetrahedron edge, from its lower node: the same bits in every
+        // The cut's crossing of a tetrahedron edge, from its lower node: the same bits in every
         // tetrahedron around the edge.
         auto on_edge = [&](std::size_t a, std::size_t b) {
             if (el.node[a] > el.node[b]) std::swap(a, b);
@@ -175,8 +202,10 @@ void Closer::build_boundary()
         for (std::size_t a = 0; a < 4; ++a)
             for (std::size_t b = a + 1; b < 4; ++b)
                 if (crossed(a, b)) {
-                    centre += on_edge(a, b).second;
+                    const auto [edge, x] = on_edge(a, b);
+                    centre += x;
                     ++count;
+                    if (!m_surface.is_plane()) m_crack_vertices.try_emplace(edge, x, t);
                 }
         if (count < 3) continue;
         centre /= count;
@@ -186,8 +215,9 @@ void Closer::build_boundary()
             for (std::size_t a = 0; a < 4; ++a)
                 for (std::size_t b = a + 1; b < 4; ++b)
                     if (static_cast<int>(a) != face && static_cast<int>(b) != face && crossed(a, b)) ends.push_back(on_edge(a, b));
-            if (ends.size() != 2) continue; // the plane through a corner of the face: no segment
-            if ((ends[1].second - ends[0].second).cross(centre - ends[0].second).dot(m_n) < 0.0) std::swap(ends[0], ends[1]);
+            if (ends.size() != 2) continue; // the cut through a corner of the face: no segment
+            if ((ends[1].second - ends[0].second).cross(centre - ends[0].second).dot(m_model.crack_normal(m_cut, t, centre)) < 0.0)
+                std::swap(ends[0], ends[1]);
             const int s = static_cast<int>(m_segments.size());
             m_segments.push_back({ends[0].first, ends[1].first, ends[0].second, ends[1].second, t, face});
             m_leaving.emplace(ends[0].first, s);
@@ -202,11 +232,27 @@ int Closer::crossing(int a, int b)
     if (const auto it = m_crossing_of.find(key); it != m_crossing_of.end()) return it->second;
     const SurfacePoint va = m_points[static_cast<std::size_t>(key.first)]; // copies: m_points grows below
     const SurfacePoint vb = m_points[static_cast<std::size_t>(key.second)];
-    const double fa = m_plane.at(va.rest_m), fb = m_plane.at(vb.rest_m);
+    double fa = m_point_level[static_cast<std::size_t>(key.first)], fb = m_point_level[static_cast<std::size_t>(key.second)];
+    Eigen::Vector3d xa = va.rest_m, xb = vb.rest_m;
     Crossing c;
-    c.x = va.rest_m + fa / (fa - fb) * (vb.rest_m - va.rest_m);
+    c.x = xa + fa / (fa - fb) * (xb - xa);
     c.label = va.label;
     std::tie(c.tet, c.bary) = walk_to(m_model.mesh(), m_neighbours, va.tet, c.x);
+    // A swept cut's level is linear only within a tetrahedron: a few steps of regula falsi put the
+    // crossing on the crack where the edge spans several.
+    for (int step = 0; step < 4 && !m_surface.is_plane(); ++step) {
+        const double f = level(c.tet, c.bary, c.x);
+        if (std::abs(f) <= 1e-9 * std::abs(fa - fb)) break;
+        if ((f < 0.0) == (fa < 0.0)) {
+            xa = c.x;
+            fa = f;
+        } else {
+            xb = c.x;
+            fb = f;
+        }
+        c.x = xa + fa / (fa - fb) * (xb - xa);
+        std::tie(c.tet, c.bary) = walk_to(m_model.mesh(), m_neighbours, c.tet, c.x);
+    }
     c.inside = in_crack(static_cast<std::int64_t>(c.tet));
     // On another cut's plane (an edge of that cut's crack faces) its side of that cut is the
     // edge's ends' (the face's side), not what rounding says.
@@ -289,12 +335,14 @@ int Closer::corner_point(int segment, std::pair<std::size_t, unsigned> near)
 
 void Closer::split(std::vector<Eigen::Vector3i>& triangles)
 {
-    // The triangles the plane crosses, and their crossings.
+    // The triangles the cut crosses, and their crossings.
+    m_point_level.resize(m_points.size());
+    for (std::size_t k = 0; k < m_points.size(); ++k) m_point_level[k] = level(m_points[k].tet, m_points[k].bary, m_points[k].rest_m);
     std::vector<std::array<bool, 3>> positive(triangles.size());
     std::vector<std::array<int, 2>> cross(triangles.size(), {-1, -1});
     for (std::size_t i = 0; i < triangles.size(); ++i) {
         const Eigen::Vector3i& t = triangles[i];
-        for (int a = 0; a < 3; ++a) positive[i][static_cast<std::size_t>(a)] = m_plane.at(m_points[static_cast<std::size_t>(t[a])].rest_m) >= 0.0;
+        for (int a = 0; a < 3; ++a) positive[i][static_cast<std::size_t>(a)] = m_point_level[static_cast<std::size_t>(t[a])] >= 0.0;
         if (positive[i][0] == positive[i][1] && positive[i][1] == positive[i][2]) continue;
         for (int a = 0, k = 0; a < 3; ++a)
             if (positive[i][static_cast<std::size_t>(a)] != positive[i][static_cast<std::size_t>((a + 1) % 3)])
@@ -330,7 +378,8 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
         const Eigen::Vector3d outward =
             (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
         auto runs = [&](int from, int to) {
-            return (m_crossings[static_cast<std::size_t>(to)].x - m_crossings[static_cast<std::size_t>(from)].x).dot(m_n.cross(outward)) > 0.0;
+            const Crossing& a = m_crossings[static_cast<std::size_t>(from)];
+            return (m_crossings[static_cast<std::size_t>(to)].x - a.x).dot(m_model.crack_normal(m_cut, a.tet, a.x).cross(outward)) > 0.0;
         };
         if (in0 && in1) {
             if (!runs(cross[i][1], cross[i][0]))
@@ -391,6 +440,25 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
     std::vector<std::array<int, 3>> faces;
     for (const std::array<int, 3>& f : triangulate_polygon(in_plane, shared))
         if (!shared[static_cast<std::size_t>(f[0])] || !shared[static_cast<std::size_t>(f[1])] || !shared[static_cast<std::size_t>(f[2])]) faces.push_back(f);
+    // Where a swept cut bends, triangles across its face would cut through the material: the
+    // cut's own vertices inside the face are added where they lie off the triangles so far.
+    const std::size_t boundary = ids.size();
+    for (const auto& [edge, at] : m_crack_vertices) {
+        const auto& [point, tet] = at;
+        const int holder = locate(in_plane, faces, flat(point));
+        if (holder < 0) continue;
+        const std::array<int, 3>& f = faces[static_cast<std::size_t>(holder)];
+        const Eigen::Vector3d& x0 = x[static_cast<std::size_t>(f[0])];
+        const Eigen::Vector3d normal = (x[static_cast<std::size_t>(f[1])] - x0).cross(x[static_cast<std::size_t>(f[2])] - x0);
+        if (std::abs(normal.normalized().dot(point - x0)) <= 1e-3 * m_longest_edge) continue;
+        insert_point(in_plane, faces, holder, flat(point), boundary);
+        const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), tet, point));
+        const unsigned region = m_model.elements()[tet].region_at(bary);
+        const unsigned bit = 1u << m_model.elements()[tet].cut_index(m_cut);
+        ids.push_back({add_point(tet, bary, static_cast<int>(region & ~bit), point, 0), add_point(tet, bary, static_cast<int>(region | bit), point, 0)});
+        x.push_back(point);
+        shared.push_back(false);
+    }
     std::map<std::pair<int, int>, std::vector<std::size_t>> glued; // shared-shared edge -> the faces using it
     for (std::size_t k = 0; k < faces.size(); ++k)
         for (int e = 0; e < 3; ++e) {
@@ -561,11 +629,17 @@ std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
 
 } // namespace
 
-CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh())) {}
+CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh()))
+{
+    for (const auto& tet : model.mesh().tets)
+        for (std::size_t a = 0; a < 4; ++a)
+            for (std::size_t b = a + 1; b < 4; ++b)
+                m_longest_edge = std::max(m_longest_edge, (model.mesh().nodes[tet[a]] - model.mesh().nodes[tet[b]]).norm());
+}
 
 ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const
 {
-    Closer closer(m_model, m_neighbours, cut, points);
+    Closer closer(m_model, m_neighbours, m_longest_edge, cut, points);
     closer.split(triangles);
     closer.fill(triangles);
     return closer.counts;

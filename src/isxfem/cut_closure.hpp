@@ -3,9 +3,9 @@
 // and exported is a closed surface whatever the cut: a cut through the object, or a slit that stops
 // inside it.
 //
-// Per cut, in its plane: the crack is R, the union of the plane's polygons in the tetrahedra the
-// cut separated; the object's cross-section is S, bounded by where the plane crosses the surface's
-// triangles. A triangle whose crossing lies in R is split along it, each piece on its side (the
+// Per cut, along its surface (a plane, or a blade's swept surface: isxfem/cut_surface.hpp): the
+// crack is R, the union of the cut's polygons in the tetrahedra it separated; the object's
+// cross-section is S, bounded by where the cut's level crosses the surface's triangles. A triangle whose crossing lies in R is split along it, each piece on its side (the
 // crossing points get one copy per side); where a crossing leaves R inside a triangle, the crack
 // ends there (a front point, one vertex shared by both sides) and the rest of the triangle stays
 // whole. The crack's faces are S and R intersected: S's boundary inside R (the split crossings)
@@ -58,6 +58,7 @@ public:
 private:
     const XfemModel& m_model;
     std::vector<std::array<std::int32_t, 4>> m_neighbours;
+    double m_longest_edge = 0.0; ///< of the mesh's tetrahedra, m
 };
 
 } // namespace vox::isxfem

@@ -97,6 +97,63 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vec
     return out;
 }
 
+int locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p)
+{
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+        const Eigen::Vector2d& a = points[static_cast<std::size_t>(triangles[k][0])];
+        const Eigen::Vector2d& b = points[static_cast<std::size_t>(triangles[k][1])];
+        const Eigen::Vector2d& c = points[static_cast<std::size_t>(triangles[k][2])];
+        // Clear of the edges by a millionth of the area: a point on an edge would leave a flat triangle.
+        const double clear = 1e-6 * cross(a, b, c);
+        if (clear > 0.0 && cross(a, b, p) > clear && cross(b, c, p) > clear && cross(c, a, p) > clear) return static_cast<int>(k);
+    }
+    return -1;
+}
+
+void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, int holder, const Eigen::Vector2d& p,
+                  std::size_t boundary)
+{
+    const int id = static_cast<int>(points.size());
+    points.push_back(p);
+    const std::array<int, 3> split = triangles[static_cast<std::size_t>(holder)];
+    triangles[static_cast<std::size_t>(holder)] = {split[0], split[1], id};
+    triangles.push_back({split[1], split[2], id});
+    triangles.push_back({split[2], split[0], id});
+    auto at = [&](int i) -> const Eigen::Vector2d& { return points[static_cast<std::size_t>(i)]; };
+    auto fixed = [&](int a, int b) {
+        const auto n = static_cast<int>(boundary);
+        return a < n && b < n && ((a + 1) % n == b || (b + 1) % n == a);
+    };
+    // Each triangle (a, b, id) holds p; its edge a-b is flipped when the point across it lies in
+    // its circumcircle, and the two new edges opposite p are checked in turn.
+    std::vector<std::pair<int, int>> edges{{split[0], split[1]}, {split[1], split[2]}, {split[2], split[0]}};
+    while (!edges.empty()) {
+        const auto [a, b] = edges.back();
+        edges.pop_back();
+        if (fixed(a, b)) continue;
+        std::size_t mine = triangles.size(), across = triangles.size();
+        int d = -1;
+        for (std::size_t k = 0; k < triangles.size(); ++k)
+            for (std::size_t e = 0; e < 3; ++e) {
+                const int u = triangles[k][e], v = triangles[k][(e + 1) % 3];
+                if (u == a && v == b && triangles[k][(e + 2) % 3] == id) mine = k;
+                if (u == b && v == a) {
+                    across = k;
+                    d = triangles[k][(e + 2) % 3];
+                }
+            }
+        if (mine == triangles.size() || across == triangles.size()) continue;
+        const Eigen::Vector2d pa = at(a) - at(d), pb = at(b) - at(d), pp = at(id) - at(d);
+        const double in_circle = pa.squaredNorm() * (pb.x() * pp.y() - pb.y() * pp.x()) - pb.squaredNorm() * (pa.x() * pp.y() - pa.y() * pp.x()) +
+                                 pp.squaredNorm() * (pa.x() * pb.y() - pa.y() * pb.x());
+        if (!(in_circle > 0.0) || cross(at(a), at(d), at(id)) <= 0.0 || cross(at(d), at(b), at(id)) <= 0.0) continue;
+        triangles[mine] = {a, d, id};
+        triangles[across] = {d, b, id};
+        edges.emplace_back(a, d);
+        edges.emplace_back(d, b);
+    }
+}
+
 std::vector<std::vector<LoopCorner>> faces_with_holes(const std::vector<std::vector<Eigen::Vector2d>>& loops, std::size_t& left_out)
 {
     std::vector<double> area;

@@ -1,6 +1,7 @@
 #pragma once
-// Triangulation of a simple polygon by ear clipping (O(n^2)), and holes bridged into the polygons
-// around them, for the faces that close a cut.
+// Triangulation of a simple polygon by ear clipping (O(n^2)), holes bridged into the polygons
+// around them, and points added inside a triangulation (split, then Lawson's flips to Delaunay),
+// for the faces that close a cut.
 
 #include <Eigen/Core>
 
@@ -14,6 +15,15 @@ namespace vox::isxfem {
 /// find, then a fan over the rest. `apart` (optional, per vertex): diagonals joining two flagged
 /// vertices are avoided where another ear will do.
 std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector2d>& polygon, const std::vector<bool>& apart = {});
+
+/// The triangle (counter-clockwise, indices into `points`) that holds p clear of its edges, or -1.
+int locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p);
+
+/// Adds p to the triangulation inside triangle `holder` (locate()): the triangle is split in three
+/// and edges are flipped until each is locally Delaunay, except the boundary's (the polygon
+/// points[0 .. boundary - 1] in order, bridges included). p is appended to `points`.
+void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, int holder, const Eigen::Vector2d& p,
+                  std::size_t boundary);
 
 /// A corner of one of several loops.
 struct LoopCorner {

@@ -32,34 +32,90 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
 CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside, int extend)
 {
     if (extend >= m_cuts) throw std::invalid_argument("XfemModel::cut: no cut " + std::to_string(extend) + " to extend");
+    const CutSurface surface = extend >= 0 ? m_surfaces[static_cast<std::size_t>(extend)] : CutSurface(plane);
+    return cut_along(
+        extend >= 0 ? extend : m_cuts, extend >= 0, surface, [](std::size_t) { return true; },
+        [&inside](const Eigen::Vector3d&, const Eigen::Vector3d&, const Eigen::Vector3d& crossing) { return !inside || inside(crossing); });
+}
+
+CutReport XfemModel::cut(const CutSurface& surface, std::size_t new_from, int extend)
+{
+    if (extend >= m_cuts) throw std::invalid_argument("XfemModel::cut: no cut " + std::to_string(extend) + " to extend");
+    if (extend >= 0) m_surfaces[static_cast<std::size_t>(extend)] = surface;
+    const Eigen::AlignedBox3d reach = surface.bounds(new_from);
+    auto candidate = [&](std::size_t t) {
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        for (std::uint32_t n : m_elements[t].node) box.extend(m_mesh.nodes[n]);
+        return box.intersects(reach);
+    };
+    return cut_along(extend >= 0 ? extend : m_cuts, extend >= 0, surface, candidate,
+                     [&surface](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d&) { return surface.meets(a, b); });
+}
+
+bool XfemModel::node_levels(int id, std::size_t tet, std::array<double, 4>& phi) const
+{
+    const auto& levels = m_node_levels[static_cast<std::size_t>(id)];
+    for (std::size_t c = 0; c < 4; ++c) {
+        const auto it = levels.find(m_elements[tet].node[c]);
+        if (it == levels.end()) return false;
+        phi[c] = it->second;
+    }
+    return true;
+}
+
+double XfemModel::level(int id, std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const
+{
+    const CutSurface& surface = m_surfaces.at(static_cast<std::size_t>(id));
+    std::array<double, 4> phi{};
+    if (surface.is_plane() || !node_levels(id, tet, phi)) return surface.level(x);
+    return bary[0] * phi[0] + bary[1] * phi[1] + bary[2] * phi[2] + bary[3] * phi[3];
+}
+
+Eigen::Vector3d XfemModel::crack_normal(int id, std::size_t tet, const Eigen::Vector3d& x) const
+{
+    const CutSurface& surface = m_surfaces.at(static_cast<std::size_t>(id));
+    std::array<double, 4> phi{};
+    if (surface.is_plane() || !node_levels(id, tet, phi)) return surface.normal(x);
+    const Eigen::Vector3d gradient = m_elements[tet].geometry.gradient.transpose() * Eigen::Vector4d(phi[0], phi[1], phi[2], phi[3]);
+    return gradient.squaredNorm() > 0.0 ? Eigen::Vector3d(gradient.normalized()) : surface.normal(x);
+}
+
+CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
+                               const EdgeTest& covered)
+{
     CutReport report;
-    const int id = extend >= 0 ? extend : m_cuts;
-    std::unordered_map<std::uint32_t, std::uint32_t> fresh;
-    std::unordered_map<std::uint32_t, std::uint32_t>& block_of_node = extend >= 0 ? m_cut_blocks[static_cast<std::size_t>(extend)] : fresh;
+    std::unordered_map<std::uint32_t, std::uint32_t> fresh_blocks;
+    std::unordered_map<std::uint32_t, double> fresh_levels;
+    auto& block_of_node = extend ? m_cut_blocks[static_cast<std::size_t>(id)] : fresh_blocks;
+    auto& level_of_node = extend ? m_node_levels[static_cast<std::size_t>(id)] : fresh_levels;
     // Which tetrahedra the cut separates whole, then their cut matrices on all threads (the
     // quadrature is most of a cut's time), then their enriched blocks in order.
     std::vector<std::uint32_t> candidates;
     std::vector<std::array<double, 4>> candidate_phi;
     for (std::size_t t = 0; t < m_elements.size(); ++t) {
         const XfemElement& e = m_elements[t];
+        if (e.cut_index(id) >= 0 || !candidate(t)) continue;
         std::array<double, 4> phi{};
         bool negative = false, positive = false;
         for (std::size_t c = 0; c < 4; ++c) {
-            phi[c] = plane.at(m_mesh.nodes[e.node[c]]);
+            const auto fixed = level_of_node.find(e.node[c]);
+            phi[c] = fixed != level_of_node.end() ? fixed->second : surface.level(m_mesh.nodes[e.node[c]]);
             (phi[c] < 0.0 ? negative : positive) = true;
         }
-        if (!negative || !positive || e.cut_index(id) >= 0) continue;
+        if (!negative || !positive) continue;
         if (e.cuts.size() >= k_max_cuts) {
             ++report.already_cut; // cut as often as it can be: left as it was
             continue;
         }
-        // A closed boundary: every edge the plane crosses is crossed inside the region.
+        // A closed boundary: every edge the level crosses is cut.
         bool whole = true;
-        for (std::size_t a = 0; a < 4 && whole && inside; ++a)
+        for (std::size_t a = 0; a < 4 && whole; ++a)
             for (std::size_t b = a + 1; b < 4 && whole; ++b)
                 if ((phi[a] < 0.0) != (phi[b] < 0.0)) {
-                    const double f = phi[a] / (phi[a] - phi[b]);
-                    whole = inside(m_mesh.nodes[e.node[a]] + f * (m_mesh.nodes[e.node[b]] - m_mesh.nodes[e.node[a]]));
+                    const Eigen::Vector3d& xa = m_mesh.nodes[e.node[a]];
+                    const Eigen::Vector3d& xb = m_mesh.nodes[e.node[b]];
+                    whole = covered(xa, xb, xa + phi[a] / (phi[a] - phi[b]) * (xb - xa));
                 }
         if (!whole) {
             ++report.partial_tets;
@@ -108,6 +164,7 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
         ElementCut cut;
         cut.id = id;
         cut.phi = candidate_phi[i];
+        for (std::size_t n = 0; n < 4; ++n) level_of_node.try_emplace(e.node[n], cut.phi[n]);
         cut.node_side = c.node_side.back();
         for (std::size_t n = 0; n < 4; ++n) {
             const auto [it, added] = block_of_node.try_emplace(e.node[n], static_cast<std::uint32_t>(block_count()));
@@ -127,9 +184,10 @@ CutReport XfemModel::cut(const PlaneCut& plane, const std::function<bool(const E
     if (report.cut_tets > 0) {
         ++m_revision;
         report.cut = id;
-        if (extend < 0) {
-            m_cut_blocks.push_back(std::move(fresh));
-            m_cut_planes.push_back(plane);
+        if (!extend) {
+            m_cut_blocks.push_back(std::move(fresh_blocks));
+            m_node_levels.push_back(std::move(fresh_levels));
+            m_surfaces.push_back(surface);
             ++m_cuts;
         }
     }

@@ -1,8 +1,10 @@
 #pragma once
 // A tetrahedral model that can be cut without remeshing (Is-XFEM): the mesh at rest, a material per
-// tetrahedron, and the cuts made so far. A cut is planar inside each tetrahedron it crosses and
-// is kept only where it separates the tetrahedron whole (its crossing points on all the
-// tetrahedron's cut edges lie inside the cut's region: a closed boundary through the element).
+// tetrahedron, and the cuts made so far. A cut goes along a plane or a blade's swept surface
+// (isxfem/cut_surface.hpp); it is planar inside each tetrahedron it crosses (the level function
+// interpolated from the tetrahedron's nodes, the same at a node for all its tetrahedra, so the
+// crack is continuous), and is kept only where it separates the tetrahedron whole: every edge
+// whose nodes lie on two sides is met by the cut's surface, a closed boundary through the element.
 // Each node of a tetrahedron cut by cut j gets a block of three enriched dofs for j; dof blocks
 // are numbered after the nodes' own, so the system grows and nothing is remeshed.
 //
@@ -14,6 +16,7 @@
 // tetrahedra keep their pieces coupled, and the report counts them (`crossed_tets`) so the
 // caller can say so. A third cut through a tetrahedron is not applied there (counted too).
 
+#include "isxfem/cut_surface.hpp"
 #include "isxfem/moment_fitting.hpp"
 #include "isxfem/plane_cut_system.hpp"
 #include "isxfem/tet_mesh.hpp"
@@ -118,6 +121,11 @@ public:
     /// cut by the same plane that this one continues (a blade going on through its stroke), whose
     /// nodes keep their enriched blocks, so the crack stays one surface; -1: a new cut.
     CutReport cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside = {}, int extend = -1);
+    /// Cuts along a swept surface where it goes through a tetrahedron whole. Its patches from
+    /// `new_from` on are new since the last call for this stroke (only the tetrahedra they reach
+    /// can have become whole); with `extend`, the surface replaces that cut's (it is the same
+    /// stroke, grown).
+    CutReport cut(const CutSurface& surface, std::size_t new_from, int extend = -1);
 
     [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
     [[nodiscard]] const std::vector<XfemElement>& elements() const { return m_elements; }
@@ -140,8 +148,16 @@ public:
     {
         return block < node_count() ? 1.0 : m_enriched_across[block - node_count()] / m_support[enriched_node(block)];
     }
-    /// The plane of cut `id`.
-    [[nodiscard]] const PlaneCut& cut_plane(int id) const { return m_cut_planes.at(static_cast<std::size_t>(id)); }
+    /// The surface cut `id` went along.
+    [[nodiscard]] const CutSurface& cut_surface(int id) const { return m_surfaces.at(static_cast<std::size_t>(id)); }
+    /// Cut `id`'s level function at the point x (world m, barycentric coordinates `bary`) of
+    /// tetrahedron `tet`: interpolated from the nodes' levels where the cut has fixed all four (in
+    /// and around the tetrahedra it cut), its surface's elsewhere.
+    [[nodiscard]] double level(int id, std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const;
+    /// The unit normal of cut `id` (towards its positive side) in tetrahedron `tet` around x: the
+    /// gradient of its interpolated level where it has all four node levels, its surface's normal
+    /// elsewhere.
+    [[nodiscard]] Eigen::Vector3d crack_normal(int id, std::size_t tet, const Eigen::Vector3d& x) const;
 
 private:
     TetMesh m_mesh;
@@ -153,7 +169,17 @@ private:
     std::vector<double> m_enriched_across;      ///< per enriched block: volume across its cut in its node's support, m^3
     std::vector<double> m_support;              ///< per node: volume of its tetrahedra, m^3
     std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> m_cut_blocks; ///< per cut: node -> enriched block
-    std::vector<PlaneCut> m_cut_planes;
+    std::vector<CutSurface> m_surfaces;                                   ///< per cut
+    std::vector<std::unordered_map<std::uint32_t, double>> m_node_levels; ///< per cut: node -> level, fixed once it cut with it
+
+    using EdgeTest = std::function<bool(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& crossing)>;
+    /// Cut `id` (extend: an existing one) along `surface` through the tetrahedra `candidate` lets
+    /// through, where `covered` says each of a tetrahedron's edges with nodes on two sides is cut
+    /// (its ends and the level's crossing point on it).
+    CutReport cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
+                        const EdgeTest& covered);
+    /// The four nodes' levels of cut `id` in tetrahedron `tet`, if all are fixed.
+    [[nodiscard]] bool node_levels(int id, std::size_t tet, std::array<double, 4>& phi) const;
     int m_cuts = 0;
     std::size_t m_revision = 0;
 };

@@ -1,10 +1,10 @@
 // `voxsculpt run` with the Is-XFEM solver, end to end: the bundled bar is cut through by its blade
 // over several frames into one crack, its far half falls away while the held half stays, and the
 // surface comes out closed along the cut (two closed pieces, the bar's volume between them), and
-// along the front of a slit that stops inside it; a finger pressing on the cylinder pushes as it
-// does on the branched grid; a two-phase knife holds the block while it marks; the haptic loop
-// runs beside it; a scene asking Is-XFEM for what it does not do yet is refused with one message
-// naming the key.
+// along the front of a slit that stops inside it; a blade turning as it cuts leaves one curved
+// crack; a finger pressing on the cylinder pushes as it does on the branched grid; a two-phase
+// knife holds the block while it marks; the haptic loop runs beside it; a scene asking Is-XFEM
+// for what it does not do yet is refused with one message naming the key.
 
 #include "app/run_command.hpp"
 #include "test_support.hpp"
@@ -136,6 +136,44 @@ TEST(IsxfemRun, AWaveringBladeCutsOnAlongItsStrokesPlane)
     EXPECT_EQ(stats["summary"]["cuts"], 1);
     EXPECT_EQ(stats["summary"]["cut_tets"], 54); // the bar's 3 x 3 cells across, six tetrahedra each
     EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
+}
+
+TEST(IsxfemRun, ACurvedIncisionIsOneCutAndItsPieceFalls)
+{
+    // A 2 mm blade drawn across a 16 x 40 x 10 mm slab (held at one end) along an arc of radius
+    // 20 mm, turning by 56 degrees about the vertical as it goes, through the slab's full height:
+    // the cut follows the blade's swept surface, one crack with no tetrahedron cut twice, and the
+    // far piece falls away closed.
+    const fs::path d = fresh_dir("isxfem_curved");
+    std::ostringstream script;
+    for (int k = 0; k <= 30; ++k) {
+        const double turn = (-28.0 + 56.0 * k / 30.0) * 3.14159265358979323846 / 180.0;
+        script << (k ? ",\n" : "") << "{\"t_s\": " << 0.01 * k << ", \"tool\": \"blade\", \"position_mm\": [" << 8.0 + 20.0 * std::sin(turn) << ", "
+               << 40.0 - 20.0 * std::cos(turn) << ", 5], \"orientation_wxyz\": [" << std::cos(turn / 2) << ", 0, 0, " << std::sin(turn / 2) << "]}";
+    }
+    std::ofstream(d / "scene.json") << R"({
+        "object": {"phantom": {"shape": "beam", "size_mm": [16, 40, 10], "voxel_mm": 1.0}, "levels": 1},
+        "materials": {"default": {"youngs_modulus_pa": 1e6, "poisson_ratio": 0.3, "density_kg_m3": 1000}},
+        "solver": {"type": "isxfem", "k": 0.1, "dt_s": 0.01, "cg_tolerance": 1e-6, "cg_max_iterations": 2000},
+        "gravity_m_s2": [0, 0, -9.81],
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [17, 2, 11]]}],
+        "tools": [{"name": "blade", "shape": "blade", "size_mm": [2, 1, 30], "cut_pressure_pa": 1}],
+        "script": [)" << script.str() << R"(]
+    })";
+    const auto r = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 40 --out " + quote((d / "out").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(d / "out" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["summary"]["cuts"], 1);
+    EXPECT_EQ(stats["summary"]["recut_tets"], 0);
+    EXPECT_EQ(stats["summary"]["crack_faces"], 1);
+    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
+    const nlohmann::json mesh = vox::test::info_json(d / "out" / "final.obj");
+    EXPECT_EQ(mesh["closed"], true);
+    EXPECT_EQ(mesh["components"], 2);
+    EXPECT_EQ(mesh["consistently_oriented"], true);
+    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 16.0 * 40.0 * 10.0, 150.0);
+    EXPECT_LT(mesh["world_bbox_mm"]["min"][2].get<double>(), -30.0); // the far piece, 0.1 s after the cut: 0.5 g t^2 = 49 mm
 }
 
 TEST(IsxfemRun, AFingerPushesOnTheTetrahedraAsOnTheBranchedGrid)

@@ -1,8 +1,8 @@
 // Closing an embedded surface along a cut: a box's surface, finer than the tetrahedra it is
-// embedded in, cut through and slit halfway down. Checked against what the geometry must give: a
-// closed, consistently oriented surface (every edge used once each way), the crack faces' area (S
-// and R intersected, computed by hand), the enclosed volume unchanged at rest, and the right number
-// of pieces.
+// embedded in, cut through and slit halfway down, by planes and by a blade's sweep that bends.
+// Checked against what the geometry must give: a closed, consistently oriented surface (every
+// edge used once each way), the crack faces' area (S and R intersected, computed by hand), the
+// enclosed volume unchanged at rest, and the right number of pieces.
 
 #include "isxfem/cut_closure.hpp"
 
@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -67,11 +68,9 @@ struct Closed {
 };
 
 /// A 6 x 4 x 4 lattice of 1 m cubes with the box surface [0.05, 5.95] x [0.05, 3.95]^2 embedded
-/// (triangles of about `step`; with `cavity`, a void inside it too), cut by the plane x = 3.1 where `inside` holds, then closed. With
-/// the default step the surface's vertices lie on y = 2 and z = 2, where the cubes' faces are: the
-/// crack's front runs along the surface's edges and meets the surface at its vertices.
-Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false,
-               const PlaneCut* second = nullptr, const std::function<bool(const Eigen::Vector3d&)>& second_inside = {})
+/// (triangles of about `step`; with `cavity`, a void inside it too), cut by `cuts` (their reports
+/// in order), then closed along each cut.
+Closed closed_box(const std::function<std::vector<CutReport>(XfemModel&)>& cuts, double step = 0.39, bool cavity = false)
 {
     Closed out;
     out.model = std::make_shared<XfemModel>(cube_lattice({6, 4, 4}, 1.0), std::vector<TetMaterial>{TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
@@ -88,21 +87,34 @@ Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double
         for (const Eigen::Vector3i& t : inner) out.triangles.emplace_back(t[0] + first, t[2] + first, t[1] + first);
     }
     const auto neighbours = face_neighbours(model.mesh());
-    const CutReport report = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}, inside);
-    EXPECT_GT(report.cut_tets, 0u);
-    CutReport again;
-    if (second) again = model.cut(*second, second_inside);
+    const std::vector<CutReport> reports = cuts(model);
     const CutClosure closure(model);
     for (const Eigen::Vector3d& p : x) {
         const auto [tet, bary] = walk_to(model.mesh(), neighbours, 0, p);
         out.points.push_back({tet, bary, static_cast<int>(model.elements()[tet].region_at(bary)), p, 0});
     }
-    out.counts = closure.close(report.cut, out.points, out.triangles);
-    if (second) {
-        EXPECT_GT(again.crossed_tets, 0u);
-        out.counts += closure.close(again.cut, out.points, out.triangles);
-    }
+    for (const CutReport& r : reports) out.counts += closure.close(r.cut, out.points, out.triangles);
     return out;
+}
+
+/// The box cut by the plane x = 3.1 where `inside` holds, and then by `second` where
+/// `second_inside` does (crossing the first). With the default step the surface's vertices lie on
+/// y = 2 and z = 2, where the cubes' faces are: the crack's front runs along the surface's edges
+/// and meets the surface at its vertices.
+Closed cut_box(const std::function<bool(const Eigen::Vector3d&)>& inside, double step = 0.39, bool cavity = false,
+               const PlaneCut* second = nullptr, const std::function<bool(const Eigen::Vector3d&)>& second_inside = {})
+{
+    return closed_box(
+        [&](XfemModel& model) {
+            std::vector<CutReport> reports{model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}, inside)};
+            EXPECT_GT(reports[0].cut_tets, 0u);
+            if (second) {
+                reports.push_back(model.cut(*second, second_inside));
+                EXPECT_GT(reports[1].crossed_tets, 0u);
+            }
+            return reports;
+        },
+        step, cavity);
 }
 
 /// Every edge used once in each direction: closed and consistently oriented.
@@ -168,8 +180,8 @@ void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
             int side = -1;
             if (at >= 0)
                 side = (p.side >> at) & 1;
-            else if (std::abs(c.model->cut_plane(cut).at(p.rest_m)) > 1e-9)
-                side = c.model->cut_plane(cut).at(p.rest_m) > 0.0;
+            else if (std::abs(c.model->cut_surface(cut).level(p.rest_m)) > 1e-9)
+                side = c.model->cut_surface(cut).level(p.rest_m) > 0.0;
             if (side < 0) continue;
             const auto [it, fresh] = side_of_piece.try_emplace(root(static_cast<int>(i)), side);
             if (!fresh && it->second != side) ++disagreements;
@@ -296,4 +308,79 @@ TEST(CutClosure, ASlitAcrossAnEarlierCutKeepsEachSideOnItsPiece)
     expect_pieces_on_one_side(c, {0}); // the slit joins the two sides of its own cut
     EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
     EXPECT_NEAR(volume_and_crack_area(c, 2.1).second, 2.0 * 5.9 * (3.95 - 2.0), 1e-9);
+}
+
+namespace {
+
+constexpr double k_bend_radius = 4.0;
+const Eigen::Vector2d k_bend_centre(7.1, 2.0);
+
+/// A blade's sweep bending through the box: patches 2 degrees wide along the arc of radius 4 about
+/// (7.1, 2) in x-y (through x = 3.1 at y = 2), from y = -0.5 to `to_y`, through all of z.
+CutSurface bent_sweep(double to_y)
+{
+    auto at = [](double angle) { return Eigen::Vector2d(k_bend_centre + k_bend_radius * Eigen::Vector2d(-std::cos(angle), std::sin(angle))); };
+    CutSurface sweep;
+    const double step = 2.0 * M_PI / 180.0, last = std::asin((to_y - 2.0) / k_bend_radius);
+    for (double angle = std::asin(-2.5 / k_bend_radius); angle < last; angle += step) {
+        const Eigen::Vector2d a = at(angle), b = at(std::min(angle + step, last));
+        CutPatch p;
+        p.corners = {{a.x(), a.y(), -1.0}, {b.x(), b.y(), -1.0}, {b.x(), b.y(), 5.0}, {a.x(), a.y(), 5.0}};
+        const Eigen::Vector2d towards_centre = (k_bend_centre - 0.5 * (a + b)).normalized();
+        p.normal = {towards_centre.x(), towards_centre.y(), 0.0};
+        if ((p.corners[1] - p.corners[0]).cross(p.corners[2] - p.corners[0]).dot(p.normal) < 0.0) std::reverse(p.corners.begin(), p.corners.end());
+        sweep.add(p);
+    }
+    return sweep;
+}
+
+/// The area of the closed surface's triangles on the bent crack (facing along x, away from the
+/// box's own faces) and how far their corners and middles lie from the bend's cylinder.
+std::pair<double, double> bent_crack(const Closed& c)
+{
+    double area = 0.0, off = 0.0;
+    for (const Eigen::Vector3i& t : c.triangles) {
+        std::array<Eigen::Vector3d, 4> x;
+        for (int k = 0; k < 3; ++k) x[static_cast<std::size_t>(k)] = c.points[static_cast<std::size_t>(t[k])].rest_m;
+        const Eigen::Vector3d n = (x[1] - x[0]).cross(x[2] - x[0]);
+        if (std::abs(n.normalized().x()) < 0.8 || std::min({x[0].x(), x[1].x(), x[2].x()}) < 0.5 || std::max({x[0].x(), x[1].x(), x[2].x()}) > 5.5)
+            continue;
+        area += 0.5 * n.norm();
+        x[3] = (x[0] + x[1] + x[2]) / 3.0;
+        for (const Eigen::Vector3d& p : x) off = std::max(off, std::abs((p.head<2>() - k_bend_centre).norm() - k_bend_radius));
+    }
+    return {area, off};
+}
+
+} // namespace
+
+TEST(CutClosure, ABentSweepIsClosedAndItsFacesFollowTheBend)
+{
+    const CutSurface sweep = bent_sweep(4.5);
+    const Closed c = closed_box([&](XfemModel& model) { return std::vector<CutReport>{model.cut(sweep, 0)}; });
+    EXPECT_EQ(c.counts.faces, 1u);
+    EXPECT_EQ(c.counts.open_chains, 0u);
+    expect_closed(c);
+    EXPECT_EQ(pieces(c), 2);
+    expect_pieces_on_one_side(c);
+    EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
+    // The crack through the box: its arc between y = 0.05 and 3.95, 3.9 high, on both sides, to
+    // within what the cut's planes in 1 m tetrahedra make of the bend (chords of tetrahedron edges
+    // up to 1.7 m long: 1.7^2 / 8 r off the arc); a face triangulated from its rim alone would lie
+    // 0.5 m off it in the middle.
+    const auto [area, off] = bent_crack(c);
+    EXPECT_NEAR(area, 2.0 * 3.9 * 2.0 * k_bend_radius * std::asin(1.95 / k_bend_radius), 0.01 * area);
+    EXPECT_LT(off, 0.1);
+}
+
+TEST(CutClosure, ABentSlitIsClosedAlongItsFront)
+{
+    const CutSurface sweep = bent_sweep(2.5); // from y = -0.5 to 2.5: into the box and stopping inside
+    const Closed c = closed_box([&](XfemModel& model) { return std::vector<CutReport>{model.cut(sweep, 0)}; });
+    EXPECT_EQ(c.counts.slit_faces, 1u);
+    EXPECT_EQ(c.counts.open_chains, 0u);
+    expect_closed(c);
+    EXPECT_EQ(pieces(c), 1);
+    EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
+    EXPECT_LT(bent_crack(c).second, 0.1);
 }

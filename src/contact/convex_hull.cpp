@@ -1,4 +1,4 @@
-#include "contact/swept_profile.hpp"
+#include "contact/convex_hull.hpp"
 
 #include <algorithm>
 
@@ -31,30 +31,6 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> points)
     }
     hull.resize(k - 1); // the last point repeats the first
     return hull;
-}
-
-SweptProfile::SweptProfile(std::vector<Eigen::Vector2d> profile) : m_profile(std::move(profile)) {}
-
-void SweptProfile::add(const Eigen::Matrix2d& r0, const Eigen::Vector2d& t0, const Eigen::Matrix2d& r1, const Eigen::Vector2d& t1)
-{
-    std::vector<Eigen::Vector2d> placed;
-    placed.reserve(2 * m_profile.size());
-    for (const Eigen::Vector2d& p : m_profile) {
-        placed.push_back(r0 * p + t0);
-        placed.push_back(r1 * p + t1);
-    }
-    m_hulls.push_back(convex_hull(std::move(placed)));
-}
-
-bool SweptProfile::covers(const Eigen::Vector2d& q) const
-{
-    for (const auto& hull : m_hulls) {
-        if (hull.size() < 3) continue;
-        bool inside = true;
-        for (std::size_t k = 0; k < hull.size() && inside; ++k) inside = cross(hull[k], hull[(k + 1) % hull.size()], q) >= 0.0;
-        if (inside) return true;
-    }
-    return false;
 }
 
 } // namespace vox::contact

@@ -1,0 +1,136 @@
+#include "isxfem/cut_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vox::isxfem {
+namespace {
+
+/// Squared distance from x to the segment a-b.
+double segment_distance2(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+    const Eigen::Vector3d ab = b - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0.0 ? std::clamp((x - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    return (a + t * ab - x).squaredNorm();
+}
+
+/// Squared distance from x to a convex patch.
+double patch_distance2(const Eigen::Vector3d& x, const CutPatch& p)
+{
+    const double height = p.normal.dot(x - p.corners[0]);
+    const Eigen::Vector3d q = x - height * p.normal;
+    bool inside = true;
+    for (std::size_t k = 0; k < p.corners.size() && inside; ++k)
+        inside = (p.corners[(k + 1) % p.corners.size()] - p.corners[k]).cross(q - p.corners[k]).dot(p.normal) >= 0.0;
+    if (inside) return height * height;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < p.corners.size(); ++k) best = std::min(best, segment_distance2(x, p.corners[k], p.corners[(k + 1) % p.corners.size()]));
+    return best;
+}
+
+/// Möller and Trumbore: whether the segment a-b meets the triangle v0 v1 v2 (edges and ends
+/// included, so a segment through the seam of two triangles meets one of them).
+bool segment_meets_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& v0, const Eigen::Vector3d& v1,
+                            const Eigen::Vector3d& v2)
+{
+    const Eigen::Vector3d d = b - a, e1 = v1 - v0, e2 = v2 - v0;
+    const Eigen::Vector3d p = d.cross(e2);
+    const double det = e1.dot(p);
+    if (std::abs(det) <= 1e-14 * d.norm() * e1.norm() * e2.norm()) return false; // along the triangle's plane
+    const double inv = 1.0 / det;
+    const Eigen::Vector3d s = a - v0;
+    const double u = s.dot(p) * inv;
+    if (u < 0.0 || u > 1.0) return false;
+    const Eigen::Vector3d q = s.cross(e1);
+    const double v = d.dot(q) * inv;
+    if (v < 0.0 || u + v > 1.0) return false;
+    const double t = e2.dot(q) * inv;
+    return t >= 0.0 && t <= 1.0;
+}
+
+} // namespace
+
+CutSurface::CutSurface(const PlaneCut& plane) : m_is_plane(true), m_plane(plane) {}
+
+void CutSurface::add(CutPatch patch)
+{
+    if (patch.corners.size() < 3) return;
+    Eigen::AlignedBox3d box;
+    box.setEmpty();
+    for (const Eigen::Vector3d& c : patch.corners) box.extend(c);
+    m_boxes.push_back(box);
+    m_patches.push_back(std::move(patch));
+}
+
+std::size_t CutSurface::nearest(const Eigen::Vector3d& x) const
+{
+    // The patch whose box is nearest first, then only those whose box could hold a nearer point.
+    std::vector<double> box_distance(m_patches.size());
+    std::size_t best = 0;
+    for (std::size_t k = 0; k < m_patches.size(); ++k) {
+        box_distance[k] = m_boxes[k].squaredExteriorDistance(x);
+        if (box_distance[k] < box_distance[best]) best = k;
+    }
+    double best_distance = patch_distance2(x, m_patches[best]);
+    for (std::size_t k = 0; k < m_patches.size(); ++k) {
+        if (k == best || box_distance[k] >= best_distance) continue;
+        const double d = patch_distance2(x, m_patches[k]);
+        if (d < best_distance) {
+            best_distance = d;
+            best = k;
+        }
+    }
+    return best;
+}
+
+double CutSurface::level(const Eigen::Vector3d& x) const
+{
+    if (m_is_plane) return m_plane.at(x);
+    if (m_patches.empty()) return 0.0;
+    const CutPatch& p = m_patches[nearest(x)];
+    return p.normal.dot(x - p.corners[0]);
+}
+
+Eigen::Vector3d CutSurface::normal(const Eigen::Vector3d& x) const
+{
+    if (m_is_plane) return m_plane.normal.normalized();
+    return m_patches.empty() ? mean_normal() : m_patches[nearest(x)].normal;
+}
+
+Eigen::Vector3d CutSurface::mean_normal() const
+{
+    if (m_is_plane) return m_plane.normal.normalized();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const CutPatch& p : m_patches)
+        for (std::size_t k = 1; k + 1 < p.corners.size(); ++k) sum += (p.corners[k] - p.corners[0]).cross(p.corners[k + 1] - p.corners[0]);
+    return sum.squaredNorm() > 0.0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::UnitX();
+}
+
+bool CutSurface::meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::size_t first) const
+{
+    if (m_is_plane) return (m_plane.at(a) < 0.0) != (m_plane.at(b) < 0.0);
+    Eigen::AlignedBox3d segment(a.cwiseMin(b), a.cwiseMax(b));
+    for (std::size_t k = first; k < m_patches.size(); ++k) {
+        if (!m_boxes[k].intersects(segment)) continue;
+        const std::vector<Eigen::Vector3d>& c = m_patches[k].corners;
+        for (std::size_t i = 1; i + 1 < c.size(); ++i)
+            if (segment_meets_triangle(a, b, c[0], c[i], c[i + 1])) return true;
+    }
+    return false;
+}
+
+Eigen::AlignedBox3d CutSurface::bounds(std::size_t first) const
+{
+    if (m_is_plane) {
+        const double huge = std::numeric_limits<double>::max();
+        return {Eigen::Vector3d::Constant(-huge), Eigen::Vector3d::Constant(huge)};
+    }
+    Eigen::AlignedBox3d box;
+    box.setEmpty();
+    for (std::size_t k = first; k < m_boxes.size(); ++k) box.extend(m_boxes[k]);
+    return box;
+}
+
+} // namespace vox::isxfem
