@@ -145,22 +145,8 @@ TEST(IsxfemRun, ACurvedIncisionIsOneCutAndItsPieceFalls)
     // the cut follows the blade's swept surface, one crack with no tetrahedron cut twice, and the
     // far piece falls away closed.
     const fs::path d = fresh_dir("isxfem_curved");
-    std::ostringstream script;
-    for (int k = 0; k <= 30; ++k) {
-        const double turn = (-28.0 + 56.0 * k / 30.0) * 3.14159265358979323846 / 180.0;
-        script << (k ? ",\n" : "") << "{\"t_s\": " << 0.01 * k << ", \"tool\": \"blade\", \"position_mm\": [" << 8.0 + 20.0 * std::sin(turn) << ", "
-               << 40.0 - 20.0 * std::cos(turn) << ", 5], \"orientation_wxyz\": [" << std::cos(turn / 2) << ", 0, 0, " << std::sin(turn / 2) << "]}";
-    }
-    std::ofstream(d / "scene.json") << R"({
-        "object": {"phantom": {"shape": "beam", "size_mm": [16, 40, 10], "voxel_mm": 1.0}, "levels": 1},
-        "materials": {"default": {"youngs_modulus_pa": 1e6, "poisson_ratio": 0.3, "density_kg_m3": 1000}},
-        "solver": {"type": "isxfem", "k": 0.1, "dt_s": 0.01, "cg_tolerance": 1e-6, "cg_max_iterations": 2000},
-        "gravity_m_s2": [0, 0, -9.81],
-        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [17, 2, 11]]}],
-        "tools": [{"name": "blade", "shape": "blade", "size_mm": [2, 1, 30], "cut_pressure_pa": 1}],
-        "script": [)" << script.str() << R"(]
-    })";
-    const auto r = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 40 --out " + quote((d / "out").string()));
+    const auto r = run_voxsculpt("run " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/slab_curved_cut_isxfem.json") + " --frames 40 --out " +
+                                 quote((d / "out").string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     std::ifstream in(d / "out" / "stats.json");
     const nlohmann::json stats = nlohmann::json::parse(in);
