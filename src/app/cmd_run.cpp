@@ -85,9 +85,16 @@ void add_run_command(CLI::App& app)
         picture_options.camera.up = scene_up(scene);
         std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
         if (scene.solver.type == io::SolverType::isxfem) {
-            if (!args->device.empty() || !args->replay.empty() || args->render_every > 0)
-                throw InputError("--device, --replay and --render-every work with \"type\": \"dbg\" scenes only so far");
-            run_isxfem(scene, args->scene, args->frames, args->out.empty() ? scene.output.dir : std::filesystem::path(args->out));
+            if (!args->device.empty() || !args->replay.empty())
+                throw InputError("--device and --replay work with \"type\": \"dbg\" scenes only so far");
+            std::unique_ptr<ScenePictures> pictures;
+            if (args->render_every > 0) {
+                pictures = std::make_unique<ScenePictures>(picture_options);
+                log::info("pictures every {} frames ({} x {}, {})", args->render_every, picture_options.width, picture_options.height,
+                          pictures->context_description());
+            }
+            run_isxfem(scene, args->scene, args->frames, args->out.empty() ? scene.output.dir : std::filesystem::path(args->out), pictures.get(),
+                       args->render_every);
             return;
         }
         const grid::LabelGrid labels = io::load_scene_object(scene);

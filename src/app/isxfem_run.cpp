@@ -29,7 +29,8 @@ void write_surface(const std::filesystem::path& path, const IsxfemSimulation& si
 
 } // namespace
 
-void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::optional<int> frame_count, const std::filesystem::path& out)
+void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::optional<int> frame_count, const std::filesystem::path& out,
+                ScenePictures* pictures, int render_every)
 {
     if (scene.object.auto_levels) throw scene.error("object.levels", "\"isxfem\" needs a fixed level (0 to 6), not \"auto\"");
     const grid::LabelGrid labels = io::load_scene_object(scene);
@@ -67,7 +68,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
         recut += frame_cut.recut_tets;
         if (frame_cut.crossed_tets > 0 && crossed == 0)
             log::warn("frame {}: two cuts cross inside {} tetrahedra; the added enrichments cannot move their four pieces apart "
-                      "independently, so the pieces stay coupled there (counted per frame in stats.json: crossed_tets)",
+                      "independently, so the pieces stay coupled there (counted per frame in stats.json: crossed_tets; "
+                      "orange in the pictures of --render-every)",
                       f, frame_cut.crossed_tets);
         crossed += frame_cut.crossed_tets;
         if (frame_cut.already_cut > 0) {
@@ -75,7 +77,8 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
             // per frame in stats.json.
             if (left_whole.empty())
                 log::warn("frame {}: {} tetrahedra already cut twice were crossed by another cut and left as they were (Is-XFEM "
-                          "takes two cuts per tetrahedron; their pieces stay joined along the new cut)",
+                          "takes two cuts per tetrahedron; their pieces stay joined along the new cut; orange in the pictures "
+                          "of --render-every)",
                           f, frame_cut.already_cut);
             left_whole.insert(static_cast<std::size_t>(f));
         }
@@ -115,6 +118,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"object_held", tool_frame.hold_object},
                                    {"tools", tool_frames_json(tool_frame.tools)}});
         if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / frame_file_name(f, "obj"), sim);
+        if (pictures && f % render_every == 0) pictures->write(out / frame_file_name(f, "png"), sim, tools, scene);
         progress.update(static_cast<std::uint64_t>(f));
     }
     progress.finish();
@@ -138,6 +142,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
         stats["linear_solver"] = sim.solver().fallback_note();
     }
     write_surface(out / "final.obj", sim);
+    if (pictures) pictures->write(out / "final.png", sim, tools, scene);
     write_atomically(out / "stats.json", [&](const std::filesystem::path &tmp) {
       std::ofstream(tmp) << stats.dump(1) << '\n';
     });

@@ -149,6 +149,18 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
     return out;
 }
 
+std::vector<IsxfemSimulation::Mark> IsxfemSimulation::surface_marks() const
+{
+    refresh_closed_surface();
+    std::vector<Mark> out;
+    out.reserve(m_closed_vertices.size());
+    for (std::size_t v = 0; v < m_closed_vertices.size(); ++v) { // the closure appends what it makes after the object's own
+        const isxfem::XfemElement& el = m_model->elements()[m_closed_vertices[v].tet];
+        out.push_back(el.crossed || el.cut_left_out ? Mark::coupled : v >= m_vertices.size() ? Mark::cut : Mark::surface);
+    }
+    return out;
+}
+
 /// The closed surface's vertices within a box: their material points, deformed positions (mm),
 /// areas and normals, and the triangles with all three corners among them.
 struct IsxfemSimulation::NearSurface {

@@ -39,6 +39,11 @@ public:
     /// crack crosses them (each piece moving with its side) and each crack is filled on both
     /// sides, through the object or, for a slit, up to its front (isxfem/cut_closure.hpp).
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
+    /// What each vertex of surface_mesh() is, for pictures: the object's surface, made by a cut
+    /// (split or crack face), or in a tetrahedron whose pieces the cuts could not all separate
+    /// (two cuts crossing inside it, or a further cut left out there).
+    enum class Mark : unsigned char { surface, cut, coupled };
+    [[nodiscard]] std::vector<Mark> surface_marks() const;
     /// What closing the surface along the cuts made, and what it had to leave open.
     [[nodiscard]] isxfem::ClosureCounts closure_counts() const;
     /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.

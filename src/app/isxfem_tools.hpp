@@ -44,6 +44,8 @@ public:
     /// A device moves `tool` from now on (its script entries are ignored): its pose for the next
     /// frames, world mm.
     void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation);
+    /// Where `tool` was at the last frame (its shape null when it was not placed).
+    [[nodiscard]] const contact::PlacedShape& placed(std::size_t tool) const { return m_last_pose[tool]; }
 
 private:
     const io::Scene& m_scene;

@@ -5,6 +5,12 @@
 #include <sstream>
 
 namespace vox::app {
+namespace {
+
+/// Cut surfaces are drawn lighter, as freshly cut tissue or clay looks.
+const Eigen::Vector3f k_cut_tone(0.95f, 0.70f, 0.62f);
+
+} // namespace
 
 Eigen::Vector3d scene_up(const io::Scene& scene)
 {
@@ -76,6 +82,24 @@ void ScenePictures::write(const std::filesystem::path& path, const SceneSimulati
     write(path, meshes);
 }
 
+void ScenePictures::write(const std::filesystem::path& path, const IsxfemSimulation& sim, const IsxfemTools& tools, const io::Scene& scene)
+{
+    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth)};
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
+    write(path, meshes);
+}
+
+render::DrawMesh surface_picture(const IsxfemSimulation& sim, int smooth)
+{
+    render::DrawMesh d = surface_drawing(sim.surface_mesh(), smooth);
+    const std::vector<IsxfemSimulation::Mark> marks = sim.surface_marks();
+    for (std::size_t v = 0; v < marks.size() && v < d.colors.size(); ++v) {
+        if (marks[v] == IsxfemSimulation::Mark::cut) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone;
+        if (marks[v] == IsxfemSimulation::Mark::coupled) d.colors[v] = 0.2f * d.colors[v] + 0.8f * Eigen::Vector3f(1.0f, 0.45f, 0.05f);
+    }
+    return d;
+}
+
 std::unordered_set<std::uint64_t> surface_keys(const SceneSimulation& sim)
 {
     std::unordered_set<std::uint64_t> keys;
@@ -93,7 +117,7 @@ render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const s
     const auto& slots = surface.embedded().vertices();
     for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < d.colors.size(); ++slot) {
         if (!slots[slot].users) continue; // the mesh lists the slots in use, in order
-        if (uncut && !uncut->contains(slots[slot].key)) d.colors[v] = 0.5f * d.colors[v] + 0.5f * Eigen::Vector3f(0.95f, 0.70f, 0.62f); // cut surface
+        if (uncut && !uncut->contains(slots[slot].key)) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone; // cut surface
         const std::uint32_t e = surface.vertex_element(slot);
         const auto w = e < sim.model().elements().size() ? static_cast<float>(sim.solver().water(e)) : 0.0f;
         if (w > 0.0f) d.colors[v] = (1.0f - 0.5f * w) * d.colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);

@@ -3,6 +3,8 @@
 // tool (its cutting shape in steel, its pushing shape as a translucent shell), rendered offscreen
 // to PNG files. A sequence keeps one camera, framed on the first picture, so frames line up.
 
+#include "app/isxfem_simulation.hpp"
+#include "app/isxfem_tools.hpp"
 #include "app/scene_simulation.hpp"
 #include "app/tool_session.hpp"
 #include "render/camera.hpp"
@@ -38,6 +40,10 @@ struct PictureOptions {
 /// The simulation's deformed surface as drawn: label colours, wet material darker, and, with
 /// `uncut` (surface_keys() before any cut), the surface cuts have made in a lighter, pinker tone.
 [[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut = nullptr);
+/// An Is-XFEM simulation's deformed, closed surface as drawn: label colours, the surface cuts made
+/// in the same lighter tone, and where the cuts could not separate all pieces of a tetrahedron
+/// (IsxfemSimulation::Mark::coupled) in orange.
+[[nodiscard]] render::DrawMesh surface_picture(const IsxfemSimulation& sim, int smooth);
 /// The fine voxels as boxes where the model has moved them: every face of a voxel not joined to a
 /// neighbour (the object's outside, removed neighbours, faces a cut opened), each corner carried
 /// by its element's trilinear map; coloured by label.
@@ -57,6 +63,7 @@ public:
     void write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes);
     /// The simulation's surface and placed tools.
     void write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene);
+    void write(const std::filesystem::path& path, const IsxfemSimulation& sim, const IsxfemTools& tools, const io::Scene& scene);
     /// Remembers the surface as it is (before any cut), so that cut surfaces show in their own tone.
     void remember_uncut(const SceneSimulation& sim) { m_uncut = surface_keys(sim); }
 

@@ -94,7 +94,7 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
     std::vector<std::uint32_t> candidates;
     std::vector<std::array<double, 4>> candidate_phi;
     for (std::size_t t = 0; t < m_elements.size(); ++t) {
-        const XfemElement& e = m_elements[t];
+        XfemElement& e = m_elements[t];
         if (e.cut_index(id) >= 0 || !candidate(t)) continue;
         std::array<double, 4> phi{};
         bool negative = false, positive = false;
@@ -104,10 +104,6 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
             (phi[c] < 0.0 ? negative : positive) = true;
         }
         if (!negative || !positive) continue;
-        if (e.cuts.size() >= k_max_cuts) {
-            ++report.already_cut; // cut as often as it can be: left as it was
-            continue;
-        }
         // A closed boundary: every edge the level crosses is cut.
         bool whole = true;
         for (std::size_t a = 0; a < 4 && whole; ++a)
@@ -119,6 +115,11 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
                 }
         if (!whole) {
             ++report.partial_tets;
+            continue;
+        }
+        if (e.cuts.size() >= k_max_cuts) {
+            ++report.already_cut; // cut as often as it can be: left as it was, and marked
+            e.cut_left_out = true;
             continue;
         }
         candidates.push_back(static_cast<std::uint32_t>(t));

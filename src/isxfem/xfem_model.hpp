@@ -54,6 +54,7 @@ struct XfemElement {
     std::vector<ElementCut> cuts;            ///< in the order they came (at most k_max_cuts)
     std::vector<Region> regions;             ///< cut: its non-empty regions
     bool crossed = false;                    ///< two cuts cross inside: four pieces, not all separable
+    bool cut_left_out = false;               ///< a further cut went through it whole after its k_max_cuts: left out here
     Matrix12d stiffness = Matrix12d::Zero(); ///< whole: K at rest
     Eigen::MatrixXd mass;                    ///< consistent mass over its dofs, kg
     [[nodiscard]] bool is_cut() const { return !cuts.empty(); }
@@ -107,7 +108,7 @@ struct CutReport {
     std::size_t crossed_tets = 0;   ///< of those, where the two cuts cross inside: pieces left coupled
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
-    std::size_t already_cut = 0;    ///< crossed but cut k_max_cuts times before: left as they were
+    std::size_t already_cut = 0;    ///< crossed whole but cut k_max_cuts times before: left as they were (XfemElement::cut_left_out)
 };
 
 class XfemModel {
