@@ -14,12 +14,11 @@ namespace {
 double cos_degrees(double degrees) { return std::cos(degrees * 3.14159265358979323846 / 180.0); }
 
 // A frame turns a blade by a few degrees: more is a new stroke (a blade lifted and set down
-// elsewhere, or a script's jump), as is moving across its own plane by more than a hand wavers.
-// A stroke turns by at most 60 degrees from where it began, so the crack is never seen edge on
-// from its mean normal, which its faces are triangulated in (isxfem/cut_closure.hpp).
+// elsewhere, or a script's jump), as is moving across its own plane by more than a hand wavers, or
+// by more than along it (a blade pushed flat does not cut on; it would stack patches side by side).
 const double k_max_frame_turn_cos = cos_degrees(10.0);
-const double k_max_turn_cos = cos_degrees(60.0);
 constexpr double k_max_offset_mm = 1.0;
+constexpr double k_waver_mm = 0.1;
 
 } // namespace
 
@@ -32,29 +31,40 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
                                        const Eigen::Vector3d& moved_mm, bool cut)
 {
     const Eigen::Vector3d normal = to.orientation.toRotationMatrix().col(1);
-    const bool goes_on = !m_surface.patches().empty() && normal.dot(m_first_normal) >= k_max_turn_cos &&
-                         normal.dot(m_last_normal) >= k_max_frame_turn_cos &&
-                         std::abs((to.position_mm - m_last_position_mm).dot(m_last_normal)) <= k_max_offset_mm;
+    const Eigen::Vector3d moved = to.position_mm - m_last_position_mm;
+    const double across = std::abs(moved.dot(m_last_normal)), along = (moved - moved.dot(m_last_normal) * m_last_normal).norm();
+    const bool going = !m_surface.patches().empty();
+    const bool goes_on = going && normal.dot(m_last_normal) >= k_max_frame_turn_cos && across <= k_max_offset_mm && across <= std::max(k_waver_mm, along);
     if (!goes_on) {
         m_surface = {};
         m_offered = 0;
         m_cut = -1;
-        m_first_normal = normal;
     }
     m_last_normal = normal;
     m_last_position_mm = to.position_mm;
-    // The frame's patch: the profile where the frame began (where the blade was, when it was in
-    // this stroke's plane) and where it ended, in the plane halfway between.
-    const bool from_here = from.placed && from.orientation.toRotationMatrix().col(1).dot(normal) >= k_max_frame_turn_cos;
+    // The frame's patch: the profile where the frame began (where the blade was, if in the same
+    // plane and not where an ended stroke left off) and where it ended, in the plane halfway between.
+    const bool from_here = (goes_on || !going) && from.placed && from.orientation.toRotationMatrix().col(1).dot(normal) >= k_max_frame_turn_cos;
     const io::ToolPose& start = from_here ? from : to;
+    // Where the blade began and ended the frame in rest space. Going on, it moved there as in the
+    // world less the material's own move within the blade's plane: across the plane the material
+    // carries the crack along with it, so the crack goes on from where it was (its patches do not
+    // step sideways as the material sways).
+    Eigen::Vector3d rest_start = start.position_mm - moved_mm, rest_end = to.position_mm - moved_mm;
+    if (goes_on && from_here) {
+        const Eigen::Vector3d material = moved_mm - m_last_moved_mm;
+        rest_start = m_last_rest_mm;
+        rest_end = rest_start + (to.position_mm - start.position_mm) - (material - material.dot(normal) * normal);
+    }
+    m_last_rest_mm = rest_end;
+    m_last_moved_mm = moved_mm;
     const Eigen::Quaterniond middle = start.orientation.slerp(0.5, to.orientation);
     const Eigen::Matrix3d frame = middle.toRotationMatrix();
-    const Eigen::Vector3d centre_mm = 0.5 * (start.position_mm + to.position_mm) - moved_mm;
+    const Eigen::Vector3d centre_mm = 0.5 * (rest_start + rest_end);
     std::vector<Eigen::Vector2d> placed;
-    for (const io::ToolPose* pose : {&start, &to})
+    for (const auto& [pose, at] : {std::pair{&start, rest_start}, std::pair{&to, rest_end}})
         for (const Eigen::Vector2d& p : m_profile) {
-            const Eigen::Vector3d local =
-                frame.transpose() * (pose->position_mm - moved_mm + pose->orientation * Eigen::Vector3d(p.x(), 0.0, p.y()) - centre_mm);
+            const Eigen::Vector3d local = frame.transpose() * (at + pose->orientation * Eigen::Vector3d(p.x(), 0.0, p.y()) - centre_mm);
             placed.emplace_back(local.x(), local.z());
         }
     isxfem::CutPatch patch;

@@ -3,10 +3,12 @@
 // x-z plane) sweeps. Each frame adds a flat patch to the stroke's swept surface
 // (isxfem/cut_surface.hpp): the convex hull of the blade's profile where the frame began and where
 // it ended, in the plane halfway between, carried back to rest space by the mean displacement of
-// the material around the blade. A stroke is one cut, one crack, while the blade goes on along
-// its own plane: it may turn and tilt as it goes (a curved incision) by up to 10 degrees a frame
-// and 60 degrees in all, and move across its plane by up to 1 mm a frame (a hand wavers); past
-// that a new stroke, a new cut, begins. A tetrahedron the blade crosses whole only over several
+// the material around the blade (within the blade's plane only, once the stroke is going: across
+// it the material carries the crack along). A stroke is one cut, one crack, while the blade goes on along
+// its own plane: it may turn and tilt as it goes (a curved incision, however far it comes round)
+// by up to 10 degrees a frame, and move across its plane by up to 1 mm a frame and no more than
+// along it (a hand wavers; a blade pushed flat does not cut); past that a new stroke, a new cut,
+// begins. A tetrahedron the blade crosses whole only over several
 // frames is cut once it has been. The caller says which frames count (from the break-in, or from
 // the first touch when the tool marks its cut in two phases) and when to cut what they swept
 // (app/isxfem_tools.hpp).
@@ -39,9 +41,10 @@ private:
     isxfem::CutSurface m_surface;           ///< the stroke's, rest space, m
     std::size_t m_offered = 0;              ///< patches the model has been asked to cut with
     int m_cut = -1;
-    Eigen::Vector3d m_first_normal = Eigen::Vector3d::UnitY(); ///< the blade's plane where the stroke began, world
-    Eigen::Vector3d m_last_normal = Eigen::Vector3d::UnitY();  ///< and where the last frame ended
-    Eigen::Vector3d m_last_position_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d m_last_normal = Eigen::Vector3d::UnitY(); ///< the blade's plane where the last frame ended, world
+    Eigen::Vector3d m_last_position_mm = Eigen::Vector3d::Zero(); ///< where the last frame ended, world
+    Eigen::Vector3d m_last_rest_mm = Eigen::Vector3d::Zero();     ///< and in rest space
+    Eigen::Vector3d m_last_moved_mm = Eigen::Vector3d::Zero();    ///< the material's displacement there
 };
 
 } // namespace vox::app

@@ -152,11 +152,17 @@ surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
 std::vector<IsxfemSimulation::Mark> IsxfemSimulation::surface_marks() const
 {
     refresh_closed_surface();
+    // Around such a tetrahedron (its nodes' tetrahedra): one alone is a speck in a picture.
+    std::vector<unsigned char> coupled_node(m_model->node_count(), 0);
+    for (const isxfem::XfemElement& el : m_model->elements())
+        if (el.crossed || el.cut_left_out)
+            for (std::uint32_t n : el.node) coupled_node[n] = 1;
     std::vector<Mark> out;
     out.reserve(m_closed_vertices.size());
     for (std::size_t v = 0; v < m_closed_vertices.size(); ++v) { // the closure appends what it makes after the object's own
         const isxfem::XfemElement& el = m_model->elements()[m_closed_vertices[v].tet];
-        out.push_back(el.crossed || el.cut_left_out ? Mark::coupled : v >= m_vertices.size() ? Mark::cut : Mark::surface);
+        const bool coupled = std::any_of(el.node.begin(), el.node.end(), [&](std::uint32_t n) { return coupled_node[n] != 0; });
+        out.push_back(coupled ? Mark::coupled : v >= m_vertices.size() ? Mark::cut : Mark::surface);
     }
     return out;
 }

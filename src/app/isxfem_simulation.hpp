@@ -40,8 +40,8 @@ public:
     /// sides, through the object or, for a slit, up to its front (isxfem/cut_closure.hpp).
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const;
     /// What each vertex of surface_mesh() is, for pictures: the object's surface, made by a cut
-    /// (split or crack face), or in a tetrahedron whose pieces the cuts could not all separate
-    /// (two cuts crossing inside it, or a further cut left out there).
+    /// (split or crack face), or in or beside a tetrahedron whose pieces the cuts could not all
+    /// separate (two cuts crossing inside it, or a further cut left out there).
     enum class Mark : unsigned char { surface, cut, coupled };
     [[nodiscard]] std::vector<Mark> surface_marks() const;
     /// What closing the surface along the cuts made, and what it had to leave open.

@@ -95,7 +95,7 @@ render::DrawMesh surface_picture(const IsxfemSimulation& sim, int smooth)
     const std::vector<IsxfemSimulation::Mark> marks = sim.surface_marks();
     for (std::size_t v = 0; v < marks.size() && v < d.colors.size(); ++v) {
         if (marks[v] == IsxfemSimulation::Mark::cut) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone;
-        if (marks[v] == IsxfemSimulation::Mark::coupled) d.colors[v] = 0.2f * d.colors[v] + 0.8f * Eigen::Vector3f(1.0f, 0.45f, 0.05f);
+        if (marks[v] == IsxfemSimulation::Mark::coupled) d.colors[v] = Eigen::Vector3f(1.0f, 0.45f, 0.05f);
     }
     return d;
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <map>
+#include <unordered_map>
 
 namespace vox::isxfem {
 namespace {
@@ -56,20 +57,14 @@ struct Loop {
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
-    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, double longest_edge, int cut,
-           std::vector<SurfacePoint>& points)
-        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_surface(model.cut_surface(cut)), m_points(points),
-          m_longest_edge(longest_edge)
+    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, int cut, std::vector<SurfacePoint>& points)
+        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_surface(model.cut_surface(cut)), m_points(points)
     {
-        // Crack faces are triangulated seen from the cut's mean normal (a swept cut turns far less
-        // than a right angle from it: app/blade_stroke.hpp, so none of it is seen edge on).
         m_n = m_surface.mean_normal();
-        m_u = m_n.unitOrthogonal();
-        m_w = m_n.cross(m_u);
         m_reach = m_surface.bounds();
         if (!m_surface.is_plane()) {
-            m_reach.extend(m_reach.min() - Eigen::Vector3d::Constant(longest_edge));
-            m_reach.extend(m_reach.max() + Eigen::Vector3d::Constant(longest_edge));
+            m_reach.extend(m_reach.min() - Eigen::Vector3d::Constant(model.longest_edge()));
+            m_reach.extend(m_reach.max() + Eigen::Vector3d::Constant(model.longest_edge()));
             for (const CutPatch& p : m_surface.patches())
                 for (const Eigen::Vector3d& c : p.corners) m_far_origin += c / static_cast<double>(p.corners.size() * m_surface.patches().size());
         }
@@ -81,14 +76,22 @@ public:
     ClosureCounts counts;
 
 private:
-    /// The cut's level at a point: the model's near the cut (its tetrahedron's nodes' levels where
-    /// the cut fixed them), its mean plane's beyond the reach of its patches (where only the
-    /// surface's crossing loops run on, which any level closes; and a surface of many vertices is
-    /// not searched patch by patch).
-    [[nodiscard]] double level(std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const
+    /// The cut's level at a point: a plane's; a swept cut's interpolated from its tetrahedron's
+    /// nodes' (XfemModel::level: so the crossings lie on the crack) within reach of its patches,
+    /// its mean plane's beyond (where only the surface's crossing loops run on, which any level
+    /// closes, and a surface of many vertices is not searched patch by patch).
+    double level(std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x)
     {
+        if (m_surface.is_plane()) return m_surface.level(x);
         if (!m_reach.contains(x)) return m_n.dot(x - m_far_origin);
-        return m_model.level(m_cut, tet, bary, x);
+        double phi = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) {
+            const std::uint32_t n = m_model.elements()[tet].node[c];
+            const auto [it, fresh] = m_node_level.try_emplace(n, 0.0);
+            if (fresh) it->second = m_model.node_level(m_cut, n);
+            phi += bary[c] * it->second;
+        }
+        return phi;
     }
     [[nodiscard]] bool in_crack(std::int64_t tet) const
     {
@@ -149,7 +152,9 @@ private:
     int corner_point(int segment, std::pair<std::size_t, unsigned> near);
     /// Chain nodes: crossings by index, fronts as -(index + 1).
     static int front_node(int f) { return -(f + 1); }
-    [[nodiscard]] Eigen::Vector2d flat(const Eigen::Vector3d& x) const { return {m_u.dot(x), m_w.dot(x)}; }
+    /// Where a crack face's point lies in the cut's surface unrolled flat, which faces are
+    /// triangulated in.
+    [[nodiscard]] Eigen::Vector2d flat(const Eigen::Vector3d& x) const { return m_surface.unrolled(x); }
     /// Faces with their holes joined in (faces_with_holes: the material is on the left of every
     /// loop, so a hole runs clockwise); holes that cannot be placed count as open.
     std::vector<Loop> with_holes(std::vector<Loop> loops);
@@ -161,9 +166,10 @@ private:
     int m_cut;
     const CutSurface& m_surface;
     std::vector<SurfacePoint>& m_points;
-    Eigen::Vector3d m_n, m_u, m_w;
+    Eigen::Vector3d m_n;                                       ///< the cut's mean normal
     Eigen::AlignedBox3d m_reach;                                ///< where the level is the model's
     Eigen::Vector3d m_far_origin = Eigen::Vector3d::Zero();    ///< a point of the mean plane
+    std::unordered_map<std::uint32_t, double> m_node_level;    ///< the model's, by node, as asked for
     std::vector<double> m_point_level;                          ///< per point split() started with
 
     std::map<VertexEdge, int> m_crossing_of;
@@ -177,7 +183,6 @@ private:
     /// A swept cut's vertices (its crossings of the cut tetrahedra's edges) and a cut tetrahedron
     /// at each: what a crack face takes inside it to follow the cut where it bends.
     std::map<NodeEdge, std::pair<Eigen::Vector3d, std::size_t>> m_crack_vertices;
-    double m_longest_edge = 0.0;
 };
 
 void Closer::build_boundary()
@@ -216,7 +221,7 @@ void Closer::build_boundary()
                 for (std::size_t b = a + 1; b < 4; ++b)
                     if (static_cast<int>(a) != face && static_cast<int>(b) != face && crossed(a, b)) ends.push_back(on_edge(a, b));
             if (ends.size() != 2) continue; // the cut through a corner of the face: no segment
-            if ((ends[1].second - ends[0].second).cross(centre - ends[0].second).dot(m_model.crack_normal(m_cut, t, centre)) < 0.0)
+            if ((ends[1].second - ends[0].second).cross(centre - ends[0].second).dot(m_model.crack_normal(m_cut, t)) < 0.0)
                 std::swap(ends[0], ends[1]);
             const int s = static_cast<int>(m_segments.size());
             m_segments.push_back({ends[0].first, ends[1].first, ends[0].second, ends[1].second, t, face});
@@ -379,7 +384,7 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
             (m_points[static_cast<std::size_t>(t[1])].rest_m - r0).cross(m_points[static_cast<std::size_t>(t[2])].rest_m - r0);
         auto runs = [&](int from, int to) {
             const Crossing& a = m_crossings[static_cast<std::size_t>(from)];
-            return (m_crossings[static_cast<std::size_t>(to)].x - a.x).dot(m_model.crack_normal(m_cut, a.tet, a.x).cross(outward)) > 0.0;
+            return (m_crossings[static_cast<std::size_t>(to)].x - a.x).dot(m_model.crack_normal(m_cut, a.tet).cross(outward)) > 0.0;
         };
         if (in0 && in1) {
             if (!runs(cross[i][1], cross[i][0]))
@@ -450,7 +455,7 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
         const std::array<int, 3>& f = faces[static_cast<std::size_t>(holder)];
         const Eigen::Vector3d& x0 = x[static_cast<std::size_t>(f[0])];
         const Eigen::Vector3d normal = (x[static_cast<std::size_t>(f[1])] - x0).cross(x[static_cast<std::size_t>(f[2])] - x0);
-        if (std::abs(normal.normalized().dot(point - x0)) <= 1e-3 * m_longest_edge) continue;
+        if (std::abs(normal.normalized().dot(point - x0)) <= 1e-3 * m_model.longest_edge()) continue;
         insert_point(in_plane, faces, holder, flat(point), boundary);
         const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), tet, point));
         const unsigned region = m_model.elements()[tet].region_at(bary);
@@ -489,7 +494,7 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
             faces.push_back({m, b, c});
         }
     }
-    // Counter-clockwise in (u, w) faces +n: out of the negative side (0).
+    // Counter-clockwise in the unrolled surface faces its positive side: out of the negative side (0).
     for (const std::array<int, 3>& f : faces) {
         auto id = [&](int k, int side) { return ids[static_cast<std::size_t>(f[static_cast<std::size_t>(k)])][static_cast<std::size_t>(side)]; };
         triangles.emplace_back(id(0, 0), id(1, 0), id(2, 0));
@@ -629,17 +634,11 @@ std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
 
 } // namespace
 
-CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh()))
-{
-    for (const auto& tet : model.mesh().tets)
-        for (std::size_t a = 0; a < 4; ++a)
-            for (std::size_t b = a + 1; b < 4; ++b)
-                m_longest_edge = std::max(m_longest_edge, (model.mesh().nodes[tet[a]] - model.mesh().nodes[tet[b]]).norm());
-}
+CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh())) {}
 
 ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const
 {
-    Closer closer(m_model, m_neighbours, m_longest_edge, cut, points);
+    Closer closer(m_model, m_neighbours, cut, points);
     closer.split(triangles);
     closer.fill(triangles);
     return closer.counts;

@@ -58,7 +58,6 @@ public:
 private:
     const XfemModel& m_model;
     std::vector<std::array<std::int32_t, 4>> m_neighbours;
-    double m_longest_edge = 0.0; ///< of the mesh's tetrahedra, m
 };
 
 } // namespace vox::isxfem

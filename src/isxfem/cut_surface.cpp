@@ -16,15 +16,19 @@ double segment_distance2(const Eigen::Vector3d& x, const Eigen::Vector3d& a, con
     return (a + t * ab - x).squaredNorm();
 }
 
+/// Whether x lies over the convex patch (its projection on the patch's plane inside it).
+bool over(const Eigen::Vector3d& x, const CutPatch& p)
+{
+    for (std::size_t k = 0; k < p.corners.size(); ++k)
+        if ((p.corners[(k + 1) % p.corners.size()] - p.corners[k]).cross(x - p.corners[k]).dot(p.normal) < 0.0) return false;
+    return true;
+}
+
 /// Squared distance from x to a convex patch.
 double patch_distance2(const Eigen::Vector3d& x, const CutPatch& p)
 {
     const double height = p.normal.dot(x - p.corners[0]);
-    const Eigen::Vector3d q = x - height * p.normal;
-    bool inside = true;
-    for (std::size_t k = 0; k < p.corners.size() && inside; ++k)
-        inside = (p.corners[(k + 1) % p.corners.size()] - p.corners[k]).cross(q - p.corners[k]).dot(p.normal) >= 0.0;
-    if (inside) return height * height;
+    if (over(x, p)) return height * height;
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < p.corners.size(); ++k) best = std::min(best, segment_distance2(x, p.corners[k], p.corners[(k + 1) % p.corners.size()]));
     return best;
@@ -57,6 +61,20 @@ CutSurface::CutSurface(const PlaneCut& plane) : m_is_plane(true), m_plane(plane)
 void CutSurface::add(CutPatch patch)
 {
     if (patch.corners.size() < 3) return;
+    Eigen::Vector3d area = Eigen::Vector3d::Zero();
+    for (std::size_t k = 1; k + 1 < patch.corners.size(); ++k)
+        area += (patch.corners[k] - patch.corners[0]).cross(patch.corners[k + 1] - patch.corners[0]);
+    if (area.dot(patch.normal) < 0.0) std::reverse(patch.corners.begin(), patch.corners.end());
+    if (m_patches.empty()) {
+        patch.u = patch.normal.unitOrthogonal();
+        patch.at.setZero();
+    } else { // carried over from the patch before: its axis turned with the normal, its place unrolled
+        const CutPatch& before = m_patches.back();
+        patch.u = (Eigen::Quaterniond::FromTwoVectors(before.normal, patch.normal) * before.u).normalized();
+        const Eigen::Vector3d u = (before.u + patch.u).normalized(), w = (before.normal + patch.normal).normalized().cross(u);
+        const Eigen::Vector3d step = patch.corners[0] - before.corners[0];
+        patch.at = before.at + Eigen::Vector2d(u.dot(step), w.dot(step));
+    }
     Eigen::AlignedBox3d box;
     box.setEmpty();
     for (const Eigen::Vector3d& c : patch.corners) box.extend(c);
@@ -67,15 +85,16 @@ void CutSurface::add(CutPatch patch)
 std::size_t CutSurface::nearest(const Eigen::Vector3d& x) const
 {
     // The patch whose box is nearest first, then only those whose box could hold a nearer point.
-    std::vector<double> box_distance(m_patches.size());
     std::size_t best = 0;
-    for (std::size_t k = 0; k < m_patches.size(); ++k) {
-        box_distance[k] = m_boxes[k].squaredExteriorDistance(x);
-        if (box_distance[k] < box_distance[best]) best = k;
-    }
+    double best_box = INFINITY;
+    for (std::size_t k = 0; k < m_patches.size(); ++k)
+        if (const double d = m_boxes[k].squaredExteriorDistance(x); d < best_box) {
+            best_box = d;
+            best = k;
+        }
     double best_distance = patch_distance2(x, m_patches[best]);
     for (std::size_t k = 0; k < m_patches.size(); ++k) {
-        if (k == best || box_distance[k] >= best_distance) continue;
+        if (k == best || m_boxes[k].squaredExteriorDistance(x) >= best_distance) continue;
         const double d = patch_distance2(x, m_patches[k]);
         if (d < best_distance) {
             best_distance = d;
@@ -108,6 +127,18 @@ Eigen::Vector3d CutSurface::mean_normal() const
     return sum.squaredNorm() > 0.0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::UnitX();
 }
 
+Eigen::Vector2d CutSurface::unrolled(const Eigen::Vector3d& x) const
+{
+    if (m_is_plane) {
+        const Eigen::Vector3d n = m_plane.normal.normalized(), u = n.unitOrthogonal();
+        return {u.dot(x), n.cross(u).dot(x)};
+    }
+    if (m_patches.empty()) return Eigen::Vector2d::Zero();
+    const CutPatch& p = m_patches[nearest(x)];
+    const Eigen::Vector3d d = x - p.corners[0];
+    return p.at + Eigen::Vector2d(p.u.dot(d), p.normal.cross(p.u).dot(d));
+}
+
 bool CutSurface::meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::size_t first) const
 {
     if (m_is_plane) return (m_plane.at(a) < 0.0) != (m_plane.at(b) < 0.0);
@@ -118,6 +149,16 @@ bool CutSurface::meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::
         for (std::size_t i = 1; i + 1 < c.size(); ++i)
             if (segment_meets_triangle(a, b, c[0], c[i], c[i + 1])) return true;
     }
+    return false;
+}
+
+bool CutSurface::covers(const Eigen::Vector3d& x, double off) const
+{
+    if (m_is_plane) return true;
+    for (std::size_t k = 0; k < m_patches.size(); ++k)
+        if (m_boxes[k].squaredExteriorDistance(x) <= off * off && std::abs(m_patches[k].normal.dot(x - m_patches[k].corners[0])) <= off &&
+            over(x, m_patches[k]))
+            return true;
     return false;
 }
 

@@ -23,8 +23,11 @@ namespace vox::isxfem {
 
 /// A flat convex piece of a swept surface, world m.
 struct CutPatch {
-    std::vector<Eigen::Vector3d> corners; ///< convex, in one plane, counter-clockwise seen from +normal
+    std::vector<Eigen::Vector3d> corners;              ///< convex, in one plane (CutSurface::add turns them counter-clockwise seen from +normal)
     Eigen::Vector3d normal = Eigen::Vector3d::UnitX(); ///< unit; the positive side
+    // Set by CutSurface::add: the patch's place in the surface unrolled flat.
+    Eigen::Vector3d u = Eigen::Vector3d::UnitY(); ///< an axis in its plane (u, normal x u, normal right-handed)
+    Eigen::Vector2d at = Eigen::Vector2d::Zero(); ///< corners[0] unrolled
 };
 
 class CutSurface {
@@ -34,7 +37,8 @@ public:
     /// All of a plane.
     explicit CutSurface(const PlaneCut& plane);
 
-    /// Appends a swept surface's patch (a patch with fewer than three corners covers nothing).
+    /// Appends a swept surface's patch, the next along the sweep (a patch with fewer than three
+    /// corners covers nothing).
     void add(CutPatch patch);
     [[nodiscard]] bool is_plane() const { return m_is_plane; }
     [[nodiscard]] const std::vector<CutPatch>& patches() const { return m_patches; }
@@ -44,10 +48,19 @@ public:
     [[nodiscard]] double level(const Eigen::Vector3d& x) const;
     /// The unit normal at x: the plane's, or the nearest patch's.
     [[nodiscard]] Eigen::Vector3d normal(const Eigen::Vector3d& x) const;
-    /// The mean normal (the patches' weighted by their areas): the direction the cut is seen from.
+    /// The mean normal (the patches' weighted by their areas).
     [[nodiscard]] Eigen::Vector3d mean_normal() const;
+    /// Coordinates of x (on or near the surface) in the surface unrolled flat, counter-clockwise
+    /// seen from its positive side: a plane's own, or the nearest patch's, each patch's axis carried
+    /// over from the one before by the turn between their normals, so a stroke that turns and
+    /// comes round lies flat without folding over itself (what its crack faces are triangulated in).
+    [[nodiscard]] Eigen::Vector2d unrolled(const Eigen::Vector3d& x) const;
     /// Whether the segment a-b meets one of patches [first, end) (a plane: whether it crosses it).
     [[nodiscard]] bool meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::size_t first = 0) const;
+    /// Whether x lies within `off` of a patch's plane and over the patch (a plane: always): where a
+    /// tetrahedron edge's level crosses, next to a patch, when the edge's ends lie so close to the
+    /// surface that the patches themselves pass beside it.
+    [[nodiscard]] bool covers(const Eigen::Vector3d& x, double off) const;
     /// The box of patches [first, end) (a plane: unbounded).
     [[nodiscard]] Eigen::AlignedBox3d bounds(std::size_t first = 0) const;
 

@@ -1,6 +1,6 @@
 #pragma once
 // Triangulation of a simple polygon by ear clipping (O(n^2)), holes bridged into the polygons
-// around them, and points added inside a triangulation (split, then Lawson's flips to Delaunay),
+// around them, and points added inside a triangulation (split, then Lawson's flips around them),
 // for the faces that close a cut.
 
 #include <Eigen/Core>
@@ -20,8 +20,9 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vec
 int locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p);
 
 /// Adds p to the triangulation inside triangle `holder` (locate()): the triangle is split in three
-/// and edges are flipped until each is locally Delaunay, except the boundary's (the polygon
-/// points[0 .. boundary - 1] in order, bridges included). p is appended to `points`.
+/// and the edges opposite p are flipped while the point across lies in their circumcircle (Lawson),
+/// except the boundary's (the polygon points[0 .. boundary - 1] in order, bridges included): the
+/// triangles around p come out locally Delaunay, the rest as they were. p is appended to `points`.
 void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, int holder, const Eigen::Vector2d& p,
                   std::size_t boundary);
 

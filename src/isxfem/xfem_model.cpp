@@ -26,6 +26,9 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
         e.stiffness = tet_stiffness(e.geometry, m.lame);
         e.mass = tet_mass(e.geometry, m.density);
         for (std::uint32_t n : e.node) m_support[n] += e.geometry.volume;
+        for (std::size_t a = 0; a < 4; ++a)
+            for (std::size_t b = a + 1; b < 4; ++b)
+                m_longest_edge = std::max(m_longest_edge, (m_mesh.nodes[e.node[a]] - m_mesh.nodes[e.node[b]]).norm());
     }
 }
 
@@ -42,43 +45,50 @@ CutReport XfemModel::cut(const CutSurface& surface, std::size_t new_from, int ex
 {
     if (extend >= m_cuts) throw std::invalid_argument("XfemModel::cut: no cut " + std::to_string(extend) + " to extend");
     if (extend >= 0) m_surfaces[static_cast<std::size_t>(extend)] = surface;
-    const Eigen::AlignedBox3d reach = surface.bounds(new_from);
+    // A new patch can also become the nearest for a node a little beyond its box.
+    Eigen::AlignedBox3d reach = surface.bounds(new_from);
+    reach.extend(reach.min() - Eigen::Vector3d::Constant(m_longest_edge));
+    reach.extend(reach.max() + Eigen::Vector3d::Constant(m_longest_edge));
     auto candidate = [&](std::size_t t) {
         Eigen::AlignedBox3d box;
         box.setEmpty();
         for (std::uint32_t n : m_elements[t].node) box.extend(m_mesh.nodes[n]);
         return box.intersects(reach);
     };
+    // An edge is cut where a patch meets it (Möller's test), or where its level crosses over a
+    // patch, close to its plane: an edge with an end almost on the surface (a blade drawn along a
+    // node plane) may pass just beside every patch, its nodes' levels taken from the nearest one.
+    const double off = 0.25 * m_longest_edge;
     return cut_along(extend >= 0 ? extend : m_cuts, extend >= 0, surface, candidate,
-                     [&surface](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d&) { return surface.meets(a, b); });
+                     [&surface, off](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& crossing) {
+                         return surface.meets(a, b) || surface.covers(crossing, off);
+                     });
 }
 
-bool XfemModel::node_levels(int id, std::size_t tet, std::array<double, 4>& phi) const
+double XfemModel::node_level(int id, std::uint32_t node) const
 {
-    const auto& levels = m_node_levels[static_cast<std::size_t>(id)];
-    for (std::size_t c = 0; c < 4; ++c) {
-        const auto it = levels.find(m_elements[tet].node[c]);
-        if (it == levels.end()) return false;
-        phi[c] = it->second;
-    }
-    return true;
+    const auto& fixed = m_node_levels.at(static_cast<std::size_t>(id));
+    const auto it = fixed.find(node);
+    return it != fixed.end() ? it->second : m_surfaces[static_cast<std::size_t>(id)].level(m_mesh.nodes[node]);
 }
 
-double XfemModel::level(int id, std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const
+double XfemModel::level(int id, std::size_t tet, const std::array<double, 4>& bary) const
 {
-    const CutSurface& surface = m_surfaces.at(static_cast<std::size_t>(id));
-    std::array<double, 4> phi{};
-    if (surface.is_plane() || !node_levels(id, tet, phi)) return surface.level(x);
-    return bary[0] * phi[0] + bary[1] * phi[1] + bary[2] * phi[2] + bary[3] * phi[3];
+    double phi = 0.0;
+    for (std::size_t c = 0; c < 4; ++c) phi += bary[c] * node_level(id, m_elements[tet].node[c]);
+    return phi;
 }
 
-Eigen::Vector3d XfemModel::crack_normal(int id, std::size_t tet, const Eigen::Vector3d& x) const
+Eigen::Vector3d XfemModel::crack_normal(int id, std::size_t tet) const
 {
-    const CutSurface& surface = m_surfaces.at(static_cast<std::size_t>(id));
-    std::array<double, 4> phi{};
-    if (surface.is_plane() || !node_levels(id, tet, phi)) return surface.normal(x);
-    const Eigen::Vector3d gradient = m_elements[tet].geometry.gradient.transpose() * Eigen::Vector4d(phi[0], phi[1], phi[2], phi[3]);
-    return gradient.squaredNorm() > 0.0 ? Eigen::Vector3d(gradient.normalized()) : surface.normal(x);
+    const XfemElement& e = m_elements[tet];
+    Eigen::Vector4d phi;
+    for (std::size_t c = 0; c < 4; ++c) phi[static_cast<Eigen::Index>(c)] = node_level(id, e.node[c]);
+    const Eigen::Vector3d gradient = e.geometry.gradient.transpose() * phi;
+    if (gradient.squaredNorm() > 0.0) return gradient.normalized();
+    Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+    for (std::uint32_t n : e.node) middle += 0.25 * m_mesh.nodes[n];
+    return m_surfaces[static_cast<std::size_t>(id)].normal(middle);
 }
 
 CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
@@ -93,14 +103,20 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
     // quadrature is most of a cut's time), then their enriched blocks in order.
     std::vector<std::uint32_t> candidates;
     std::vector<std::array<double, 4>> candidate_phi;
+    std::unordered_map<std::uint32_t, double> evaluated; // the surface's level at nodes not fixed, once each
+    auto node_phi = [&](std::uint32_t n) {
+        if (const auto fixed = level_of_node.find(n); fixed != level_of_node.end()) return fixed->second;
+        const auto [it, fresh] = evaluated.try_emplace(n, 0.0);
+        if (fresh) it->second = surface.level(m_mesh.nodes[n]);
+        return it->second;
+    };
     for (std::size_t t = 0; t < m_elements.size(); ++t) {
         XfemElement& e = m_elements[t];
         if (e.cut_index(id) >= 0 || !candidate(t)) continue;
         std::array<double, 4> phi{};
         bool negative = false, positive = false;
         for (std::size_t c = 0; c < 4; ++c) {
-            const auto fixed = level_of_node.find(e.node[c]);
-            phi[c] = fixed != level_of_node.end() ? fixed->second : surface.level(m_mesh.nodes[e.node[c]]);
+            phi[c] = node_phi(e.node[c]);
             (phi[c] < 0.0 ? negative : positive) = true;
         }
         if (!negative || !positive) continue;

@@ -119,8 +119,9 @@ public:
 
     /// Cuts by the plane where it crosses a tetrahedron whole within the region `inside` (a
     /// point of the plane, world m; all of the plane when null). `extend`: the id of an earlier
-    /// cut by the same plane that this one continues (a blade going on through its stroke), whose
-    /// nodes keep their enriched blocks, so the crack stays one surface; -1: a new cut.
+    /// cut that this one continues (a blade going on through its stroke; its own plane is kept and
+    /// `plane` is not used), whose nodes keep their enriched blocks, so the crack stays one
+    /// surface; -1: a new cut.
     CutReport cut(const PlaneCut& plane, const std::function<bool(const Eigen::Vector3d&)>& inside = {}, int extend = -1);
     /// Cuts along a swept surface where it goes through a tetrahedron whole. Its patches from
     /// `new_from` on are new since the last call for this stroke (only the tetrahedra they reach
@@ -151,14 +152,18 @@ public:
     }
     /// The surface cut `id` went along.
     [[nodiscard]] const CutSurface& cut_surface(int id) const { return m_surfaces.at(static_cast<std::size_t>(id)); }
-    /// Cut `id`'s level function at the point x (world m, barycentric coordinates `bary`) of
-    /// tetrahedron `tet`: interpolated from the nodes' levels where the cut has fixed all four (in
-    /// and around the tetrahedra it cut), its surface's elsewhere.
-    [[nodiscard]] double level(int id, std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x) const;
-    /// The unit normal of cut `id` (towards its positive side) in tetrahedron `tet` around x: the
-    /// gradient of its interpolated level where it has all four node levels, its surface's normal
-    /// elsewhere.
-    [[nodiscard]] Eigen::Vector3d crack_normal(int id, std::size_t tet, const Eigen::Vector3d& x) const;
+    /// Cut `id`'s level at a node: as the cut fixed it where it cut a tetrahedron of the node, its
+    /// surface's elsewhere.
+    [[nodiscard]] double node_level(int id, std::uint32_t node) const;
+    /// Cut `id`'s level function at the point with barycentric coordinates `bary` in tetrahedron
+    /// `tet`: interpolated from its nodes' levels (continuous from tetrahedron to tetrahedron; in a
+    /// tetrahedron the cut went through, its crack's).
+    [[nodiscard]] double level(int id, std::size_t tet, const std::array<double, 4>& bary) const;
+    /// The unit normal of cut `id` (towards its positive side) in tetrahedron `tet`: the gradient of
+    /// its interpolated level (the surface's normal at the tetrahedron's middle where that is flat).
+    [[nodiscard]] Eigen::Vector3d crack_normal(int id, std::size_t tet) const;
+    /// The longest edge of the mesh's tetrahedra, m.
+    [[nodiscard]] double longest_edge() const { return m_longest_edge; }
 
 private:
     TetMesh m_mesh;
@@ -170,6 +175,7 @@ private:
     std::vector<double> m_enriched_across;      ///< per enriched block: volume across its cut in its node's support, m^3
     std::vector<double> m_support;              ///< per node: volume of its tetrahedra, m^3
     std::vector<std::unordered_map<std::uint32_t, std::uint32_t>> m_cut_blocks; ///< per cut: node -> enriched block
+    double m_longest_edge = 0.0;
     std::vector<CutSurface> m_surfaces;                                   ///< per cut
     std::vector<std::unordered_map<std::uint32_t, double>> m_node_levels; ///< per cut: node -> level, fixed once it cut with it
 
@@ -179,8 +185,6 @@ private:
     /// (its ends and the level's crossing point on it).
     CutReport cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
                         const EdgeTest& covered);
-    /// The four nodes' levels of cut `id` in tetrahedron `tet`, if all are fixed.
-    [[nodiscard]] bool node_levels(int id, std::size_t tet, std::array<double, 4>& phi) const;
     int m_cuts = 0;
     std::size_t m_revision = 0;
 };

@@ -1,6 +1,8 @@
 // Pictures without a display: the sphere phantom rendered orthographically covers the share of
 // the frame a disk framed with the renderer's margin covers, and its outline is round; the cut
-// cylinder shows two separate silhouettes; bad picture options get one clear message.
+// cylinder shows two separate silhouettes, and so does the flap an Is-XFEM blade cut out; where
+// two Is-XFEM cuts cross, the pieces left coupled show orange; bad picture options get one clear
+// message.
 
 #include "app/run_command.hpp"
 #include "test_support.hpp"
@@ -9,7 +11,9 @@
 #include <stb/stb_image.h>
 
 #include <cmath>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 using namespace vox::test;
@@ -37,6 +41,8 @@ Picture read_png(const fs::path& path)
 bool foreground(const unsigned char* c) { return std::abs(c[0] - 236) + std::abs(c[1] - 238) + std::abs(c[2] - 242) > 24; }
 /// Pixels of the object (its warm material colour), not of the grey-blue tool.
 bool object(const unsigned char* c) { return foreground(c) && c[0] > c[2] + 30; }
+/// Pixels of the orange an Is-XFEM picture marks pieces left coupled with.
+bool coupled(const unsigned char* c) { return c[0] > 200 && c[2] < 90 && c[0] > c[1] + 60; }
 
 /// Sizes of the 4-connected components of the pixels `inside` picks, largest first.
 template <class Inside>
@@ -116,6 +122,51 @@ TEST(Render, TheCutCylinderShowsTwoSilhouettes)
     };
     EXPECT_EQ(pieces(read_png(dir.path("before.png"))), 1);
     EXPECT_EQ(pieces(read_png(dir.root() / "run" / "final.png")), 2);
+}
+
+TEST(Render, AnIsxfemRunDrawsTheFlapItCutOut)
+{
+    // The half-circle incision (Is-XFEM): 0.1 s after the blade came out the flap has dropped away
+    // from the slab, and nothing is marked as left coupled. (Seen from the back: from the front the
+    // blade, come out there, stands before the slab.)
+    ScratchDir dir;
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/slab_flap_cut_isxfem.json");
+    const auto r = run_voxsculpt("run " + scene + " --frames 70 --render-every 70 --camera back --size 480x360 --out " + quote(dir.path("run")));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Picture p = read_png(dir.root() / "run" / "final.png");
+    int pieces = 0;
+    for (int size : components(p, object)) pieces += size >= 100;
+    EXPECT_EQ(pieces, 2);
+    EXPECT_EQ(components(p, coupled).size(), 0u);
+}
+
+TEST(Render, WhereTwoCutsCrossAnIsxfemPictureShowsTheCoupledPiecesInOrange)
+{
+    // Two blades through a slab at rest, the second across the first: where they cross inside a
+    // tetrahedron its four pieces stay coupled, and the picture marks them.
+    ScratchDir dir;
+    std::ostringstream script;
+    for (int k = 0; k <= 12; ++k)
+        script << (k ? ",\n" : "") << "{\"t_s\": " << 0.01 * k << ", \"tool\": \"a\", \"position_mm\": [" << -2 + 2 * k
+               << ", 10.3, 5], \"orientation_wxyz\": [1, 0, 0, 0]}";
+    for (int k = 0; k <= 12; ++k)
+        script << ",\n{\"t_s\": " << 0.13 + 0.01 * k << ", \"tool\": \"b\", \"position_mm\": [10.3, " << -2 + 2 * k
+               << ", 5], \"orientation_wxyz\": [0.7071068, 0, 0, 0.7071068]}";
+    std::ofstream(dir.path("cross.json")) << R"({
+        "object": {"phantom": {"shape": "beam", "size_mm": [20, 20, 10], "voxel_mm": 1.0}, "levels": 1},
+        "materials": {"default": {"youngs_modulus_pa": 1e6, "poisson_ratio": 0.3, "density_kg_m3": 1000}},
+        "solver": {"type": "isxfem", "k": 0.1, "dt_s": 0.01, "cg_tolerance": 1e-6, "cg_max_iterations": 2000},
+        "gravity_m_s2": [0, 0, 0],
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [3, 3, 11]]}],
+        "tools": [{"name": "a", "shape": "blade", "size_mm": [2, 1, 30], "cut_pressure_pa": 1},
+                  {"name": "b", "shape": "blade", "size_mm": [2, 1, 30], "cut_pressure_pa": 1}],
+        "script": [)" << script.str() << R"(]
+    })";
+    const auto r = run_voxsculpt("run " + quote(dir.path("cross.json")) +  " --frames 40 --render-every 40 --camera top --size 480x360 --out " +
+                                 quote(dir.path("run")));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("orange in the pictures"), std::string::npos) << r.err;
+    EXPECT_GT(components(read_png(dir.root() / "run" / "final.png"), coupled).size(), 0u);
 }
 
 TEST(Render, BadPictureOptionsNameTheOptionAndTheProblem)

@@ -1,6 +1,6 @@
 // A blade's swept surface as a cut: Möller's test finds the edges its patches meet (through a
 // triangle, across the seam between two, not beside or along them); its level is the signed
-// distance from the nearest patch's plane; a model cut along patches in one plane cuts exactly as
+// distance from the nearest patch's plane; a half circle of patches unrolls flat; a model cut along patches in one plane cuts exactly as
 // along the plane within their region; and along a bent sweep each tetrahedron's crack meets its
 // neighbours' on their shared edges, with no tetrahedron cut twice.
 
@@ -64,6 +64,37 @@ TEST(CutSurface, ItsLevelIsTheSignedDistanceFromTheNearestPatchsPlane)
     EXPECT_NEAR((s.normal(above) - upper.normal).norm(), 0.0, 1e-12);
     EXPECT_NEAR((s.mean_normal() - (Eigen::Vector3d::UnitX() + upper.normal).normalized()).norm(), 0.0, 1e-12); // equal areas
     EXPECT_NEAR(s.bounds(1).min().z(), 1.0, 1e-12);
+}
+
+TEST(CutSurface, AHalfCircleSweepUnrollsFlatWithoutFolding)
+{
+    // 36 patches of 5 degrees round a half circle of radius 2 about the z axis, 1 high, half of
+    // them given clockwise (add() turns them): unrolled, the arc becomes a straight strip as long
+    // as the arc, its height the other axis, the same way up all along.
+    const double radius = 2.0, step = M_PI / 36.0;
+    CutSurface s;
+    auto on_arc = [&](double angle, double z) { return Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), z); };
+    for (int k = 0; k < 36; ++k) {
+        CutPatch p;
+        p.corners = {on_arc(k * step, 0.0), on_arc((k + 1) * step, 0.0), on_arc((k + 1) * step, 1.0), on_arc(k * step, 1.0)};
+        if (k % 2) std::reverse(p.corners.begin(), p.corners.end());
+        const double middle = (k + 0.5) * step;
+        p.normal = -Eigen::Vector3d(std::cos(middle), std::sin(middle), 0.0); // towards the centre
+        s.add(p);
+    }
+    for (const CutPatch& p : s.patches()) // counter-clockwise seen from +normal, each
+        EXPECT_GT((p.corners[1] - p.corners[0]).cross(p.corners[2] - p.corners[0]).dot(p.normal), 0.0);
+    const Eigen::Vector2d start = s.unrolled(on_arc(0.01, 0.5)), up = s.unrolled(on_arc(0.01, 0.9)) - start;
+    for (double angle = 0.3; angle < M_PI - 0.05; angle += 0.3) {
+        const Eigen::Vector2d here = s.unrolled(on_arc(angle, 0.5));
+        EXPECT_NEAR((here - start).norm(), radius * (angle - 0.01), 0.01 * radius * angle) << angle; // a chord's sagitta aside
+        EXPECT_NEAR((here - start).dot(up), 0.0, 1e-3) << angle;                                      // straight
+        EXPECT_NEAR(((s.unrolled(on_arc(angle, 0.9)) - here) - up).norm(), 0.0, 1e-9) << angle;      // the same way up
+    }
+    // Over a patch and near its plane; too far off it; beyond the sweep's end.
+    EXPECT_TRUE(s.covers(0.95 * on_arc(1.0, 0.5), 0.15));
+    EXPECT_FALSE(s.covers(0.95 * on_arc(1.0, 0.5), 0.05));
+    EXPECT_FALSE(s.covers(on_arc(-0.2, 0.5), 0.15));
 }
 
 TEST(CutSurface, PatchesInOnePlaneCutAsThePlaneWithinTheirRegion)
