@@ -31,8 +31,8 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
                                        const Eigen::Vector3d& moved_mm, bool cut)
 {
     const Eigen::Vector3d normal = to.orientation.toRotationMatrix().col(1);
-    const Eigen::Vector3d moved = to.position_mm - m_last_position_mm;
-    const double across = std::abs(moved.dot(m_last_normal)), along = (moved - moved.dot(m_last_normal) * m_last_normal).norm();
+    const Eigen::Vector3d step = to.position_mm - m_last_position_mm; // the blade's, in the world
+    const double across = std::abs(step.dot(m_last_normal)), along = (step - step.dot(m_last_normal) * m_last_normal).norm();
     const bool going = !m_surface.patches().empty();
     const bool goes_on = going && normal.dot(m_last_normal) >= k_max_frame_turn_cos && across <= k_max_offset_mm && across <= std::max(k_waver_mm, along);
     if (!goes_on) {
