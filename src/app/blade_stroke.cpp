@@ -14,11 +14,9 @@ namespace {
 double cos_degrees(double degrees) { return std::cos(degrees * 3.14159265358979323846 / 180.0); }
 
 // A frame turns a blade by a few degrees: more is a new stroke (a blade lifted and set down
-// elsewhere, or a script's jump), as is moving across its own plane by more than a hand wavers, or
-// by more than along it (a blade pushed flat does not cut on; it would stack patches side by side).
+// elsewhere, or a script's jump), as is drifting across its own plane by more than a hand wavers.
 const double k_max_frame_turn_cos = cos_degrees(10.0);
-constexpr double k_max_offset_mm = 1.0;
-constexpr double k_waver_mm = 0.1;
+constexpr double k_max_drift_mm = 1.0;
 
 } // namespace
 
@@ -32,9 +30,11 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
 {
     const Eigen::Vector3d normal = to.orientation.toRotationMatrix().col(1);
     const Eigen::Vector3d step = to.position_mm - m_last_position_mm; // the blade's, in the world
-    const double across = std::abs(step.dot(m_last_normal)), along = (step - step.dot(m_last_normal) * m_last_normal).norm();
+    // Across the plane halfway through the turn: a blade turning as it goes moves along that.
+    const double across = step.dot((m_last_normal + normal).normalized());
     const bool going = !m_surface.patches().empty();
-    const bool goes_on = going && normal.dot(m_last_normal) >= k_max_frame_turn_cos && across <= k_max_offset_mm && across <= std::max(k_waver_mm, along);
+    const bool goes_on = going && normal.dot(m_last_normal) >= k_max_frame_turn_cos && std::abs(m_drift_mm + across) <= k_max_drift_mm;
+    m_drift_mm = goes_on ? m_drift_mm + across : 0.0;
     if (!goes_on) {
         m_surface = {};
         m_offered = 0;
@@ -46,20 +46,19 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     // plane and not where an ended stroke left off) and where it ended, in the plane halfway between.
     const bool from_here = (goes_on || !going) && from.placed && from.orientation.toRotationMatrix().col(1).dot(normal) >= k_max_frame_turn_cos;
     const io::ToolPose& start = from_here ? from : to;
-    // Where the blade began and ended the frame in rest space. Going on, it moved there as in the
-    // world less the material's own move within the blade's plane: across the plane the material
-    // carries the crack along with it, so the crack goes on from where it was (its patches do not
-    // step sideways as the material sways).
+    const Eigen::Matrix3d frame = start.orientation.slerp(0.5, to.orientation).toRotationMatrix(); // the plane halfway
+    // Where the blade began and ended the frame in rest space. Going on, it moved there within its
+    // plane only: as in the world less the material's own move, each without what crosses the
+    // plane (a wavering blade cuts on along its plane, and the material carries the crack along
+    // across it), so the crack goes on from where it was rather than stepping sideways.
     Eigen::Vector3d rest_start = start.position_mm - moved_mm, rest_end = to.position_mm - moved_mm;
     if (goes_on && from_here) {
-        const Eigen::Vector3d material = moved_mm - m_last_moved_mm;
+        const Eigen::Vector3d within = (to.position_mm - start.position_mm) - (moved_mm - m_last_moved_mm);
         rest_start = m_last_rest_mm;
-        rest_end = rest_start + (to.position_mm - start.position_mm) - (material - material.dot(normal) * normal);
+        rest_end = rest_start + within - within.dot(frame.col(1)) * frame.col(1);
     }
     m_last_rest_mm = rest_end;
     m_last_moved_mm = moved_mm;
-    const Eigen::Quaterniond middle = start.orientation.slerp(0.5, to.orientation);
-    const Eigen::Matrix3d frame = middle.toRotationMatrix();
     const Eigen::Vector3d centre_mm = 0.5 * (rest_start + rest_end);
     std::vector<Eigen::Vector2d> placed;
     for (const auto& [pose, at] : {std::pair{&start, rest_start}, std::pair{&to, rest_end}})
@@ -71,7 +70,6 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     patch.normal = frame.col(1);
     for (const Eigen::Vector2d& q : contact::convex_hull(std::move(placed)))
         patch.corners.push_back(1e-3 * (centre_mm + frame.col(0) * q.x() + frame.col(2) * q.y()));
-    std::reverse(patch.corners.begin(), patch.corners.end()); // counter-clockwise in x-z is clockwise seen from +y
     m_surface.add(std::move(patch));
     if (!cut) return {};
     const isxfem::CutReport report = sim.cut(m_surface, m_offered, m_cut);

@@ -3,14 +3,14 @@
 // x-z plane) sweeps. Each frame adds a flat patch to the stroke's swept surface
 // (isxfem/cut_surface.hpp): the convex hull of the blade's profile where the frame began and where
 // it ended, in the plane halfway between, carried back to rest space by the mean displacement of
-// the material around the blade (within the blade's plane only, once the stroke is going: across
-// it the material carries the crack along). A stroke is one cut, one crack, while the blade goes on along
-// its own plane: it may turn and tilt as it goes (a curved incision, however far it comes round)
-// by up to 10 degrees a frame, and move across its plane by up to 1 mm a frame and no more than
-// along it (a hand wavers; a blade pushed flat does not cut); past that a new stroke, a new cut,
-// begins. A tetrahedron the blade crosses whole only over several
-// frames is cut once it has been. The caller says which frames count (from the break-in, or from
-// the first touch when the tool marks its cut in two phases) and when to cut what they swept
+// the material around the blade (within the blade's plane only, once the stroke is going). A
+// stroke is one cut, one crack, while the blade goes on along its own plane: it may turn and tilt
+// as it goes (a curved incision, however far it comes round) by up to 10 degrees a frame, and
+// waver across its plane by up to 1 mm in all (that motion dropped, so the crack does not step
+// sideways); past that a new stroke, a new cut, begins. A tetrahedron the blade crosses whole
+// only over several frames is cut once it has been. The caller says which frames count (from the
+// break-in, or from the first touch when the tool marks its cut in two phases) and when to cut
+// what they swept
 // (app/isxfem_tools.hpp).
 
 #include "app/isxfem_simulation.hpp"
@@ -34,7 +34,12 @@ public:
     isxfem::CutReport advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to, const Eigen::Vector3d& moved_mm,
                               bool cut);
     /// The blade left: the next frame starts a new stroke.
-    void end() { m_surface = {}; }
+    void end()
+    {
+        m_surface = {};
+        m_cut = -1;
+    }
+
 
 private:
     std::vector<Eigen::Vector2d> m_profile; ///< the blade's, in its x-z plane, mm
@@ -45,6 +50,7 @@ private:
     Eigen::Vector3d m_last_position_mm = Eigen::Vector3d::Zero(); ///< where the last frame ended, world
     Eigen::Vector3d m_last_rest_mm = Eigen::Vector3d::Zero();     ///< and in rest space
     Eigen::Vector3d m_last_moved_mm = Eigen::Vector3d::Zero();    ///< the material's displacement there
+    double m_drift_mm = 0.0; ///< how far the blade has moved across its plane since the stroke began (dropped from the sweep)
 };
 
 } // namespace vox::app

@@ -52,7 +52,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                          {"linear_solver", std::string("CG, ") + sim.solver().preconditioner_name() + " preconditioner"}, {"frames", nlohmann::json::array()}};
     double total_ms = 0.0, max_ms = 0.0, cut_total_ms = 0.0;
     int converged = 0;
-    std::size_t cut_tets = 0, partial = 0, recut = 0, crossed = 0;
+    std::size_t cut_tets = 0, partial = 0, recut = 0, crossed = 0, beside = 0;
     std::set<std::size_t> left_whole; // frames where a cut crossed tetrahedra already cut twice
     isxfem::XfemStepStats last;
     Progress progress("simulating", static_cast<std::uint64_t>(frames));
@@ -72,6 +72,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                       "orange in the pictures of --render-every)",
                       f, frame_cut.crossed_tets);
         crossed += frame_cut.crossed_tets;
+        beside += frame_cut.beside_earlier;
         if (frame_cut.already_cut > 0) {
             // Two cuts per tetrahedron at most: a third leaves it as it was. Said once, counted
             // per frame in stats.json.
@@ -113,6 +114,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
                                    {"recut_tets", frame_cut.recut_tets},
                                    {"crossed_tets", frame_cut.crossed_tets},
                                    {"recut_tets_left", frame_cut.already_cut},
+                                   {"beside_earlier_cut_tets", frame_cut.beside_earlier},
                                    {"dofs", sim.solver().dof_count()},
                                    {"regularised_blocks", sim.solver().regularised_blocks()},
                                    {"object_held", tool_frame.hold_object},
@@ -129,6 +131,7 @@ void run_isxfem(const io::Scene& scene, const std::string& scene_path, std::opti
          {"partly_crossed_tets_last_frame", partial},
          {"recut_tets", recut},
          {"crossed_tets", crossed},
+         {"beside_earlier_cut_tets", beside},
          {"frames_with_recut_tets_left", left_whole.size()},
          {"total_cut_ms", cut_total_ms},
          {"final_dofs", sim.solver().dof_count()},

@@ -126,8 +126,10 @@ void IsxfemSimulation::refresh_closed_surface() const
         m_closed_vertices.push_back({e.tet, e.bary, side_of(e.tet, e.bary), e.rest_m, m_rest.labels[k]});
     }
     m_closed_triangles = m_rest.triangles;
+    m_closed_crack.assign(m_closed_triangles.size(), -1);
     m_closure_counts = {};
-    for (int cut = 0; cut < m_model->cut_count(); ++cut) m_closure_counts += m_closure->close(cut, m_closed_vertices, m_closed_triangles);
+    for (int cut = 0; cut < m_model->cut_count(); ++cut)
+        m_closure_counts += m_closure->close(cut, m_closed_vertices, m_closed_triangles, &m_closed_crack);
     m_closed_revision = m_model->revision();
 }
 
@@ -177,7 +179,7 @@ struct IsxfemSimulation::NearSurface {
     std::vector<Eigen::Vector3i> triangles;       ///< among `near` (indices into it)
 };
 
-IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach) const
+IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach, bool crack_walls) const
 {
     NearSurface out;
     refresh_closed_surface();
@@ -214,8 +216,10 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
     std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
     std::vector<double> area(vertices.size(), 0.0);
     std::vector<Eigen::Vector3i> touching;
-    for (const Eigen::Vector3i& t : triangles) {
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const Eigen::Vector3i& t = triangles[i];
         if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
+        if (!crack_walls && m_closed_crack[i] >= 0) continue;
         for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
             if (!std::isfinite(position[static_cast<std::size_t>(t[c])].x())) {
                 const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
@@ -245,12 +249,12 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
 }
 
 IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
-                                                const contact::PlacedShape* from) const
+                                                const contact::PlacedShape* from, bool crack_walls) const
 {
     // Only the surface within the tool's reach (at both poses) is measured.
     Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
-    const NearSurface s = near_surface(reach);
+    const NearSurface s = near_surface(reach, crack_walls);
     Touch out;
     out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
@@ -260,9 +264,9 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     return out;
 }
 
-void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out) const
+void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, bool crack_walls) const
 {
-    const NearSurface s = near_surface(box);
+    const NearSurface s = near_surface(box, crack_walls);
     out.count = std::min(s.positions.size(), out.capacity());
     out.truncated = s.positions.size() > out.capacity();
     std::copy_n(s.positions.begin(), out.count, out.positions_mm.begin());

@@ -56,18 +56,22 @@ public:
     /// vertices, each carrying a third of its triangles' area and their area-weighted normal),
     /// and the contact's forces as point loads at the vertices' material points for the solver.
     /// With `from`, the tool's pose at the previous frame: the penalty is integrated over the
-    /// move (continuous penalty).
+    /// move (continuous penalty). Without `crack_walls` the cuts' crack faces are left out: a
+    /// blade's (walls that lie on each other at rest close on a blade in them from both sides at
+    /// once, which only stiffens the solve and shakes a haptic tool; a finger pressing into a
+    /// crack touches them).
     struct Touch {
         contact::ContactResult contact;
         std::vector<isxfem::PointLoad> loads;
     };
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
-                              const contact::PlacedShape* from = nullptr) const;
+                              const contact::PlacedShape* from = nullptr, bool crack_walls = true) const;
 
     /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
     /// with its area and outward normal, and the triangles among them: the snapshot the haptic
-    /// thread touches (at most out.capacity() points; out.truncated says when more were near).
-    void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out) const;
+    /// thread touches (at most out.capacity() points; out.truncated says when more were near),
+    /// with or without the crack faces (as touch()).
+    void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, bool crack_walls = true) const;
 
     /// The side (of its cut; 0 when uncut) of the material point with barycentric coordinates
     /// `bary` in tetrahedron `tet`.
@@ -79,7 +83,7 @@ public:
 
 private:
     struct NearSurface;
-    [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box) const;
+    [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box, bool crack_walls) const;
     /// The closed surface's vertices (material points) and triangles, kept until the next cut.
     void refresh_closed_surface() const;
 
@@ -98,6 +102,7 @@ private:
     surface::SurfaceMesh m_rest;      ///< the surface at rest: its triangles and labels
     mutable std::vector<isxfem::SurfacePoint> m_closed_vertices; ///< the closed surface as of the model's revision
     mutable std::vector<Eigen::Vector3i> m_closed_triangles;
+    mutable std::vector<std::int32_t> m_closed_crack; ///< per closed triangle: the cut whose crack face it is, or -1
     mutable isxfem::ClosureCounts m_closure_counts;
     mutable std::size_t m_closed_revision = 0;
 };

@@ -64,7 +64,8 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         // The penalty integrated over the tool's move since the last frame.
         const contact::PlacedShape placed{&m_shapes[k], to.position_mm, to.orientation};
         const IsxfemSimulation::Touch touch =
-            sim.touch(placed, {spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, m_last_pose[k].shape ? &m_last_pose[k] : nullptr);
+            sim.touch(placed, {spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, m_last_pose[k].shape ? &m_last_pose[k] : nullptr,
+                      !m_strokes[k]);
         m_last_pose[k] = placed;
         loads.insert(loads.end(), touch.loads.begin(), touch.loads.end());
         for (const isxfem::PointLoad& l : touch.loads) cuts_known.push_back(sim.model().elements()[l.tet].cuts.size());
@@ -96,6 +97,7 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         out.cut.new_blocks += r.new_blocks;
         out.cut.partial_tets += r.partial_tets;
         out.cut.already_cut += r.already_cut;
+        out.cut.beside_earlier += r.beside_earlier;
         out.cut.recut_tets += r.recut_tets;
         out.cut.crossed_tets += r.crossed_tets;
         t.cut = r.cut_tets > 0;

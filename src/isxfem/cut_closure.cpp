@@ -57,16 +57,14 @@ struct Loop {
 /// One cut's closing (see the header): the state of a single call of CutClosure::close.
 class Closer {
 public:
-    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, int cut, std::vector<SurfacePoint>& points)
-        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_surface(model.cut_surface(cut)), m_points(points)
+    Closer(const XfemModel& model, const std::vector<std::array<std::int32_t, 4>>& neighbours, int cut, std::vector<SurfacePoint>& points,
+           std::vector<std::int32_t>* crack_of)
+        : m_model(model), m_neighbours(neighbours), m_cut(cut), m_surface(model.cut_surface(cut)), m_points(points), m_crack_of(crack_of)
     {
-        m_n = m_surface.mean_normal();
         m_reach = m_surface.bounds();
         if (!m_surface.is_plane()) {
             m_reach.extend(m_reach.min() - Eigen::Vector3d::Constant(model.longest_edge()));
             m_reach.extend(m_reach.max() + Eigen::Vector3d::Constant(model.longest_edge()));
-            for (const CutPatch& p : m_surface.patches())
-                for (const Eigen::Vector3d& c : p.corners) m_far_origin += c / static_cast<double>(p.corners.size() * m_surface.patches().size());
         }
         build_boundary();
     }
@@ -78,12 +76,13 @@ public:
 private:
     /// The cut's level at a point: a plane's; a swept cut's interpolated from its tetrahedron's
     /// nodes' (XfemModel::level: so the crossings lie on the crack) within reach of its patches,
-    /// its mean plane's beyond (where only the surface's crossing loops run on, which any level
-    /// closes, and a surface of many vertices is not searched patch by patch).
+    /// and beyond it positive, 1 m, whatever side: the surface's crossing loops near the crack
+    /// then close at the edge of the reach (any level closes them; only where they pass through
+    /// the crack do they part the surface), so a cut far away costs no crossings.
     double level(std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x)
     {
         if (m_surface.is_plane()) return m_surface.level(x);
-        if (!m_reach.contains(x)) return m_n.dot(x - m_far_origin);
+        if (!m_reach.contains(x)) return 1.0;
         double phi = 0.0;
         for (std::size_t c = 0; c < 4; ++c) {
             const std::uint32_t n = m_model.elements()[tet].node[c];
@@ -166,9 +165,8 @@ private:
     int m_cut;
     const CutSurface& m_surface;
     std::vector<SurfacePoint>& m_points;
-    Eigen::Vector3d m_n;                                       ///< the cut's mean normal
+    std::vector<std::int32_t>* m_crack_of; ///< per triangle, whose crack face it is (-1: the object's surface); may be null
     Eigen::AlignedBox3d m_reach;                                ///< where the level is the model's
-    Eigen::Vector3d m_far_origin = Eigen::Vector3d::Zero();    ///< a point of the mean plane
     std::unordered_map<std::uint32_t, double> m_node_level;    ///< the model's, by node, as asked for
     std::vector<double> m_point_level;                          ///< per point split() started with
 
@@ -365,11 +363,13 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
         if (m_crossings[c].inside) reaches_crack[root(static_cast<int>(c))] = true;
 
     std::vector<Eigen::Vector3i> kept;
+    std::vector<std::int32_t> kept_crack; // each piece the crack face its triangle was, if any
     kept.reserve(triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i) {
         const Eigen::Vector3i& t = triangles[i];
         if (cross[i][0] < 0 || !reaches_crack[root(cross[i][0])]) {
             kept.push_back(t);
+            if (m_crack_of) kept_crack.push_back((*m_crack_of)[i]);
             continue;
         }
         const bool in0 = m_crossings[static_cast<std::size_t>(cross[i][0])].inside, in1 = m_crossings[static_cast<std::size_t>(cross[i][1])].inside;
@@ -427,8 +427,10 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
             const std::size_t m = piece.size();
             for (std::size_t k = 1; k + 1 < m; ++k) kept.emplace_back(piece[corner], piece[(corner + k) % m], piece[(corner + k + 1) % m]);
         }
+        if (m_crack_of) kept_crack.resize(kept.size(), (*m_crack_of)[i]);
     }
     triangles = std::move(kept);
+    if (m_crack_of) *m_crack_of = std::move(kept_crack);
 }
 
 void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3i>& triangles)
@@ -499,6 +501,7 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
         auto id = [&](int k, int side) { return ids[static_cast<std::size_t>(f[static_cast<std::size_t>(k)])][static_cast<std::size_t>(side)]; };
         triangles.emplace_back(id(0, 0), id(1, 0), id(2, 0));
         triangles.emplace_back(id(0, 1), id(2, 1), id(1, 1));
+        if (m_crack_of) m_crack_of->insert(m_crack_of->end(), 2, m_cut);
     }
 }
 
@@ -636,9 +639,11 @@ std::vector<Loop> Closer::with_holes(std::vector<Loop> loops)
 
 CutClosure::CutClosure(const XfemModel& model) : m_model(model), m_neighbours(face_neighbours(model.mesh())) {}
 
-ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const
+ClosureCounts CutClosure::close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles,
+                                std::vector<std::int32_t>* crack_of) const
 {
-    Closer closer(m_model, m_neighbours, cut, points);
+    if (crack_of) crack_of->resize(triangles.size(), -1);
+    Closer closer(m_model, m_neighbours, cut, points, crack_of);
     closer.split(triangles);
     closer.fill(triangles);
     return closer.counts;

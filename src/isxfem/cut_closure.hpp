@@ -52,8 +52,11 @@ public:
     explicit CutClosure(const XfemModel& model);
 
     /// Splits `triangles` (indices into `points`) along cut `cut` and fills its crack on both
-    /// sides; new points are appended.
-    ClosureCounts close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles) const;
+    /// sides; new points are appended. With `crack_of` (per triangle: the cut whose crack face it
+    /// is, -1 for the object's own surface; missing entries taken as -1), it is kept in step: the
+    /// pieces of a split triangle keep its entry, the new faces get `cut`.
+    ClosureCounts close(int cut, std::vector<SurfacePoint>& points, std::vector<Eigen::Vector3i>& triangles,
+                        std::vector<std::int32_t>* crack_of = nullptr) const;
 
 private:
     const XfemModel& m_model;

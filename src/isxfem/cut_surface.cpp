@@ -115,16 +115,7 @@ double CutSurface::level(const Eigen::Vector3d& x) const
 Eigen::Vector3d CutSurface::normal(const Eigen::Vector3d& x) const
 {
     if (m_is_plane) return m_plane.normal.normalized();
-    return m_patches.empty() ? mean_normal() : m_patches[nearest(x)].normal;
-}
-
-Eigen::Vector3d CutSurface::mean_normal() const
-{
-    if (m_is_plane) return m_plane.normal.normalized();
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const CutPatch& p : m_patches)
-        for (std::size_t k = 1; k + 1 < p.corners.size(); ++k) sum += (p.corners[k] - p.corners[0]).cross(p.corners[k + 1] - p.corners[0]);
-    return sum.squaredNorm() > 0.0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::UnitX();
+    return m_patches.empty() ? Eigen::Vector3d::UnitX() : m_patches[nearest(x)].normal;
 }
 
 Eigen::Vector2d CutSurface::unrolled(const Eigen::Vector3d& x) const

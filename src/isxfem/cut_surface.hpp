@@ -46,10 +46,8 @@ public:
     /// phi at x: the plane's, or the signed distance from the plane of the nearest patch (a
     /// surface without patches: 0).
     [[nodiscard]] double level(const Eigen::Vector3d& x) const;
-    /// The unit normal at x: the plane's, or the nearest patch's.
+    /// The unit normal at x: the plane's, or the nearest patch's (x without patches).
     [[nodiscard]] Eigen::Vector3d normal(const Eigen::Vector3d& x) const;
-    /// The mean normal (the patches' weighted by their areas).
-    [[nodiscard]] Eigen::Vector3d mean_normal() const;
     /// Coordinates of x (on or near the surface) in the surface unrolled flat, counter-clockwise
     /// seen from its positive side: a plane's own, or the nearest patch's, each patch's axis carried
     /// over from the one before by the turn between their normals, so a stroke that turns and

@@ -4,10 +4,26 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace vox::isxfem {
+namespace {
+
+/// The smallest region (share of its tetrahedron) a second cut alongside the first may leave.
+constexpr double k_min_second_cut_region = 0.01;
+
+/// Whether two cuts run alongside each other in tetrahedron `e` (their planes there within 30
+/// degrees), given their levels at its nodes.
+bool alongside(const XfemElement& e, const std::array<double, 4>& a, const std::array<double, 4>& b)
+{
+    const Eigen::Vector3d ga = e.geometry.gradient.transpose() * Eigen::Vector4d(a[0], a[1], a[2], a[3]);
+    const Eigen::Vector3d gb = e.geometry.gradient.transpose() * Eigen::Vector4d(b[0], b[1], b[2], b[3]);
+    return std::abs(ga.dot(gb)) >= std::cos(30.0 * 3.14159265358979323846 / 180.0) * ga.norm() * gb.norm();
+}
+
+} // namespace
 
 XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vector<std::uint32_t> material, double k)
     : m_mesh(std::move(mesh)), m_materials(std::move(materials)), m_k(k)
@@ -171,6 +187,15 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
         for (const Region& r : c.regions) side_volume[(r.pattern >> bit) & 1u] += r.volume;
         if (std::min(side_volume[0], side_volume[1]) <= 0.0) {
             ++report.partial_tets; // the plane only touches it (through nodes): nothing to separate
+            continue;
+        }
+        // A second cut running alongside the first within the tetrahedron (a blade drawn again
+        // along a crack) would leave a sliver between them, whose pieces' rotations and dofs the
+        // solve cannot hold (a haptic session cutting the same plane over and over diverged): the
+        // earlier crack is taken to separate it. (Crossing cuts may leave small corners: kept.)
+        if (!e.cuts.empty() && alongside(e, e.cuts.front().phi, candidate_phi[i]) &&
+            std::any_of(c.regions.begin(), c.regions.end(), [&](const Region& r) { return r.volume < k_min_second_cut_region * e.geometry.volume; })) {
+            ++report.beside_earlier;
             continue;
         }
         if (!e.cuts.empty()) {

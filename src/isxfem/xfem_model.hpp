@@ -14,7 +14,10 @@
 // inside a tetrahedron leave three regions, which the added enrichments separate whole; two that
 // cross leave four, and three linear fields cannot move four pieces independently: those
 // tetrahedra keep their pieces coupled, and the report counts them (`crossed_tets`) so the
-// caller can say so. A third cut through a tetrahedron is not applied there (counted too).
+// caller can say so. A third cut through a tetrahedron is not applied there (counted too), nor a
+// second that runs alongside the first within it (within 30 degrees, leaving a region under 1 % of
+// the tetrahedron: a blade drawn again along its crack), which the earlier crack is taken to
+// separate.
 
 #include "isxfem/cut_surface.hpp"
 #include "isxfem/moment_fitting.hpp"
@@ -109,6 +112,7 @@ struct CutReport {
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
     std::size_t already_cut = 0;    ///< crossed whole but cut k_max_cuts times before: left as they were (XfemElement::cut_left_out)
+    std::size_t beside_earlier = 0; ///< cut once before along nearly the same surface (a region under 1 %): left to the earlier crack
 };
 
 class XfemModel {
