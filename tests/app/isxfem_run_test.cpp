@@ -24,40 +24,19 @@ using vox::test::fresh_dir;
 using vox::test::quote;
 using vox::test::run_voxsculpt;
 
-TEST(IsxfemRun, TheBarIsCutThroughAndItsFarHalfFalls)
-{
-    const fs::path out = fresh_dir("isxfem_bar");
-    const auto r = run_voxsculpt("run " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/bar_cut_isxfem.json") + " --frames 30 --out " +
-                                 quote(out.string()));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    std::ifstream in(out / "stats.json");
-    const nlohmann::json stats = nlohmann::json::parse(in);
-    EXPECT_EQ(stats["solver"], "isxfem");
-    EXPECT_EQ(stats["summary"]["cuts"], 1);       // one stroke, one crack, however many frames it took
-    EXPECT_EQ(stats["summary"]["cut_tets"], 54);  // the bar's 3 x 3 cells across at level 2, six tetrahedra each
-    EXPECT_EQ(stats["summary"]["converged_frames"], 30);
-    EXPECT_EQ(stats["summary"]["crack_faces"], 1); // the bar's cross-section, on both sides
-    EXPECT_EQ(stats["summary"]["slit_faces"], 0);
-    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
-    int cutting_frames = 0;
-    for (const auto& f : stats["frames"]) cutting_frames += f["cut_tets"].get<int>() > 0;
-    EXPECT_GT(cutting_frames, 1); // the blade goes down through it over several frames
-    // By 0.3 s the far half has fallen tens of centimetres (free fall from the last cut: 0.5 g t^2).
-    EXPECT_GT(stats["frames"].back()["max_displacement_mm"].get<double>(), 150.0);
-    // Closed along the cut: two closed pieces holding the bar's 100 x 10 x 10 mm between them.
-    const nlohmann::json mesh = vox::test::info_json(out / "final.obj");
-    EXPECT_EQ(mesh["closed"], true);
-    EXPECT_EQ(mesh["components"], 2);
-    EXPECT_EQ(mesh["consistently_oriented"], true);
-    // The pieces are elastic (nu = 0.3) and the blade presses on them: their volume follows the
-    // deformation to about a percent.
-    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 150.0);
-    // The held half stays up (its top still near z = 9.5 mm), the far half is far below.
-    EXPECT_GT(mesh["world_bbox_mm"]["max"][2].get<double>(), 8.0);
-    EXPECT_LT(mesh["world_bbox_mm"]["min"][2].get<double>(), -150.0);
-}
-
 namespace {
+
+/// A run's final surface (`voxsculpt info` of it), checked closed and consistently oriented, in
+/// `pieces` pieces holding `volume_mm3` between them (to `tolerance`: the pieces are elastic).
+nlohmann::json closed_pieces(const fs::path& mesh_path, int pieces, double volume_mm3, double tolerance)
+{
+    const nlohmann::json mesh = vox::test::info_json(mesh_path);
+    EXPECT_EQ(mesh["closed"], true);
+    EXPECT_EQ(mesh["components"], pieces);
+    EXPECT_EQ(mesh["consistently_oriented"], true);
+    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), volume_mm3, tolerance);
+    return mesh;
+}
 
 /// The bundled scene `name` with `from` replaced by `to` (each must occur), written to d/scene.json.
 fs::path edited_scene(const fs::path& d, const std::string& name, const std::vector<std::pair<std::string, std::string>>& edits)
@@ -85,6 +64,34 @@ double last_finger_force_z(const fs::path& stats_path)
 
 } // namespace
 
+TEST(IsxfemRun, TheBarIsCutThroughAndItsFarHalfFalls)
+{
+    const fs::path out = fresh_dir("isxfem_bar");
+    const auto r = run_voxsculpt("run " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/bar_cut_isxfem.json") + " --frames 30 --out " +
+                                 quote(out.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(out / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["solver"], "isxfem");
+    EXPECT_EQ(stats["summary"]["cuts"], 1);       // one stroke, one crack, however many frames it took
+    EXPECT_EQ(stats["summary"]["cut_tets"], 54);  // the bar's 3 x 3 cells across at level 2, six tetrahedra each
+    EXPECT_EQ(stats["summary"]["converged_frames"], 30);
+    EXPECT_EQ(stats["summary"]["crack_faces"], 1); // the bar's cross-section, on both sides
+    EXPECT_EQ(stats["summary"]["slit_faces"], 0);
+    EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
+    int cutting_frames = 0;
+    for (const auto& f : stats["frames"]) cutting_frames += f["cut_tets"].get<int>() > 0;
+    EXPECT_GT(cutting_frames, 1); // the blade goes down through it over several frames
+    // By 0.3 s the far half has fallen tens of centimetres (free fall from the last cut: 0.5 g t^2).
+    EXPECT_GT(stats["frames"].back()["max_displacement_mm"].get<double>(), 150.0);
+    // Closed along the cut: two closed pieces holding the bar's 100 x 10 x 10 mm between them (the
+    // pieces are elastic, nu = 0.3: their volume follows the deformation to about a percent).
+    const nlohmann::json mesh = closed_pieces(out / "final.obj", 2, 1e4, 150.0);
+    // The held half stays up (its top still near z = 9.5 mm), the far half is far below.
+    EXPECT_GT(mesh["world_bbox_mm"]["max"][2].get<double>(), 8.0);
+    EXPECT_LT(mesh["world_bbox_mm"]["min"][2].get<double>(), -150.0);
+}
+
 TEST(IsxfemRun, ASlitThatStopsInsideTheBarIsClosedAlongItsFront)
 {
     // The same blade stopped with its edge at the bar's bottom face: the soft bar gives way
@@ -100,11 +107,7 @@ TEST(IsxfemRun, ASlitThatStopsInsideTheBarIsClosedAlongItsFront)
     EXPECT_LT(stats["summary"]["cut_tets"].get<int>(), 54); // not through
     EXPECT_EQ(stats["summary"]["slit_faces"], 1);
     EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
-    const nlohmann::json mesh = vox::test::info_json(d / "out" / "final.obj");
-    EXPECT_EQ(mesh["closed"], true);
-    EXPECT_EQ(mesh["components"], 1);
-    EXPECT_EQ(mesh["consistently_oriented"], true);
-    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 1e4, 150.0);
+    closed_pieces(d / "out" / "final.obj", 1, 1e4, 150.0);
 }
 
 TEST(IsxfemRun, AWaveringBladeCutsOnAlongItsStrokesPlane)
@@ -154,11 +157,7 @@ TEST(IsxfemRun, AHalfCircleIncisionIsOneCutAndItsFlapFalls)
     EXPECT_EQ(stats["summary"]["recut_tets"], 0);
     EXPECT_EQ(stats["summary"]["crack_faces"], 1);
     EXPECT_EQ(stats["summary"]["open_crack_chains"], 0);
-    const nlohmann::json mesh = vox::test::info_json(d / "out" / "final.obj");
-    EXPECT_EQ(mesh["closed"], true);
-    EXPECT_EQ(mesh["components"], 2);
-    EXPECT_EQ(mesh["consistently_oriented"], true);
-    EXPECT_NEAR(mesh["enclosed_volume_mm3"].get<double>(), 40.0 * 40.0 * 10.0, 200.0);
+    const nlohmann::json mesh = closed_pieces(d / "out" / "final.obj", 2, 40.0 * 40.0 * 10.0, 200.0);
     EXPECT_LT(mesh["world_bbox_mm"]["min"][2].get<double>(), -20.0); // the flap, 0.1 s after the blade came out: 0.5 g t^2 = 49 mm
 }
 

@@ -7,6 +7,7 @@
 #include "isxfem/cut_closure.hpp"
 
 #include "grid/union_find.hpp"
+#include "isxfem/arc_sweep.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -319,19 +320,8 @@ const Eigen::Vector2d k_bend_centre(7.1, 2.0);
 /// (7.1, 2) in x-y (through x = 3.1 at y = 2), from y = -0.5 to `to_y`, through all of z.
 CutSurface bent_sweep(double to_y)
 {
-    auto at = [](double angle) { return Eigen::Vector2d(k_bend_centre + k_bend_radius * Eigen::Vector2d(-std::cos(angle), std::sin(angle))); };
-    CutSurface sweep;
-    const double step = 2.0 * M_PI / 180.0, last = std::asin((to_y - 2.0) / k_bend_radius);
-    for (double angle = std::asin(-2.5 / k_bend_radius); angle < last; angle += step) {
-        const Eigen::Vector2d a = at(angle), b = at(std::min(angle + step, last));
-        CutPatch p;
-        p.corners = {{a.x(), a.y(), -1.0}, {b.x(), b.y(), -1.0}, {b.x(), b.y(), 5.0}, {a.x(), a.y(), 5.0}};
-        const Eigen::Vector2d towards_centre = (k_bend_centre - 0.5 * (a + b)).normalized();
-        p.normal = {towards_centre.x(), towards_centre.y(), 0.0};
-        if ((p.corners[1] - p.corners[0]).cross(p.corners[2] - p.corners[0]).dot(p.normal) < 0.0) std::reverse(p.corners.begin(), p.corners.end());
-        sweep.add(p);
-    }
-    return sweep;
+    return vox::test::arc_sweep(k_bend_centre, k_bend_radius, std::asin(-2.5 / k_bend_radius), std::asin((to_y - 2.0) / k_bend_radius),
+                                2.0 * M_PI / 180.0);
 }
 
 /// The area of the closed surface's triangles on the bent crack (facing along x, away from the

@@ -6,6 +6,8 @@
 
 #include "isxfem/xfem_model.hpp"
 
+#include "isxfem/arc_sweep.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -121,18 +123,8 @@ TEST(CutSurface, ABentSweepCutsEachTetrahedronOnceAndItsCracksMeet)
     // degrees, each a flat patch: one cut through, no tetrahedron cut twice or left partly cut, and
     // where two cut tetrahedra share an edge the crack crosses it at the same point in both.
     const Eigen::Vector2d centre(7.1, 2.0);
-    const double radius = 4.0, step = 2.0 * M_PI / 180.0;
-    CutSurface sweep;
-    for (double angle = -40.0 * M_PI / 180.0; angle < 40.0 * M_PI / 180.0 - 1e-9; angle += step) {
-        auto at = [&](double a) { return Eigen::Vector2d(centre + radius * Eigen::Vector2d(-std::cos(a), std::sin(a))); };
-        const Eigen::Vector2d a = at(angle), b = at(angle + step);
-        CutPatch p;
-        p.corners = {{a.x(), a.y(), -1.0}, {b.x(), b.y(), -1.0}, {b.x(), b.y(), 5.0}, {a.x(), a.y(), 5.0}};
-        const Eigen::Vector2d towards = (centre - 0.5 * (a + b)).normalized();
-        p.normal = {towards.x(), towards.y(), 0.0};
-        if ((p.corners[1] - p.corners[0]).cross(p.corners[2] - p.corners[0]).dot(p.normal) < 0.0) std::reverse(p.corners.begin(), p.corners.end());
-        sweep.add(p);
-    }
+    const double radius = 4.0;
+    const CutSurface sweep = vox::test::arc_sweep(centre, radius, -40.0 * M_PI / 180.0, 40.0 * M_PI / 180.0, 2.0 * M_PI / 180.0);
     XfemModel model = lattice_model();
     const CutReport r = model.cut(sweep, 0);
     EXPECT_EQ(r.cut, 0);
