@@ -101,7 +101,7 @@ void run_haptics_bench(double seconds, bool isxfem)
             const IsxfemToolFrame t = xfem_tools->frame(*xfem, frame, scene.solver.dt_s);
             if (!t.hold_object) xfem->solver().step();
             const Eigen::AlignedBox3d box = pose.world_bounds(0.0);
-            xfem->sample_surface(Eigen::AlignedBox3d(box.min() - reach, box.max() + reach), out, false); // a knife: no crack walls
+            xfem->sample_surface(Eigen::AlignedBox3d(box.min() - reach, box.max() + reach), out, knife.size_mm.y()); // not crack walls closer than the knife is thick
             return t.cut.cut_tets > 0;
         };
     } else {

@@ -34,11 +34,7 @@ public:
     isxfem::CutReport advance(IsxfemSimulation& sim, const io::ToolPose& from, const io::ToolPose& to, const Eigen::Vector3d& moved_mm,
                               bool cut);
     /// The blade left: the next frame starts a new stroke.
-    void end()
-    {
-        m_surface = {};
-        m_cut = -1;
-    }
+    void end() { m_surface = {}; }
 
 
 private:

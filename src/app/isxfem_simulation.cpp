@@ -179,7 +179,7 @@ struct IsxfemSimulation::NearSurface {
     std::vector<Eigen::Vector3i> triangles;       ///< among `near` (indices into it)
 };
 
-IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach, bool crack_walls) const
+IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach, double closed_walls_mm) const
 {
     NearSurface out;
     refresh_closed_surface();
@@ -216,15 +216,27 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
     std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
     std::vector<double> area(vertices.size(), 0.0);
     std::vector<Eigen::Vector3i> touching;
+    // A crack face whose corners lie within `closed_walls_mm` of their own points across the crack:
+    // its walls have not opened.
+    auto closed = [&](const Eigen::Vector3i& t, int cut) {
+        for (int c = 0; c < 3; ++c) {
+            const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
+            const int j = m_model->elements()[v.tet].cut_index(cut);
+            if (j < 0) continue; // on the crack's front: one point for both walls
+            const Eigen::Vector3d across = 1e3 * m_solver->position(v.tet, v.bary, v.side ^ (1 << j));
+            if ((across - position[static_cast<std::size_t>(t[c])]).norm() >= closed_walls_mm) return false;
+        }
+        return true;
+    };
     for (std::size_t i = 0; i < triangles.size(); ++i) {
         const Eigen::Vector3i& t = triangles[i];
         if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
-        if (!crack_walls && m_closed_crack[i] >= 0) continue;
         for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
             if (!std::isfinite(position[static_cast<std::size_t>(t[c])].x())) {
                 const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
                 position[static_cast<std::size_t>(t[c])] = 1e3 * m_solver->position(v.tet, v.bary, v.side);
             }
+        if (closed_walls_mm > 0.0 && m_closed_crack[i] >= 0 && closed(t, m_closed_crack[i])) continue;
         const Eigen::Vector3d n = (position[static_cast<std::size_t>(t[1])] - position[static_cast<std::size_t>(t[0])])
                                       .cross(position[static_cast<std::size_t>(t[2])] - position[static_cast<std::size_t>(t[0])]);
         for (int c = 0; c < 3; ++c) {
@@ -249,12 +261,12 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
 }
 
 IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
-                                                const contact::PlacedShape* from, bool crack_walls) const
+                                                const contact::PlacedShape* from, double closed_walls_mm) const
 {
     // Only the surface within the tool's reach (at both poses) is measured.
     Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
-    const NearSurface s = near_surface(reach, crack_walls);
+    const NearSurface s = near_surface(reach, closed_walls_mm);
     Touch out;
     out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
@@ -264,9 +276,9 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     return out;
 }
 
-void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, bool crack_walls) const
+void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, double closed_walls_mm) const
 {
-    const NearSurface s = near_surface(box, crack_walls);
+    const NearSurface s = near_surface(box, closed_walls_mm);
     out.count = std::min(s.positions.size(), out.capacity());
     out.truncated = s.positions.size() > out.capacity();
     std::copy_n(s.positions.begin(), out.count, out.positions_mm.begin());

@@ -56,22 +56,22 @@ public:
     /// vertices, each carrying a third of its triangles' area and their area-weighted normal),
     /// and the contact's forces as point loads at the vertices' material points for the solver.
     /// With `from`, the tool's pose at the previous frame: the penalty is integrated over the
-    /// move (continuous penalty). Without `crack_walls` the cuts' crack faces are left out: a
-    /// blade's (walls that lie on each other at rest close on a blade in them from both sides at
-    /// once, which only stiffens the solve and shakes a haptic tool; a finger pressing into a
-    /// crack touches them).
+    /// move (continuous penalty). With `closed_walls_mm` > 0, crack faces whose walls are still
+    /// closer together than that (a blade's thickness) are left out: walls that lie on each other
+    /// close on a blade from both sides at once, which only stiffens the solve and shakes a haptic
+    /// tool; walls that have opened (a piece fallen away) are touched like the rest.
     struct Touch {
         contact::ContactResult contact;
         std::vector<isxfem::PointLoad> loads;
     };
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
-                              const contact::PlacedShape* from = nullptr, bool crack_walls = true) const;
+                              const contact::PlacedShape* from = nullptr, double closed_walls_mm = 0.0) const;
 
     /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
     /// with its area and outward normal, and the triangles among them: the snapshot the haptic
     /// thread touches (at most out.capacity() points; out.truncated says when more were near),
-    /// with or without the crack faces (as touch()).
-    void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, bool crack_walls = true) const;
+    /// without the crack faces whose walls are closer than `closed_walls_mm` (as touch()).
+    void sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, double closed_walls_mm = 0.0) const;
 
     /// The side (of its cut; 0 when uncut) of the material point with barycentric coordinates
     /// `bary` in tetrahedron `tet`.
@@ -83,7 +83,7 @@ public:
 
 private:
     struct NearSurface;
-    [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box, bool crack_walls) const;
+    [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box, double closed_walls_mm) const;
     /// The closed surface's vertices (material points) and triangles, kept until the next cut.
     void refresh_closed_surface() const;
 

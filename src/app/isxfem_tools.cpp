@@ -65,7 +65,7 @@ IsxfemToolFrame IsxfemTools::frame(IsxfemSimulation& sim, int frame, double dt)
         const contact::PlacedShape placed{&m_shapes[k], to.position_mm, to.orientation};
         const IsxfemSimulation::Touch touch =
             sim.touch(placed, {spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, m_last_pose[k].shape ? &m_last_pose[k] : nullptr,
-                      !m_strokes[k]);
+                      m_strokes[k] ? spec.size_mm.y() : 0.0); // a blade's thickness
         m_last_pose[k] = placed;
         loads.insert(loads.end(), touch.loads.begin(), touch.loads.end());
         for (const isxfem::PointLoad& l : touch.loads) cuts_known.push_back(sim.model().elements()[l.tet].cuts.size());

@@ -76,13 +76,10 @@ public:
 private:
     /// The cut's level at a point: a plane's; a swept cut's interpolated from its tetrahedron's
     /// nodes' (XfemModel::level: so the crossings lie on the crack) within reach of its patches,
-    /// and beyond it positive, 1 m, whatever side: the surface's crossing loops near the crack
-    /// then close at the edge of the reach (any level closes them; only where they pass through
-    /// the crack do they part the surface), so a cut far away costs no crossings.
+    /// and its surface's beyond (the nearest patch's plane, with the right sign).
     double level(std::size_t tet, const std::array<double, 4>& bary, const Eigen::Vector3d& x)
     {
-        if (m_surface.is_plane()) return m_surface.level(x);
-        if (!m_reach.contains(x)) return 1.0;
+        if (m_surface.is_plane() || !m_reach.contains(x)) return m_surface.level(x);
         double phi = 0.0;
         for (std::size_t c = 0; c < 4; ++c) {
             const std::uint32_t n = m_model.elements()[tet].node[c];
@@ -339,8 +336,23 @@ int Closer::corner_point(int segment, std::pair<std::size_t, unsigned> near)
 void Closer::split(std::vector<Eigen::Vector3i>& triangles)
 {
     // The triangles the cut crosses, and their crossings.
-    m_point_level.resize(m_points.size());
-    for (std::size_t k = 0; k < m_points.size(); ++k) m_point_level[k] = level(m_points[k].tet, m_points[k].bary, m_points[k].rest_m);
+    // The level at every point within reach of the cut, and at those beyond only where a triangle
+    // reaches in from them: elsewhere the surface stays whole (positive, whatever side), so a
+    // cut far away costs no search of its patches and no crossings.
+    m_point_level.assign(m_points.size(), NAN);
+    for (std::size_t k = 0; k < m_points.size(); ++k)
+        if (m_surface.is_plane() || m_reach.contains(m_points[k].rest_m)) m_point_level[k] = level(m_points[k].tet, m_points[k].bary, m_points[k].rest_m);
+    for (const Eigen::Vector3i& t : triangles) {
+        int beyond = 0;
+        for (int a = 0; a < 3; ++a) beyond += std::isnan(m_point_level[static_cast<std::size_t>(t[a])]) ? 1 : 0;
+        if (beyond == 0 || beyond == 3) continue;
+        for (int a = 0; a < 3; ++a) {
+            double& l = m_point_level[static_cast<std::size_t>(t[a])];
+            if (std::isnan(l)) l = m_surface.level(m_points[static_cast<std::size_t>(t[a])].rest_m);
+        }
+    }
+    for (double& l : m_point_level)
+        if (std::isnan(l)) l = 1.0;
     std::vector<std::array<bool, 3>> positive(triangles.size());
     std::vector<std::array<int, 2>> cross(triangles.size(), {-1, -1});
     for (std::size_t i = 0; i < triangles.size(); ++i) {

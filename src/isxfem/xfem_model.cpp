@@ -4,23 +4,26 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace vox::isxfem {
 namespace {
 
-/// The smallest region (share of its tetrahedron) a second cut alongside the first may leave.
+/// The smallest region (share of its tetrahedron) a second cut may leave between itself and the first.
 constexpr double k_min_second_cut_region = 0.01;
 
-/// Whether two cuts run alongside each other in tetrahedron `e` (their planes there within 30
-/// degrees), given their levels at its nodes.
-bool alongside(const XfemElement& e, const std::array<double, 4>& a, const std::array<double, 4>& b)
+/// Whether two cuts that do not cross in a tetrahedron (three regions) leave a region between them
+/// (the one across each cut from another) under k_min_second_cut_region of its `volume`.
+bool sliver_between(const std::vector<Region>& regions, double volume)
 {
-    const Eigen::Vector3d ga = e.geometry.gradient.transpose() * Eigen::Vector4d(a[0], a[1], a[2], a[3]);
-    const Eigen::Vector3d gb = e.geometry.gradient.transpose() * Eigen::Vector4d(b[0], b[1], b[2], b[3]);
-    return std::abs(ga.dot(gb)) >= std::cos(30.0 * 3.14159265358979323846 / 180.0) * ga.norm() * gb.norm();
+    if (regions.size() != 3) return false;
+    unsigned missing = 0;
+    for (unsigned p = 0; p < 4; ++p)
+        if (std::none_of(regions.begin(), regions.end(), [p](const Region& r) { return r.pattern == p; })) missing = p;
+    const unsigned middle = missing ^ 3u;
+    return std::any_of(regions.begin(), regions.end(),
+                       [&](const Region& r) { return r.pattern == middle && r.volume < k_min_second_cut_region * volume; });
 }
 
 } // namespace
@@ -192,10 +195,10 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
         // A second cut running alongside the first within the tetrahedron (a blade drawn again
         // along a crack) would leave a sliver between them, whose pieces' rotations and dofs the
         // solve cannot hold (a haptic session cutting the same plane over and over diverged): the
-        // earlier crack is taken to separate it. (Crossing cuts may leave small corners: kept.)
-        if (!e.cuts.empty() && alongside(e, e.cuts.front().phi, candidate_phi[i]) &&
-            std::any_of(c.regions.begin(), c.regions.end(), [&](const Region& r) { return r.volume < k_min_second_cut_region * e.geometry.volume; })) {
-            ++report.beside_earlier;
+        // earlier crack is taken to separate it. (A small corner either cut leaves is kept.)
+        if (!e.cuts.empty() && sliver_between(c.regions, e.geometry.volume)) {
+            if (!e.left_to_earlier_cut) ++report.beside_earlier; // each tetrahedron once, though asked again each frame
+            e.left_to_earlier_cut = true;
             continue;
         }
         if (!e.cuts.empty()) {

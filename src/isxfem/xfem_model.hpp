@@ -15,9 +15,8 @@
 // cross leave four, and three linear fields cannot move four pieces independently: those
 // tetrahedra keep their pieces coupled, and the report counts them (`crossed_tets`) so the
 // caller can say so. A third cut through a tetrahedron is not applied there (counted too), nor a
-// second that runs alongside the first within it (within 30 degrees, leaving a region under 1 % of
-// the tetrahedron: a blade drawn again along its crack), which the earlier crack is taken to
-// separate.
+// second that runs alongside the first within it, leaving a region under 1 % of the tetrahedron
+// between them (a blade drawn again along its crack), which the earlier crack is taken to separate.
 
 #include "isxfem/cut_surface.hpp"
 #include "isxfem/moment_fitting.hpp"
@@ -58,6 +57,7 @@ struct XfemElement {
     std::vector<Region> regions;             ///< cut: its non-empty regions
     bool crossed = false;                    ///< two cuts cross inside: four pieces, not all separable
     bool cut_left_out = false;               ///< a further cut went through it whole after its k_max_cuts: left out here
+    bool left_to_earlier_cut = false;        ///< a second cut ran alongside its first too close: left to the first
     Matrix12d stiffness = Matrix12d::Zero(); ///< whole: K at rest
     Eigen::MatrixXd mass;                    ///< consistent mass over its dofs, kg
     [[nodiscard]] bool is_cut() const { return !cuts.empty(); }
@@ -112,7 +112,7 @@ struct CutReport {
     std::size_t new_blocks = 0;     ///< enriched dof blocks added
     std::size_t partial_tets = 0;   ///< crossed but not separated whole (or only touched): left uncut
     std::size_t already_cut = 0;    ///< crossed whole but cut k_max_cuts times before: left as they were (XfemElement::cut_left_out)
-    std::size_t beside_earlier = 0; ///< cut once before along nearly the same surface (a region under 1 %): left to the earlier crack
+    std::size_t beside_earlier = 0; ///< cut once before along nearly the same surface (under 1 % between): left to the earlier crack, counted once
 };
 
 class XfemModel {

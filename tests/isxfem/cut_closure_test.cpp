@@ -374,3 +374,22 @@ TEST(CutClosure, ABentSlitIsClosedAlongItsFront)
     EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
     EXPECT_LT(bent_crack(c).second, 0.1);
 }
+
+TEST(CutClosure, ASweptSlitAcrossAnEarlierPlaneCutIsClosed)
+{
+    // Through at x = 3.1, then a blade's sweep (one patch) at y = 2.3 from the top down to z = 2,
+    // across the first cut: near the sweep its level is the nodes', beyond it its surface's, so
+    // the first cut's large crack faces, reaching from near it to far, cross it where it is.
+    CutSurface sweep;
+    CutPatch p;
+    p.corners = {{1.5, 2.3, 2.0}, {4.6, 2.3, 2.0}, {4.6, 2.3, 4.5}, {1.5, 2.3, 4.5}};
+    p.normal = Eigen::Vector3d::UnitY();
+    sweep.add(p);
+    const Closed c = closed_box([&](XfemModel& model) {
+        return std::vector<CutReport>{model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 3.1}), model.cut(sweep, 0)};
+    });
+    EXPECT_EQ(c.counts.open_chains, 0u);
+    expect_closed(c);
+    EXPECT_EQ(pieces(c), 2);
+    EXPECT_NEAR(volume_and_crack_area(c).first, 5.9 * 3.9 * 3.9, 1e-9);
+}

@@ -192,6 +192,17 @@ TEST(XfemSolver, ACutAlongsideAnEarlierOneIsLeftToIt)
     EXPECT_NEAR(far0 - mean_z(model, solver, 0.055, 1.0), free_fall, 0.1 * free_fall);
 }
 
+TEST(XfemSolver, ASecondCutClippingCornersBesideTheFirstIsKept)
+{
+    // 3.5 mm apart in 10 mm tetrahedra: where the second plane clips a small corner of a
+    // tetrahedron the first crosses, the corner is no sliver between the two, and is cut.
+    XfemModel model = bar_model(0.1);
+    const CutReport first = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.045});
+    const CutReport second = model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.0415});
+    EXPECT_EQ(second.beside_earlier, 0u);
+    EXPECT_EQ(second.cut_tets, first.cut_tets);
+}
+
 TEST(XfemSolver, ASecondCutThroughFallingTetrahedraIsPatchedIn)
 {
     // The bar cut once and falling, then cut again through the same slab while it moves: the new
