@@ -6,7 +6,7 @@
 // (app/blade_stroke.hpp): a stroke breaks in when the blade's inner shape reaches the surface with
 // the contact pressure at or above the tool's cut_pressure_pa, as a branched-grid cut begins, and
 // from then on cuts wherever the blade passes until it lets go (leaves the surface's reach) or
-// changes plane. Crack walls closer together than a blade's thickness are not in its contact
+// starts a new stroke (turned or moved off its plane: app/blade_stroke.hpp). Crack walls closer together than a blade's thickness are not in its contact
 // surface (they would close on it from both sides at once; walls that have opened are touched
 // like the rest), so past the break-in the pressure at the blade's edge inside the material is not
 // measured.

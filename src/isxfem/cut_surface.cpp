@@ -130,11 +130,11 @@ Eigen::Vector2d CutSurface::unrolled(const Eigen::Vector3d& x) const
     return p.at + Eigen::Vector2d(p.u.dot(d), p.normal.cross(p.u).dot(d));
 }
 
-bool CutSurface::meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::size_t first) const
+bool CutSurface::meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const
 {
     if (m_is_plane) return (m_plane.at(a) < 0.0) != (m_plane.at(b) < 0.0);
     Eigen::AlignedBox3d segment(a.cwiseMin(b), a.cwiseMax(b));
-    for (std::size_t k = first; k < m_patches.size(); ++k) {
+    for (std::size_t k = 0; k < m_patches.size(); ++k) {
         if (!m_boxes[k].intersects(segment)) continue;
         const std::vector<Eigen::Vector3d>& c = m_patches[k].corners;
         for (std::size_t i = 1; i + 1 < c.size(); ++i)

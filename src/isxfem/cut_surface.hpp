@@ -7,7 +7,8 @@
 // rather than one plane.
 //
 // A tetrahedron edge is cut where it meets a patch: Möller and Trumbore's segment-triangle test
-// on the patches' triangles (the test the sculpting paper cuts its tetrahedra with). The level of
+// on the patches' triangles (the sculpting paper finds its cut tetrahedra with Möller's
+// triangle-triangle test; an edge's crossings are what the cut needs). The level of
 // a point is its signed distance from the plane of the patch nearest to it: exact for a stroke
 // in one plane, and along a curved one the local tangent plane (XfemModel keeps the levels of the
 // nodes it cut with, so the cut is planar in each tetrahedron and continuous between them).
@@ -46,15 +47,15 @@ public:
     /// phi at x: the plane's, or the signed distance from the plane of the nearest patch (a
     /// surface without patches: 0).
     [[nodiscard]] double level(const Eigen::Vector3d& x) const;
-    /// The unit normal at x: the plane's, or the nearest patch's (x without patches).
+    /// The unit normal at x: the plane's, or the nearest patch's (the x axis without patches).
     [[nodiscard]] Eigen::Vector3d normal(const Eigen::Vector3d& x) const;
     /// Coordinates of x (on or near the surface) in the surface unrolled flat, counter-clockwise
     /// seen from its positive side: a plane's own, or the nearest patch's, each patch's axis carried
     /// over from the one before by the turn between their normals, so a stroke that turns and
     /// comes round lies flat without folding over itself (what its crack faces are triangulated in).
     [[nodiscard]] Eigen::Vector2d unrolled(const Eigen::Vector3d& x) const;
-    /// Whether the segment a-b meets one of patches [first, end) (a plane: whether it crosses it).
-    [[nodiscard]] bool meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::size_t first = 0) const;
+    /// Whether the segment a-b meets a patch (a plane: whether it crosses it).
+    [[nodiscard]] bool meets(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
     /// Whether x lies within `off` of a patch's plane and over the patch (a plane: always): where a
     /// tetrahedron edge's level crosses, next to a patch, when the edge's ends lie so close to the
     /// surface that the patches themselves pass beside it.
