@@ -92,6 +92,10 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
 {
     const io::Scene loaded = io::load_scene(scene_path);
     if (loaded.tools.empty()) throw loaded.error("tools", "the viewer needs at least one tool to sculpt with");
+    // Not silently the other method: a researcher comparing the two must see the one asked for.
+    if (loaded.solver.type == io::SolverType::isxfem)
+        throw loaded.error("solver.type", "the viewer simulates with the branched grid (\"dbg\") only so far; run \"isxfem\" scenes with "
+                                          "`voxsculpt run` (--render-every N for pictures) or feel them in `voxsculpt bench haptics --isxfem`");
     // The user moves the tools: the script does not.
     io::Scene scene = loaded;
     scene.script.clear();
