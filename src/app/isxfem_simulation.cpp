@@ -217,14 +217,17 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
     std::vector<double> area(vertices.size(), 0.0);
     std::vector<Eigen::Vector3i> touching;
     // A crack face whose corners lie within `closed_walls_mm` of their own points across the crack:
-    // its walls have not opened.
+    // its walls have not opened. Each corner's gap is measured once (a corner has several faces).
+    std::vector<float> gap(closed_walls_mm > 0.0 ? vertices.size() : 0, -1.0f);
     auto closed = [&](const Eigen::Vector3i& t, int cut) {
         for (int c = 0; c < 3; ++c) {
-            const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
-            const int j = m_model->elements()[v.tet].cut_index(cut);
-            if (j < 0) continue; // on the crack's front: one point for both walls
-            const Eigen::Vector3d across = 1e3 * m_solver->position(v.tet, v.bary, v.side ^ (1 << j));
-            if ((across - position[static_cast<std::size_t>(t[c])]).norm() >= closed_walls_mm) return false;
+            const auto k = static_cast<std::size_t>(t[c]);
+            if (gap[k] < 0.0f) {
+                const isxfem::SurfacePoint& v = vertices[k];
+                const int j = m_model->elements()[v.tet].cut_index(cut); // < 0 on the crack's front: one point for both walls
+                gap[k] = j < 0 ? 0.0f : static_cast<float>((1e3 * m_solver->position(v.tet, v.bary, v.side ^ (1 << j)) - position[k]).norm());
+            }
+            if (gap[k] >= closed_walls_mm) return false;
         }
         return true;
     };

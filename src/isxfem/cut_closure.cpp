@@ -464,13 +464,14 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
     const std::size_t boundary = ids.size();
     for (const auto& [edge, at] : m_crack_vertices) {
         const auto& [point, tet] = at;
-        const int holder = locate(in_plane, faces, flat(point));
+        const Eigen::Vector2d unrolled = flat(point);
+        const int holder = locate(in_plane, faces, unrolled);
         if (holder < 0) continue;
         const std::array<int, 3>& f = faces[static_cast<std::size_t>(holder)];
         const Eigen::Vector3d& x0 = x[static_cast<std::size_t>(f[0])];
         const Eigen::Vector3d normal = (x[static_cast<std::size_t>(f[1])] - x0).cross(x[static_cast<std::size_t>(f[2])] - x0);
         if (std::abs(normal.normalized().dot(point - x0)) <= 1e-3 * m_model.longest_edge()) continue;
-        insert_point(in_plane, faces, holder, flat(point), boundary);
+        insert_point(in_plane, faces, holder, unrolled, boundary);
         const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), tet, point));
         const unsigned region = m_model.elements()[tet].region_at(bary);
         const unsigned bit = 1u << m_model.elements()[tet].cut_index(m_cut);
