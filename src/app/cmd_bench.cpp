@@ -1,242 +1,35 @@
-// voxsculpt bench tradeoff: the speed/accuracy trade of the coarsening level, measured.
-// A cantilever beam sagging under gravity (quasi-static) against Euler-Bernoulli and against its
-// level-0 solution, and the liver against its level-1 solution. Errors compare the deformed
-// surface, which follows the voxels and so is the same at every level; writes a Markdown table
-// and an SVG plot of error against solve time.
+// voxsculpt bench: the benchmark harnesses (bench/harness) behind one subcommand each. Every
+// bench writes to --out (default out/), never over the committed tables in docs/benchmarks, which
+// are rendered from a bench's output on purpose.
 
 #include "app/commands.hpp"
-#include "core/atomic_file.hpp"
-#include "core/log.hpp"
-#include "app/bench_compare.hpp"
-#include "app/bench_conditioning.hpp"
-#include "app/bench_cutting.hpp"
-#include "app/bench_haptics.hpp"
-#include "app/bench_stability.hpp"
-#include "app/scene_simulation.hpp"
+#include "bench/harness/compare.hpp"
+#include "bench/harness/conditioning.hpp"
+#include "bench/harness/cutting.hpp"
+#include "bench/harness/haptics.hpp"
+#include "bench/harness/stability.hpp"
+#include "bench/harness/tradeoff.hpp"
 #include "core/error.hpp"
-#include "io/scene_object.hpp"
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
-#include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <functional>
-#include <map>
+#include <memory>
 #include <optional>
-#include <sstream>
+#include <string>
 
 namespace vox::app {
-namespace {
 
-constexpr int k_liver_reference = 1;
-
-/// Quasi-static equilibrium under gravity at one level: surface displacements and cost.
-struct Solution {
-    int level = 0;
-    std::map<std::uint64_t, Eigen::Vector3d> displacement; ///< surface vertex key -> mm
-    std::map<std::uint64_t, Eigen::Vector3d> rest;         ///< surface vertex key -> world mm
-    std::size_t elements = 0, dofs = 0;
-    double solve_ms = 0.0;
-    int cg_iterations = 0;
-};
-
-/// A scene document for a quasi-static solve of `object` under gravity -z, held in `held_box_mm`.
-nlohmann::json static_scene(nlohmann::json object, double youngs_modulus_pa, double poisson_ratio, double density,
-                            const nlohmann::json& held_box_mm, int level)
-{
-    object["levels"] = level;
-    return {{"object", object},
-            {"materials", {{"default", {{"youngs_modulus_pa", youngs_modulus_pa}, {"poisson_ratio", poisson_ratio},
-                                        {"density_kg_m3", density}}}}},
-            {"solver", {{"mode", "static"}, {"cg_tolerance", 1e-8}, {"cg_max_iterations", 5000}, {"newton_max_iterations", 30},
-                        {"preconditioner", "auto"}}},
-            {"gravity_m_s2", {0, 0, -9.81}},
-            {"constraints", {{{"type", "fixed"}, {"box_mm", held_box_mm}}}}};
-}
-
-/// Quasi-static equilibrium of a scene at its level: surface displacements and cost.
-Solution solve_static(const nlohmann::json& document)
-{
-    const io::Scene scene = io::parse_scene(document, std::filesystem::current_path(), "bench scene");
-    const grid::LabelGrid labels = io::build_scene_object(scene);
-    const int level = scene.object.levels;
-    const grid::BranchedGrid g = build_scene_grid(scene, labels, std::min(6, std::max(level, 1) + 3));
-    SceneSimulation sim(scene, g, level);
-    const fem::StepStats s = sim.solver().step();
-
-    Solution out;
-    out.level = level;
-    out.elements = sim.model().elements().size();
-    out.dofs = sim.solver().dof_count();
-    out.solve_ms = s.step_ms;
-    out.cg_iterations = s.cg_iterations;
-    const std::vector<Eigen::Vector3d> u = sim.surface().displacements(sim.solver().positions());
-    const auto& vertices = sim.surface().embedded().vertices();
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        if (vertices[i].users == 0) continue;
-        out.displacement[vertices[i].key] = u[i] * 1e3;
-        out.rest[vertices[i].key] = g.voxels().world_mm(vertices[i].rest);
-    }
-    return out;
-}
-
-/// RMS of the displacement difference over the reference's RMS displacement.
-double relative_error(const Solution& s, const Solution& reference)
-{
-    double diff = 0.0, norm = 0.0;
-    for (const auto& [key, u] : reference.displacement) {
-        const auto it = s.displacement.find(key);
-        if (it == s.displacement.end()) continue;
-        diff += (it->second - u).squaredNorm();
-        norm += u.squaredNorm();
-    }
-    return std::sqrt(diff / norm);
-}
-
-/// Mean z displacement of the surface vertices on the beam's free end (x >= end_x), mm.
-double tip_deflection(const Solution& s, double end_x)
-{
-    double sum = 0.0;
-    int n = 0;
-    for (const auto& [key, p] : s.rest)
-        if (p.x() >= end_x) {
-            sum += s.displacement.at(key).z();
-            ++n;
-        }
-    return n ? sum / n : 0.0;
-}
-
-std::string svg_plot(const std::vector<std::pair<std::string, std::vector<Solution>>>& series,
-                     const std::vector<std::vector<double>>& errors)
-{
-    // Log-log: x = solve time (ms), y = relative error (%).
-    const double w = 640, h = 420, left = 70, bottom = 50, top = 20, right = 20;
-    double x0 = 1e9, x1 = 0, y0 = 1e9, y1 = 0;
-    for (std::size_t s = 0; s < series.size(); ++s)
-        for (std::size_t i = 0; i < series[s].second.size(); ++i) {
-            if (errors[s][i] <= 0) continue;
-            x0 = std::min(x0, series[s].second[i].solve_ms);
-            x1 = std::max(x1, series[s].second[i].solve_ms);
-            y0 = std::min(y0, 100 * errors[s][i]);
-            y1 = std::max(y1, 100 * errors[s][i]);
-        }
-    x0 = std::pow(10, std::floor(std::log10(x0))), x1 = std::pow(10, std::ceil(std::log10(x1)));
-    y0 = std::pow(10, std::floor(std::log10(y0))), y1 = std::pow(10, std::ceil(std::log10(y1)));
-    auto px = [&](double x) { return left + (w - left - right) * std::log10(x / x0) / std::log10(x1 / x0); };
-    auto py = [&](double y) { return h - bottom - (h - bottom - top) * std::log10(y / y0) / std::log10(y1 / y0); };
-    std::ostringstream o;
-    o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << w << "' height='" << h
-      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
-    for (double x = x0; x <= x1 * 1.001; x *= 10)
-        o << "<line x1='" << px(x) << "' y1='" << top << "' x2='" << px(x) << "' y2='" << h - bottom
-          << "' stroke='#ddd'/><text x='" << px(x) << "' y='" << h - bottom + 16 << "' text-anchor='middle'>" << x
-          << "</text>\n";
-    for (double y = y0; y <= y1 * 1.001; y *= 10)
-        o << "<line x1='" << left << "' y1='" << py(y) << "' x2='" << w - right << "' y2='" << py(y)
-          << "' stroke='#ddd'/><text x='" << left - 6 << "' y='" << py(y) + 4 << "' text-anchor='end'>" << y
-          << "</text>\n";
-    o << "<text x='" << (left + w - right) / 2 << "' y='" << h - 12
-      << "' text-anchor='middle'>quasi-static solve time, ms (log)</text>\n"
-      << "<text transform='translate(16," << (top + h - bottom) / 2
-      << ") rotate(-90)' text-anchor='middle'>relative error of the deformed surface, % (log)</text>\n";
-    const char* colours[] = {"#1f77b4", "#d62728"};
-    for (std::size_t s = 0; s < series.size(); ++s) {
-        std::string path;
-        for (std::size_t i = 0; i < series[s].second.size(); ++i) {
-            if (errors[s][i] <= 0) continue;
-            const double x = px(series[s].second[i].solve_ms), y = py(100 * errors[s][i]);
-            path += (path.empty() ? "M" : " L") + std::to_string(x) + " " + std::to_string(y);
-            o << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colours[s] << "'/><text x='" << x + 6
-              << "' y='" << y - 6 << "' fill='" << colours[s] << "'>L" << series[s].second[i].level << "</text>\n";
-        }
-        o << "<path d='" << path << "' fill='none' stroke='" << colours[s] << "'/>\n";
-        o << "<text x='" << w - right - 150 << "' y='" << top + 16 + 16 * s << "' fill='" << colours[s] << "'>"
-          << series[s].first << "</text>\n";
-    }
-    o << "</svg>\n";
-    return o.str();
-}
-
-void run_tradeoff(const std::filesystem::path& out, bool liver)
-{
-    std::ostringstream md;
-    // The beam: 200 x 10 x 10 mm of 1 mm voxels, clamped at x = -0.5 mm, E = 1e8 Pa, nu = 0.3,
-    // rho = 1000 kg/m^3: Euler-Bernoulli tip deflection q L^4 / (8 E I) = 2.354 mm (1.2 % of L).
-    const double q = 1000.0 * 9.81 * 1e-4, length = 0.2, inertia = 1e-8 / 12.0;
-    const double euler_bernoulli_mm = q * std::pow(length, 4) / (8 * 1e8 * inertia) * 1e3;
-    std::vector<Solution> beam_rows;
-    for (int level = 0; level <= 4; ++level) {
-        log::info("bench tradeoff: beam, level {}", level);
-        beam_rows.push_back(solve_static(static_scene({{"phantom", {{"shape", "beam"}}}}, 1e8, 0.3, 1000.0,
-                                                      {{-1e3, -1e3, -1e3}, {-0.5, 1e3, 1e3}}, level)));
-    }
-    std::vector<double> beam_errors;
-    md << "Cantilever beam 200 x 10 x 10 mm (1 mm voxels), E = 1e8 Pa, nu = 0.3, sagging under gravity, "
-          "quasi-static (Newton + preconditioned CG to 1e-8: warped Cholesky up to 20 k DOFs, multigrid above). Euler-Bernoulli tip deflection: "
-       << euler_bernoulli_mm << " mm.\n\n"
-       << "| level | elements | DOFs | tip deflection (mm) | error vs Euler-Bernoulli | error vs level 0 (surface) | "
-          "solve time (ms) | CG iterations |\n|---|---|---|---|---|---|---|---|\n";
-    for (const Solution& s : beam_rows) {
-        const double tip = -tip_deflection(s, 199.4);
-        const double error = s.level == 0 ? 0.0 : relative_error(s, beam_rows.front());
-        beam_errors.push_back(error);
-        char line[256];
-        std::snprintf(line, sizeof line, "| %d | %zu | %zu | %.4f | %+.1f %% | %.2f %% | %.0f | %d |\n", s.level, s.elements,
-                      s.dofs, tip, 100 * (tip / euler_bernoulli_mm - 1), 100 * error, s.solve_ms, s.cg_iterations);
-        md << line;
-    }
-    std::vector<std::pair<std::string, std::vector<Solution>>> series{{"beam vs level 0", beam_rows}};
-    std::vector<std::vector<double>> errors{beam_errors};
-
-    if (liver) {
-        const nlohmann::json liver_object{{"volume", VOX_DATA_DIR "/liver.inr.gz"}, {"select", {{"label", {255}}}}};
-        std::vector<Solution> liver_rows;
-        for (int level = k_liver_reference; level <= 5; ++level) {
-            log::info("bench tradeoff: liver, level {}", level);
-            liver_rows.push_back(solve_static(static_scene(liver_object, 1e8, 0.45, 1060.0, {{-1e4, -1e4, -1e4}, {1e4, 1e4, 60}}, level)));
-        }
-        std::vector<double> liver_errors;
-        md << "\nLiver (label 255, 3.16 M voxels), E = 1e8 Pa, nu = 0.45, held below z = 60 mm, sagging under "
-              "gravity, quasi-static; reference: level "
-           << k_liver_reference << ".\n\n"
-           << "| level | elements | DOFs | RMS surface displacement (mm) | error vs reference (surface) | solve time (ms) | "
-              "CG iterations |\n|---|---|---|---|---|---|---|\n";
-        for (const Solution& s : liver_rows) {
-            double rms = 0.0;
-            for (const auto& [key, u] : s.displacement) rms += u.squaredNorm();
-            rms = std::sqrt(rms / static_cast<double>(s.displacement.size()));
-            const double error = s.level == k_liver_reference ? 0.0 : relative_error(s, liver_rows.front());
-            liver_errors.push_back(error);
-            char line[256];
-            std::snprintf(line, sizeof line, "| %d | %zu | %zu | %.4f | %.2f %% | %.0f | %d |\n", s.level, s.elements, s.dofs,
-                          rms, 100 * error, s.solve_ms, s.cg_iterations);
-            md << line;
-        }
-        series.emplace_back("liver vs level " + std::to_string(k_liver_reference), liver_rows);
-        errors.push_back(liver_errors);
-    }
-    md << "\n![error against solve time](tradeoff.svg)\n";
-    std::filesystem::create_directories(out);
-    write_atomically(out / "tradeoff.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
-    write_atomically(out / "tradeoff.svg", [&](const std::filesystem::path& tmp) {
-        std::ofstream(tmp) << svg_plot(series, errors);
-    });
-    std::printf("%s\nwrote %s and %s\n", md.str().c_str(), (out / "tradeoff.md").c_str(), (out / "tradeoff.svg").c_str());
-}
-
-} // namespace
+using namespace vox::bench;
 
 void add_bench_command(CLI::App& app)
 {
     CLI::App* bench = app.add_subcommand("bench", "Measure the product: speed against accuracy");
     bench->require_subcommand(1);
-    auto out = std::make_shared<std::string>("docs");
+    auto out = std::make_shared<std::string>("out");
     auto skip_liver = std::make_shared<bool>(false);
     CLI::App* tradeoff = bench->add_subcommand(
         "tradeoff", "Cantilever vs Euler-Bernoulli and level 0, liver vs level 1: a table and an SVG plot");
-    tradeoff->add_option("--out", *out, "Folder for tradeoff.md and tradeoff.svg (default docs)");
+    tradeoff->add_option("--out", *out, "Folder for tradeoff.md and tradeoff.svg (default out)");
     tradeoff->add_flag("--skip-liver", *skip_liver, "Only the beam (faster)");
     tradeoff->callback([out, skip_liver] { run_tradeoff(*out, !*skip_liver); });
 
@@ -252,14 +45,14 @@ void add_bench_command(CLI::App& app)
     cutting->add_option("--runs", *cutting_runs, "How many times to replay the incision (default 5)")->check(CLI::Range(1, 100));
     cutting->callback([cutting_runs] { run_cutting_bench(*cutting_runs); });
 
-    auto conditioning_out = std::make_shared<std::string>("docs");
+    auto conditioning_out = std::make_shared<std::string>("out");
     CLI::App* conditioning = bench->add_subcommand(
         "conditioning", "Condition numbers of XFEM and Is-XFEM systems as a cut nears a node plane, with and without preconditioning");
-    conditioning->add_option("--out", *conditioning_out, "Folder for conditioning.md (default docs)");
+    conditioning->add_option("--out", *conditioning_out, "Folder for conditioning.md (default out)");
     conditioning->callback([conditioning_out] { write_conditioning(*conditioning_out, run_conditioning()); });
 
     struct CompareArgs {
-        std::string scene, out = "docs";
+        std::string scene, out = "out";
         std::optional<int> frames;
     };
     auto compare_args = std::make_shared<CompareArgs>();
@@ -268,14 +61,14 @@ void add_bench_command(CLI::App& app)
     compare->add_option("scene", compare_args->scene, "Scene file (.json)")->required();
     compare->add_option("--frames", compare_args->frames, "Number of frames (default: the script's duration / dt_s, else 100)")
         ->check(CLI::PositiveNumber);
-    compare->add_option("--out", compare_args->out, "Folder for compare-SCENE.md (default docs)");
+    compare->add_option("--out", compare_args->out, "Folder for compare-SCENE.md (default out)");
     compare->callback([compare_args] { run_compare(compare_args->scene, compare_args->frames, compare_args->out); });
 
-    auto stability_out = std::make_shared<std::string>("docs");
+    auto stability_out = std::make_shared<std::string>("out");
     auto quick = std::make_shared<bool>(false);
     CLI::App* stability = bench->add_subcommand(
         "stability", "The solver at the extremes (Poisson ratio, stiffness, time step, 1/512 fill, twist, inversion, 100 N kick)");
-    stability->add_option("--out", *stability_out, "Folder for stability.md and stability.json (default docs)");
+    stability->add_option("--out", *stability_out, "Folder for stability.md and stability.json (default out)");
     stability->add_flag("--quick", *quick, "A short beam only, few steps (the test suite's subset)");
     stability->callback([stability_out, quick] {
         const std::vector<StabilityResult> results = run_stability(*quick);

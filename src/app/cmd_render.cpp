@@ -5,6 +5,8 @@
 
 #include "app/commands.hpp"
 #include "app/scene_pictures.hpp"
+#include "sim/method_factory.hpp"
+#include "sim/tool_policy.hpp"
 #include "app/selection_options.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -53,12 +55,10 @@ void add_render_command(CLI::App& app)
         if (ends_with(args->input, ".json")) {
             const io::Scene scene = io::load_scene(args->input);
             options.camera.up = scene_up(scene);
-            const grid::LabelGrid labels = io::load_scene_object(scene);
-            const int level = std::max(scene.object.levels, 1);
-            grid::BranchedGrid g = build_scene_grid(scene, labels, level);
-            const SceneSimulation sim(scene, g, level);
-            meshes.push_back(surface_picture(sim, options.smooth)); // the same picture as a run's (wet regions tinted)
-            const ToolSession tools(scene);
+            // The scene's object as its method starts it: the same picture as a run's first.
+            const sim::OpenedMethod opened = sim::open_method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene)));
+            meshes.push_back(surface_picture(*opened.method, options.smooth));
+            const sim::ToolPolicy tools(scene);
             for (std::size_t k = 0; k < scene.tools.size(); ++k) {
                 const io::ToolPose pose = io::tool_pose(scene, k, 0.0);
                 if (pose.placed) add_tool_drawings({&tools.shape(k), pose.position_mm, pose.orientation}, scene.tools[k].push_margin_mm, meshes);

@@ -75,58 +75,31 @@ void ScenePictures::write(const std::filesystem::path& path, const std::vector<r
     render::write_png(path, m_renderer.render(meshes, *m_camera, m_options.width, m_options.height));
 }
 
-void ScenePictures::write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene)
+void ScenePictures::write(const std::filesystem::path& path, const sim::Method& method, const sim::ToolPolicy& tools, const io::Scene& scene)
 {
-    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth, m_uncut.empty() ? nullptr : &m_uncut)};
+    std::vector<render::DrawMesh> meshes{surface_picture(method, m_options.smooth)};
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
     write(path, meshes);
 }
 
-void ScenePictures::write(const std::filesystem::path& path, const IsxfemSimulation& sim, const IsxfemTools& tools, const io::Scene& scene)
+render::DrawMesh surface_picture(const sim::Method& method, int smooth)
 {
-    std::vector<render::DrawMesh> meshes{surface_picture(sim, m_options.smooth)};
-    for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
-    write(path, meshes);
-}
-
-render::DrawMesh surface_picture(const IsxfemSimulation& sim, int smooth)
-{
-    render::DrawMesh d = surface_drawing(sim.surface_mesh(), smooth);
-    const std::vector<IsxfemSimulation::Mark> marks = sim.surface_marks();
-    for (std::size_t v = 0; v < marks.size() && v < d.colors.size(); ++v) {
-        if (marks[v] == IsxfemSimulation::Mark::cut) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone;
-        if (marks[v] == IsxfemSimulation::Mark::coupled) d.colors[v] = Eigen::Vector3f(1.0f, 0.45f, 0.05f);
-    }
-    return d;
-}
-
-std::unordered_set<std::uint64_t> surface_keys(const SceneSimulation& sim)
-{
-    std::unordered_set<std::uint64_t> keys;
-    for (const surface::SurfaceVertex& v : sim.surface().embedded().vertices())
-        if (v.users) keys.insert(v.key);
-    return keys;
-}
-
-render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut)
-{
-    render::DrawMesh d = surface_drawing(sim.surface().mesh(sim.solver().positions()), smooth);
-    // Wet material shows darker and cooler, by its element's water content (what a sculptor sees
-    // on soaked clay); cut surfaces lighter, as freshly cut tissue or clay looks.
-    const cut::ModelSurface& surface = sim.surface();
-    const auto& slots = surface.embedded().vertices();
-    for (std::uint32_t slot = 0, v = 0; slot < slots.size() && v < d.colors.size(); ++slot) {
-        if (!slots[slot].users) continue; // the mesh lists the slots in use, in order
-        if (uncut && !uncut->contains(slots[slot].key)) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone; // cut surface
-        const std::uint32_t e = surface.vertex_element(slot);
-        const auto w = e < sim.model().elements().size() ? static_cast<float>(sim.solver().water(e)) : 0.0f;
+    render::DrawMesh d = surface_drawing(method.surface_mesh(), smooth);
+    // Cut surfaces lighter, as freshly cut tissue or clay looks; wet material darker and cooler,
+    // by its water content (what a sculptor sees on soaked clay).
+    const std::vector<sim::SurfaceMark> marks = method.surface_marks();
+    const std::vector<float> wetness = method.surface_wetness();
+    for (std::size_t v = 0; v < d.colors.size(); ++v) {
+        const sim::SurfaceMark m = v < marks.size() ? marks[v] : sim::SurfaceMark::surface;
+        if (m == sim::SurfaceMark::cut) d.colors[v] = 0.5f * d.colors[v] + 0.5f * k_cut_tone;
+        if (m == sim::SurfaceMark::coupled) d.colors[v] = Eigen::Vector3f(1.0f, 0.45f, 0.05f);
+        const float w = v < wetness.size() ? wetness[v] : 0.0f;
         if (w > 0.0f) d.colors[v] = (1.0f - 0.5f * w) * d.colors[v] + 0.5f * w * Eigen::Vector3f(0.30f, 0.32f, 0.38f);
-        ++v;
     }
     return d;
 }
 
-render::DrawMesh voxel_boxes(const SceneSimulation& sim)
+render::DrawMesh voxel_boxes(const sim::DbgSimulation& sim)
 {
     render::DrawMesh d;
     const cut::ModelSurface& surface = sim.surface();
@@ -166,7 +139,7 @@ render::DrawMesh voxel_boxes(const SceneSimulation& sim)
     return d;
 }
 
-render::DrawMesh element_cage(const SceneSimulation& sim)
+render::DrawMesh element_cage(const sim::DbgSimulation& sim)
 {
     render::DrawMesh d;
     d.lines = true;

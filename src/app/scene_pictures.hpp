@@ -3,11 +3,10 @@
 // tool (its cutting shape in steel, its pushing shape as a translucent shell), rendered offscreen
 // to PNG files. A sequence keeps one camera, framed on the first picture, so frames line up.
 
-#include "app/isxfem_simulation.hpp"
-#include "app/isxfem_tools.hpp"
-#include "app/scene_simulation.hpp"
-#include "app/tool_session.hpp"
 #include "render/camera.hpp"
+#include "sim/dbg_simulation.hpp"
+#include "sim/method.hpp"
+#include "sim/tool_policy.hpp"
 #include "render/offscreen_context.hpp"
 #include "render/renderer.hpp"
 #include "surface/embedded_surface.hpp"
@@ -15,7 +14,6 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <unordered_set>
 
 namespace vox::app {
 
@@ -35,21 +33,16 @@ struct PictureOptions {
 /// The surface mesh (world mm, labels per vertex) as a drawable mesh, smoothed for display by
 /// `smooth` Taubin iterations.
 [[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth);
-/// The identities of the surface's vertices now: those a later cut creates are not among them.
-[[nodiscard]] std::unordered_set<std::uint64_t> surface_keys(const SceneSimulation& sim);
-/// The simulation's deformed surface as drawn: label colours, wet material darker, and, with
-/// `uncut` (surface_keys() before any cut), the surface cuts have made in a lighter, pinker tone.
-[[nodiscard]] render::DrawMesh surface_picture(const SceneSimulation& sim, int smooth, const std::unordered_set<std::uint64_t>* uncut = nullptr);
-/// An Is-XFEM simulation's deformed, closed surface as drawn: label colours, the surface cuts made
-/// in the same lighter tone, and where the cuts could not separate all pieces of a tetrahedron
-/// (IsxfemSimulation::Mark::coupled) in orange.
-[[nodiscard]] render::DrawMesh surface_picture(const IsxfemSimulation& sim, int smooth);
+/// A method's deformed surface as drawn: label colours, wet material darker, the surface cuts
+/// made in a lighter, pinker tone, and where the cuts could not separate all pieces of an
+/// element (sim::SurfaceMark::coupled) in orange.
+[[nodiscard]] render::DrawMesh surface_picture(const sim::Method& method, int smooth);
 /// The fine voxels as boxes where the model has moved them: every face of a voxel not joined to a
 /// neighbour (the object's outside, removed neighbours, faces a cut opened), each corner carried
 /// by its element's trilinear map; coloured by label.
-[[nodiscard]] render::DrawMesh voxel_boxes(const SceneSimulation& sim);
+[[nodiscard]] render::DrawMesh voxel_boxes(const sim::DbgSimulation& sim);
 /// The simulated level's elements as a wire cage (their corner nodes where they are now).
-[[nodiscard]] render::DrawMesh element_cage(const SceneSimulation& sim);
+[[nodiscard]] render::DrawMesh element_cage(const sim::DbgSimulation& sim);
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
 /// `margin_mm`) translucent when the margin is visible.
 void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);
@@ -61,11 +54,8 @@ public:
 
     /// Writes the picture of `meshes` to `path` (PNG), framing the camera on them the first time.
     void write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes);
-    /// The simulation's surface and placed tools.
-    void write(const std::filesystem::path& path, const SceneSimulation& sim, const ToolSession& tools, const io::Scene& scene);
-    void write(const std::filesystem::path& path, const IsxfemSimulation& sim, const IsxfemTools& tools, const io::Scene& scene);
-    /// Remembers the surface as it is (before any cut), so that cut surfaces show in their own tone.
-    void remember_uncut(const SceneSimulation& sim) { m_uncut = surface_keys(sim); }
+    /// The method's surface and the placed tools.
+    void write(const std::filesystem::path& path, const sim::Method& method, const sim::ToolPolicy& tools, const io::Scene& scene);
 
     [[nodiscard]] const std::string& context_description() const { return m_context.description(); }
 
@@ -74,7 +64,6 @@ private:
     render::OffscreenContext m_context;
     render::Renderer m_renderer;
     std::optional<render::Camera> m_camera;
-    std::unordered_set<std::uint64_t> m_uncut;
 };
 
 } // namespace vox::app

@@ -1,11 +1,11 @@
 #include "app/view_session.hpp"
 
 #include "app/scene_pictures.hpp"
-#include "app/scene_simulation.hpp"
-#include "app/tool_session.hpp"
+#include "sim/dbg_method.hpp"
+#include "sim/frame_loop.hpp"
+#include "sim/isxfem_method.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "cut/surface_contact.hpp"
 #include "haptics/coupled_tool.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/hid_devices.hpp"
@@ -41,15 +41,6 @@ struct RenderState {
     int level = 0;
     std::string tool;                     ///< the active tool and what it does
     int smooth = 0;                       ///< display smoothing the window is to give the surface
-};
-
-/// The state before a stroke, to undo it: how many cuts had been made, and the solver's state on
-/// the model those cuts give (rebuilt by replaying them, the same model node for node).
-struct Checkpoint {
-    std::size_t cuts = 0;
-    std::vector<Eigen::Vector3d> positions, velocities;
-    std::vector<double> water;
-    std::vector<Eigen::Matrix3d> plastic;
 };
 
 /// The tool the haptic thread moved, where, and where the device is heading (the surface
@@ -93,27 +84,25 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     const io::Scene loaded = io::load_scene(scene_path);
     if (loaded.tools.empty()) throw loaded.error("tools", "the viewer needs at least one tool to sculpt with");
     // Not silently the other method: a researcher comparing the two must see the one asked for.
-    if (loaded.solver.type == io::SolverType::isxfem)
-        throw loaded.error("solver.type", "the viewer simulates with the branched grid (\"dbg\") only so far; run \"isxfem\" scenes with "
-                                          "`voxsculpt run` (--render-every N for pictures) or feel them in `voxsculpt bench haptics --isxfem`");
     // The user moves the tools: the script does not.
     io::Scene scene = loaded;
     scene.script.clear();
+    if (!options.solver.empty()) io::use_method(scene, options.solver == "isxfem" ? io::SolverType::isxfem : io::SolverType::dbg);
     render::CameraSpec spec = render::parse_camera(options.camera);
     spec.up = scene_up(scene);
     spec.orthographic = false; // the viewer orbits in perspective
-    const grid::LabelGrid labels = io::load_scene_object(scene);
+    const auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     const int level = std::max(scene.object.levels, 1);
-    // The grid has two levels above the scene's, for the coarser-level key.
+    // The branched grid has two levels above the scene's, for the coarser-level key.
     const int grid_levels = std::min(6, level + 2);
-    auto g = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, labels, grid_levels));
-    auto sim = std::make_unique<SceneSimulation>(scene, *g, level);
-    ToolSession tools(scene);
-    std::vector<CutRecord> cut_log;
-    tools.log_cuts(&cut_log);
+    std::unique_ptr<sim::Method> method;
+    if (scene.solver.type == io::SolverType::isxfem) method = std::make_unique<sim::IsxfemMethod>(scene, labels, level);
+    else method = std::make_unique<sim::DbgMethod>(scene, labels, level, grid_levels);
+    sim::ToolPolicy tools(scene);
+    sim::FrameLoop sim_loop(scene, *method, tools);
 
     // Where the first tool starts: where the scene's script puts it, else above the object.
-    render::DrawMesh first = surface_picture(*sim, 0);
+    render::DrawMesh first = surface_picture(*method, 0);
     Eigen::AlignedBox3d bounds;
     bounds.setEmpty();
     for (const std::uint32_t i : first.indices) bounds.extend(first.positions[i].cast<double>());
@@ -177,8 +166,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         },
         haptics::SafetySettings{});
 
-    log::info("viewer: {} ({} elements at level {}), tools: {}; press H for the keys", scene_path, sim->model().elements().size(), level,
-              scene.tools.size());
+    log::info("viewer: {} ({}), tools: {}; press H for the keys", scene_path, method->description(), scene.tools.size());
     // The simulation thread (from here on the only one to touch the grid, the simulation, the
     // tools' session and the scene's tool settings).
     std::string failure;
@@ -189,18 +177,12 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             int driven = -1, simulated = level;
             contact::PlacedShape pose{&tools.shape(0), start, Eigen::Quaterniond::Identity()};
             Eigen::Vector3d heading = start;
-            std::vector<Checkpoint> checkpoints;
-            const std::unordered_set<std::uint64_t> uncut = surface_keys(*sim); // cut surfaces show in their own tone
-            // The object as it was after the first `cuts` cuts, at level `at`, from rest.
-            auto rebuild = [&](int at, std::size_t cuts) {
-                sim.reset();
-                g = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, labels, grid_levels));
-                sim = std::make_unique<SceneSimulation>(scene, *g, at);
-                for (std::size_t c = 0; c < cuts; ++c) sim->apply_cut(*g, cut_log[c].removed, cut_log[c].faces);
-                cut_log.resize(cuts);
+            std::vector<std::unique_ptr<sim::Checkpoint>> checkpoints;
+            // The device lets go of its tool: after the object changed under it.
+            auto let_go = [&] {
+                tools.reset();
                 if (driven >= 0) tools.release(static_cast<std::size_t>(driven));
                 driven = -1;
-                simulated = at;
             };
             std::uint64_t frame = 0;
             auto next = clock_type::now();
@@ -209,28 +191,23 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 if (const int d = level_change.exchange(0); d != 0) {
                     const int at = std::clamp(simulated + d, 1, grid_levels);
                     if (at != simulated) {
-                        rebuild(at, cut_log.size());
+                        method = method->at_level(at);
+                        sim_loop.set_method(*method);
+                        let_go();
+                        simulated = at;
                         checkpoints.clear(); // the deformation restarts from rest at the new level
-                        log::info("level {}: {} elements (the cuts kept, the deformation from rest)", at, sim->model().elements().size());
+                        log::info("level {}: {} elements ({}the deformation from rest)", at, method->element_count(),
+                                  method->name() == std::string("dbg") ? "the cuts kept, " : "uncut: Is-XFEM cannot carry cuts across levels yet; ");
                     }
                 }
                 if (undo.exchange(false)) {
                     if (checkpoints.empty()) {
-                        log::info("undo: nothing to undo");
+                        log::info("{}", method->checkpoint() ? "undo: nothing to undo" : "undo: not available with this method yet (docs/viewer.md)");
                     } else {
-                        const Checkpoint c = std::move(checkpoints.back());
+                        method->restore(*checkpoints.back());
                         checkpoints.pop_back();
-                        rebuild(simulated, c.cuts);
-                        fem::ImplicitSolver& s = sim->solver();
-                        if (s.positions().size() == c.positions.size()) {
-                            s.positions() = c.positions;
-                            s.velocities() = c.velocities;
-                            for (std::uint32_t e = 0; e < c.water.size() && e < sim->model().elements().size(); ++e) {
-                                s.set_water(e, c.water[e]);
-                                s.set_plastic_strain(e, c.plastic[e]);
-                            }
-                        }
-                        log::info("undo: back to before the last stroke ({} cuts)", c.cuts);
+                        let_go();
+                        log::info("undo: back to before the last stroke");
                     }
                 }
                 if (const int a = set_action.exchange(-1); a >= 0) {
@@ -239,7 +216,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 }
                 if (toggle_cut_mode.exchange(false)) {
                     io::ToolSpec& t = scene.tools[static_cast<std::size_t>(active.load())];
-                    t.cut_mode = t.cut_mode == io::CutMode::remove ? io::CutMode::separate : io::CutMode::remove;
+                    if (scene.solver.type == io::SolverType::isxfem) log::info("Is-XFEM cuts by separating only (it cannot remove material)");
+                    else t.cut_mode = t.cut_mode == io::CutMode::remove ? io::CutMode::separate : io::CutMode::remove;
                 }
                 if (paused.load() && !step_once.exchange(false)) {
                     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -255,57 +233,57 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 }
                 // A stroke's checkpoint before any of its cuts: the window flags the stroke before it
                 // moves the pointer, so a pose read above that belongs to the stroke sees the flag.
-                if (stroke_started.exchange(false)) {
-                    Checkpoint c;
-                    c.cuts = cut_log.size();
-                    c.positions = sim->solver().positions();
-                    c.velocities = sim->solver().velocities();
-                    for (std::uint32_t e = 0; e < sim->model().elements().size(); ++e) {
-                        c.water.push_back(sim->solver().water(e));
-                        c.plastic.push_back(sim->solver().plastic_strain(e));
+                if (stroke_started.exchange(false))
+                    if (std::unique_ptr<sim::Checkpoint> c = method->checkpoint()) {
+                        checkpoints.push_back(std::move(c));
+                        if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
                     }
-                    checkpoints.push_back(std::move(c));
-                    if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
-                }
                 if (driven >= 0) tools.drive(static_cast<std::size_t>(driven), pose.position, pose.orientation);
-                const ToolFrameStats t = tools.frame(*sim, *g, static_cast<double>(frame + 1) * dt, dt);
-                if (!t.hold_object) sim->solver().step();
+                try {
+                    sim_loop.next();
+                } catch (const InputError& e) { // a step that cannot be trusted: said, and the session paused to keep it
+                    log::warn("{}; paused (SPACE runs on, U undoes the last stroke)", e.what());
+                    paused = true;
+                }
                 contact::SurfacePoints& out = snapshots.write_slot();
-                const double margin = scene.tools[static_cast<std::size_t>(std::max(driven, 0))].push_margin_mm;
-                Eigen::AlignedBox3d near = pose.world_bounds(margin + 5.0);
-                near.extend(contact::PlacedShape{pose.shape, heading, pose.orientation}.world_bounds(margin + 5.0));
-                cut::sample_surface(sim->surface(), sim->solver().positions(), near, out);
+                const io::ToolSpec& held = scene.tools[static_cast<std::size_t>(std::max(driven, 0))];
+                Eigen::AlignedBox3d near = pose.world_bounds(held.push_margin_mm + 5.0);
+                near.extend(contact::PlacedShape{pose.shape, heading, pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
+                method->sample_surface(near, held, out);
                 out.t_s = now_s();
                 snapshots.publish();
                 if (save_object.exchange(false)) try {
                     const std::filesystem::path dir(options.out_dir);
-                    const surface::SurfaceMesh m = sim->surface().mesh(sim->solver().positions());
+                    const surface::SurfaceMesh m = method->surface_mesh();
                     for (const char* name : {"view_surface.obj", "view_surface.ply", "view_surface.stl"})
                         io::write_mesh((dir / name).string(), m.positions, m.triangles, m.labels);
-                    const grid::FineVoxels& voxels = g->voxels();
-                    grid::LabelGrid kept(voxels.index_to_world());
-                    for (std::uint32_t v = 0; v < voxels.slots(); ++v)
-                        if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
-                    kept.save(dir / "view_object.vdb");
-                    log::info("saved the deformed surface to {}.obj, .ply and .stl ({} triangles) and the object's {} voxels to {}", (dir / "view_surface").string(),
-                              m.triangles.size(), voxels.alive_count(), (dir / "view_object.vdb").string());
+                    log::info("saved the deformed surface to {}.obj, .ply and .stl ({} triangles)", (dir / "view_surface").string(), m.triangles.size());
+                    if (const auto* dbg = dynamic_cast<const sim::DbgMethod*>(method.get())) { // the voxels left, as the branched grid has them
+                        const grid::FineVoxels& voxels = dbg->grid().voxels();
+                        grid::LabelGrid kept(voxels.index_to_world());
+                        for (std::uint32_t v = 0; v < voxels.slots(); ++v)
+                            if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
+                        kept.save(dir / "view_object.vdb");
+                        log::info("saved the object's {} voxels to {}", voxels.alive_count(), (dir / "view_object.vdb").string());
+                    }
                 } catch (const std::exception& e) {
                     log::warn("not saved: {}", e.what()); // the session goes on
                 }
                 if (picture_taken.exchange(false)) { // the window has the last one: make the next
                     RenderState& r = pictures.write_slot();
                     r.meshes.clear();
-                    if (show_voxels.load()) {
-                        r.meshes.push_back(voxel_boxes(*sim));
+                    const auto* dbg = dynamic_cast<const sim::DbgMethod*>(method.get()); // voxels and cages are the branched grid's
+                    if (show_voxels.load() && dbg) {
+                        r.meshes.push_back(voxel_boxes(dbg->simulation()));
                         r.smooth = 0;
                     } else {
-                        r.meshes.push_back(surface_picture(*sim, 0, &uncut)); // smoothed by the window's thread
+                        r.meshes.push_back(surface_picture(*method, 0)); // smoothed by the window's thread
                         r.smooth = options.smooth;
                     }
                     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, r.meshes);
-                    if (show_cage.load()) r.meshes.push_back(element_cage(*sim));
+                    if (show_cage.load() && dbg) r.meshes.push_back(element_cage(dbg->simulation()));
                     r.t_s = static_cast<double>(frame + 1) * dt;
-                    r.elements = sim->model().elements().size();
+                    r.elements = method->element_count();
                     r.level = simulated;
                     const io::ToolSpec& tool = scene.tools[static_cast<std::size_t>(active.load())];
                     r.tool = tool.name + " (" +

@@ -1,6 +1,6 @@
 #pragma once
 // The convex hull of points in a plane: what a blade's profile covers at the start and the end of
-// a frame (app/blade_stroke.hpp).
+// a frame (sim/blade_stroke.hpp).
 
 #include <Eigen/Core>
 

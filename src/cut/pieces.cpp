@@ -1,6 +1,6 @@
 #include "cut/pieces.hpp"
 
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 
 #include <algorithm>
 
@@ -8,7 +8,7 @@ namespace vox::cut {
 
 std::vector<std::uint32_t> element_pieces(const fem::HexModel& model)
 {
-    grid::UnionFind nodes(model.node_count()); // the corners of every element joined
+    UnionFind nodes(model.node_count()); // the corners of every element joined
     for (const fem::HexElement& el : model.elements())
         for (int c = 1; c < 8; ++c) nodes.unite(el.dof_node[c], el.dof_node[0]);
     std::vector<std::uint32_t> number(model.node_count(), ~0u), out;

@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "grid/hex8.hpp"
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -62,7 +62,7 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
     // sharing, as on every other level), numbered by union-find over 8 corner slots per voxel.
     const grid::FineVoxels& v = grid.voxels();
     const Eigen::Vector3d h = v.voxel_size_m();
-    grid::UnionFind sets(8 * std::size_t{v.slots()});
+    UnionFind sets(8 * std::size_t{v.slots()});
     for (std::uint32_t a = 0; a < v.slots(); ++a) {
         if (!v.alive(a)) continue;
         for (int axis = 0; axis < 3; ++axis) {

@@ -6,7 +6,7 @@
 #include "core/morton.hpp"
 #include "grid/condensation.hpp"
 #include "grid/hex8.hpp"
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -3,7 +3,7 @@
 
 #include "io/mesh_info.hpp"
 
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 
 #include <Eigen/Geometry>
 
@@ -64,7 +64,7 @@ void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, Me
     info.boundary_edges = boundary.size();
     info.closed = !mesh.triangles.empty() && info.boundary_edges == 0 && info.non_manifold_edges == 0;
 
-    grid::UnionFind loops(mesh.vertices.size()); // boundary edges grouped into loops
+    UnionFind loops(mesh.vertices.size()); // boundary edges grouped into loops
     for (const auto& [a, b] : boundary) loops.unite(a, b);
     std::unordered_map<std::uint32_t, Eigen::Vector3d> loop_area; // by the loop's representative vertex
     for (const auto& [a, b] : boundary) {
@@ -76,7 +76,7 @@ void summarise_edges(const TriangleMesh& mesh, const Eigen::Vector3d& centre, Me
     info.boundary_loops = loop_area.size();
     for (const auto& [root, area] : loop_area) info.boundary_cap_area_mm2 += area.norm();
 
-    grid::UnionFind pieces(mesh.vertices.size());
+    UnionFind pieces(mesh.vertices.size());
     for (const Eigen::Vector3i& t : mesh.triangles) {
         pieces.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]));
         pieces.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[2]));

@@ -418,7 +418,7 @@ WetRegion read_wet_region(JsonReader r)
     return w;
 }
 
-ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
+ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverType type)
 {
     ToolSpec t;
     const JsonNode name = r.required_node("name");
@@ -453,8 +453,10 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared)
     if (const std::optional<JsonNode> node = r.optional_node("action")) {
         t.action = choose_enum(*node, tool_actions);
     }
+    t.cut_mode = default_cut_mode(type);
     if (const std::optional<JsonNode> node = r.optional_node("cut_mode")) {
         t.cut_mode = choose_enum(*node, cut_modes);
+        t.cut_mode_given = true;
     }
     t.push_margin_mm = r.optional("push_margin_mm", t.push_margin_mm, closed_range(0.0, 100.0));
     t.contact_stiffness_n_per_mm =
@@ -573,7 +575,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     }
     if (tools) {
         for (const JsonNode& node : tools->elements()) {
-            ToolSpec tool = read_tool(JsonReader(node), scene.tools);
+            ToolSpec tool = read_tool(JsonReader(node), scene.tools, scene.solver.type);
             scene.tools.push_back(std::move(tool));
         }
     }
@@ -589,6 +591,15 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
         scene.output = read_output(JsonReader(*output), scene.output);
     }
     return scene;
+}
+
+CutMode default_cut_mode(SolverType type) { return type == SolverType::isxfem ? CutMode::separate : CutMode::remove; }
+
+void use_method(Scene& scene, SolverType type)
+{
+    scene.solver.type = type;
+    for (ToolSpec& t : scene.tools)
+        if (!t.cut_mode_given) t.cut_mode = default_cut_mode(type);
 }
 
 Scene load_scene(const std::filesystem::path& path)

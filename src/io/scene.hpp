@@ -217,8 +217,11 @@ struct ToolSpec {
     std::filesystem::path mesh;
     /// What the tool does; absent from the file: default_tool_action(shape).
     ToolAction action = default_tool_action(ToolShape::blade);
-    /// cut tools: what the cut does to the voxels (default remove).
+    /// cut tools: what the cut does to the material. Default per method (use_method): the
+    /// branched grid removes, Is-XFEM separates (it cannot remove).
     CutMode cut_mode = CutMode::remove;
+    /// The scene file said which cut_mode (else the method's default applies).
+    bool cut_mode_given = false;
     /// The outer (pushing) shape is the inner (cutting) shape grown by this much, mm, in [0, 100].
     double push_margin_mm = 1.0;
     /// Penalty stiffness per cm^2 of contact, N/mm, in (0, 1e4]: a flat face of the outer shape
@@ -297,6 +300,13 @@ struct Scene {
     /// "loads[0].box_mm".
     [[nodiscard]] InputError error(std::string_view key_path, std::string_view problem) const;
 };
+
+/// The cut_mode a cutting tool has when the scene does not say: "remove" on the branched grid,
+/// "separate" on Is-XFEM (which cannot remove material).
+[[nodiscard]] CutMode default_cut_mode(SolverType type);
+/// Simulates `scene` with `type` (a command line's override of solver.type): the tools whose
+/// cut_mode the file left open take that method's default.
+void use_method(Scene& scene, SolverType type);
 
 /// Reads and validates a scene file. Comments (// and /* */) are allowed in it. Throws
 /// InputError "FILE: key.path: problem", or "FILE: line L column C: problem" for bad JSON.

@@ -1,6 +1,6 @@
 #include "isxfem/cut_closure.hpp"
 
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 #include "isxfem/polygon_triangulation.hpp"
 
 #include <Eigen/Geometry>
@@ -366,7 +366,7 @@ void Closer::split(std::vector<Eigen::Vector3i>& triangles)
     // A loop of crossings that enters the crack anywhere is split all round (outside the crack each
     // piece keeps the crossing's one point): a triangle split beside one left whole would leave a
     // vertex in the middle of its edge.
-    grid::UnionFind loops(m_crossings.size());
+    UnionFind loops(m_crossings.size());
     auto root = [&](int c) { return loops.find(static_cast<std::uint32_t>(c)); };
     for (const std::array<int, 2>& c : cross)
         if (c[0] >= 0) loops.unite(static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]));

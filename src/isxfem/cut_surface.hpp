@@ -2,7 +2,7 @@
 // What a cut goes along: a level function phi, negative on one side, positive on the other and
 // zero on the cut, and where the cut reaches. Either a plane (PlaneCut; the caller says where in
 // it the cut reaches), or a blade's swept surface: flat convex patches, one per frame of a stroke,
-// each what the blade's mid-plane swept over that frame (app/blade_stroke.hpp). A stroke that turns
+// each what the blade's mid-plane swept over that frame (sim/blade_stroke.hpp). A stroke that turns
 // or tilts as it goes leaves patches that turn with it, so its cut follows the blade's path
 // rather than one plane.
 //

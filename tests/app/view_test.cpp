@@ -47,13 +47,3 @@ TEST(View, WithoutADisplayItSaysSoAndExits)
     EXPECT_NE(r.err.find("no window"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("xvfb-run"), std::string::npos) << r.err;
 }
-
-TEST(View, AnIsxfemSceneIsRefusedNotShownByTheOtherMethod)
-{
-    // Before any window: the viewer simulates with the branched grid only, and says so rather than
-    // quietly showing an Is-XFEM scene cut by the other method.
-    const auto r = run_voxsculpt("view " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/slab_flap_cut_isxfem.json") + " --exit-after 1");
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("solver.type"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("isxfem"), std::string::npos) << r.err;
-}

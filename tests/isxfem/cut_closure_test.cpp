@@ -6,7 +6,7 @@
 
 #include "isxfem/cut_closure.hpp"
 
-#include "grid/union_find.hpp"
+#include "core/union_find.hpp"
 #include "isxfem/arc_sweep.hpp"
 
 #include <Eigen/Geometry>
@@ -154,9 +154,9 @@ std::pair<double, double> volume_and_crack_area(const Closed& c, double y = NAN)
 }
 
 /// The surface's points joined by its triangles.
-vox::grid::UnionFind joined(const Closed& c)
+vox::UnionFind joined(const Closed& c)
 {
-    vox::grid::UnionFind sets(c.points.size());
+    vox::UnionFind sets(c.points.size());
     for (const Eigen::Vector3i& t : c.triangles)
         for (int k = 1; k < 3; ++k) sets.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[k]));
     return sets;
@@ -169,7 +169,7 @@ void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
 {
     if (through.empty())
         for (int cut = 0; cut < c.model->cut_count(); ++cut) through.push_back(cut);
-    vox::grid::UnionFind pieces = joined(c);
+    vox::UnionFind pieces = joined(c);
     auto root = [&](int i) { return static_cast<int>(pieces.find(static_cast<std::uint32_t>(i))); };
     for (const int cut : through) {
         std::map<int, int> side_of_piece;
@@ -195,7 +195,7 @@ void expect_pieces_on_one_side(const Closed& c, std::vector<int> through = {})
 /// per side, so a through-cut leaves two).
 int pieces(const Closed& c)
 {
-    vox::grid::UnionFind sets = joined(c);
+    vox::UnionFind sets = joined(c);
     std::set<std::uint32_t> roots;
     for (const Eigen::Vector3i& t : c.triangles) roots.insert(sets.find(static_cast<std::uint32_t>(t[0])));
     return static_cast<int>(roots.size());

@@ -1,0 +1,273 @@
+#include "sim/dbg_method.hpp"
+
+#include "core/stopwatch.hpp"
+#include "cut/pieces.hpp"
+#include "cut/voxel_cut.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+namespace vox::sim {
+namespace {
+
+struct DbgCheckpoint final : Checkpoint {
+    std::size_t cuts = 0;
+    std::vector<Eigen::Vector3d> positions, velocities;
+    std::vector<double> water;
+    std::vector<Eigen::Matrix3d> plastic;
+    std::unordered_set<std::uint32_t> separated;
+};
+
+} // namespace
+
+DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, int level, int grid_levels)
+    : DbgMethod(scene, labels, std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *labels, std::max({grid_levels, level, 1}))), level)
+{
+}
+
+DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, std::unique_ptr<grid::BranchedGrid> grid, int level)
+    : m_scene(scene), m_labels(std::move(labels)), m_level(level), m_grid_levels(grid->max_level()), m_grid(std::move(grid))
+{
+    m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
+    for (const surface::SurfaceVertex& v : m_sim->surface().embedded().vertices())
+        if (v.users) m_uncut.insert(v.key);
+}
+
+DbgMethod::~DbgMethod() = default;
+
+std::string DbgMethod::linear_solver() const
+{
+    return m_sim->solver().fallback_note().empty() ? m_sim->linear_solver() : m_sim->solver().fallback_note();
+}
+
+std::string DbgMethod::description() const
+{
+    char text[256];
+    std::snprintf(text, sizeof text, "branched grid, level %d, %zu elements, %zu degrees of freedom", m_level, element_count(), dof_count());
+    return text;
+}
+
+void DbgMethod::begin_tools(std::size_t tool_count)
+{
+    m_touch.resize(tool_count);
+    m_touched.assign(tool_count, false);
+    m_fresh.assign(tool_count, false);
+    m_previous_section.resize(tool_count);
+    m_marked_from.resize(tool_count);
+}
+
+const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at,
+                                               const contact::PlacedShape* from)
+{
+    const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
+    m_touch[tool] = cut::touch_surface(m_sim->surface(), m_sim->solver().positions(), at, parameters, from);
+    m_touched[tool] = true;
+    m_fresh[tool] = true;
+    return m_touch[tool].contact;
+}
+
+CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose&, const contact::PlacedShape& at,
+                             const CutOrder& order)
+{
+    // A separating tool's section, carried back to rest space (cut/voxel_cut.hpp): each frame
+    // sweeps from the previous frame's section to this one.
+    std::vector<Eigen::Vector3d> rest_section;
+    if (spec.cut_mode == io::CutMode::separate) {
+        rest_section = cut::section_polygon(*at.shape, 0.0, at);
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        for (const Eigen::Vector3d& p : rest_section) box.extend(p);
+        const Eigen::Vector3d moved = cut::mean_displacement_mm(m_sim->surface(), m_sim->solver().positions(), box);
+        for (Eigen::Vector3d& p : rest_section) p -= moved;
+    }
+    std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[tool], rest_section);
+    // Two-phase: the whole path marked since the first touch is cut at once.
+    if (spec.two_phase) {
+        if (!order.touching) {
+            m_marked_from[tool].clear(); // let go: the next touch marks a new cut
+        } else if (order.marking && !rest_section.empty()) {
+            if (m_marked_from[tool].empty()) m_marked_from[tool] = rest_section;
+            previous = m_marked_from[tool];
+        }
+    }
+    if (!order.cut) return {};
+    std::vector<grid::Coord> removed;
+    std::vector<std::pair<grid::Coord, int>> faces;
+    if (spec.cut_mode == io::CutMode::remove) {
+        for (std::uint32_t v : cut::voxels_inside(m_sim->surface(), m_sim->solver().positions(), at, m_touch[tool].vertices))
+            removed.push_back(m_grid->voxels().coord(v));
+    } else {
+        faces = cut::faces_crossed(m_grid->voxels(), cut::sweep_polygons(previous.empty() ? rest_section : previous, rest_section,
+                                                                         at.orientation * Eigen::Vector3d::UnitY()));
+    }
+    if (removed.empty() && faces.empty()) return {};
+    return apply(std::move(removed), std::move(faces));
+}
+
+CutFigures DbgMethod::apply(std::vector<grid::Coord> removed, std::vector<std::pair<grid::Coord, int>> faces)
+{
+    CutFigures out;
+    const CutTimings t = m_sim->apply_cut(*m_grid, removed, faces);
+    out.grid_update_ms = t.grid_update_ms;
+    out.remesh_ms = t.remesh_ms;
+    out.fem_update_ms = t.fem_update_ms;
+    out.removed_voxels = removed.size();
+    out.separated_faces = faces.size();
+    std::unordered_set<std::uint32_t> sides;
+    for (const auto& [coord, axis] : faces)
+        for (const grid::Coord& side : {coord, grid::Coord(coord + grid::Coord::Unit(axis))}) {
+            const std::uint32_t v = m_grid->voxels().find(side);
+            sides.insert(v);
+            m_separated.insert(v);
+        }
+    out.separated_voxels = sides.size();
+    out.cut_elements = removed.size() + faces.size();
+    m_cuts.push_back({std::move(removed), std::move(faces)});
+    std::fill(m_fresh.begin(), m_fresh.end(), false); // node numbers changed: contacts are carried over
+    return out;
+}
+
+void DbgMethod::wet(std::size_t tool, double water)
+{
+    fem::ImplicitSolver& solver = m_sim->solver();
+    for (std::uint32_t e : m_touch[tool].elements) solver.set_water(e, solver.water(e) + water);
+}
+
+void DbgMethod::end_tools()
+{
+    // The forces for the next step, on the model as it now is.
+    std::vector<fem::NodeContact> nodes;
+    for (std::size_t k = 0; k < m_touch.size(); ++k) {
+        if (!m_touched[k]) continue;
+        if (!m_fresh[k]) m_touch[k].nodes = cut::node_contacts(m_sim->surface(), m_touch[k]); // onto the rebuilt model's nodes
+        cut::merge_node_contacts(nodes, m_touch[k].nodes);
+    }
+    m_sim->solver().set_contact(std::move(nodes));
+}
+
+StepFigures DbgMethod::step()
+{
+    const fem::StepStats s = m_sim->solver().step();
+    StepFigures out;
+    out.step_ms = s.step_ms;
+    out.assembly_ms = s.assembly_ms;
+    out.solve_ms = s.solve_ms;
+    out.cg_iterations = s.cg_iterations;
+    out.newton_iterations = s.newton_iterations;
+    out.residual = s.residual;
+    out.converged = s.converged;
+    out.substeps = s.substeps;
+    out.kinetic_energy_j = s.kinetic_energy_j;
+    out.elastic_energy_j = s.elastic_energy_j;
+    out.max_displacement_mm = s.max_displacement_m * 1e3;
+    out.energy_guarded = s.energy_guarded;
+    return out;
+}
+
+surface::SurfaceMesh DbgMethod::surface_mesh() const { return m_sim->surface().mesh(m_sim->solver().positions()); }
+
+std::vector<SurfaceMark> DbgMethod::surface_marks() const
+{
+    std::vector<SurfaceMark> out;
+    for (const surface::SurfaceVertex& v : m_sim->surface().embedded().vertices()) // the mesh lists the slots in use, in order
+        if (v.users) out.push_back(m_uncut.contains(v.key) ? SurfaceMark::surface : SurfaceMark::cut);
+    return out;
+}
+
+std::vector<float> DbgMethod::surface_wetness() const
+{
+    const cut::ModelSurface& surface = m_sim->surface();
+    const auto& slots = surface.embedded().vertices();
+    std::vector<float> out;
+    for (std::uint32_t slot = 0; slot < slots.size(); ++slot) {
+        if (!slots[slot].users) continue;
+        const std::uint32_t e = surface.vertex_element(slot);
+        out.push_back(e < m_sim->model().elements().size() ? static_cast<float>(m_sim->solver().water(e)) : 0.0f);
+    }
+    return out;
+}
+
+std::vector<Eigen::Vector3d> DbgMethod::surface_displacements_mm() const
+{
+    const std::vector<Eigen::Vector3d> u = m_sim->surface().displacements(m_sim->solver().positions());
+    const auto& slots = m_sim->surface().embedded().vertices();
+    std::vector<Eigen::Vector3d> out;
+    for (std::size_t i = 0; i < slots.size(); ++i)
+        if (slots[i].users) out.push_back(1e3 * u[i]);
+    return out;
+}
+
+std::vector<std::uint64_t> DbgMethod::surface_keys() const
+{
+    std::vector<std::uint64_t> out;
+    for (const surface::SurfaceVertex& v : m_sim->surface().embedded().vertices())
+        if (v.users) out.push_back(v.key);
+    return out;
+}
+
+void DbgMethod::sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec&, contact::SurfacePoints& out) const
+{
+    cut::sample_surface(m_sim->surface(), m_sim->solver().positions(), box, out);
+}
+
+std::size_t DbgMethod::piece_count() const { return cut::piece_count(m_sim->model()); }
+
+void DbgMethod::add_summary_figures(nlohmann::json& summary) const
+{
+    std::size_t wet = 0;
+    for (std::uint32_t e = 0; e < m_sim->model().elements().size(); ++e) wet += m_sim->solver().water(e) > 0.0;
+    summary.update({{"voxels", m_grid->voxels().alive_count()},
+                    {"wet_elements", wet},
+                    {"mass_kg", m_grid->total_mass_kg()},
+                    {"separated_voxels", m_separated.size()}}); // each voxel once, however many of its faces opened
+}
+
+std::unique_ptr<Method> DbgMethod::at_level(int level) const
+{
+    auto out = std::make_unique<DbgMethod>(m_scene, m_labels, level, m_grid_levels);
+    for (const CutRecord& r : m_cuts) out->apply(r.removed, r.faces);
+    out->m_separated = m_separated;
+    return out;
+}
+
+std::unique_ptr<Checkpoint> DbgMethod::checkpoint() const
+{
+    auto c = std::make_unique<DbgCheckpoint>();
+    const fem::ImplicitSolver& s = m_sim->solver();
+    c->cuts = m_cuts.size();
+    c->positions = s.positions();
+    c->velocities = s.velocities();
+    for (std::uint32_t e = 0; e < m_sim->model().elements().size(); ++e) {
+        c->water.push_back(s.water(e));
+        c->plastic.push_back(s.plastic_strain(e));
+    }
+    c->separated = m_separated;
+    return c;
+}
+
+void DbgMethod::restore(const Checkpoint& checkpoint)
+{
+    const auto& c = dynamic_cast<const DbgCheckpoint&>(checkpoint);
+    // The grid as it was after the first c.cuts cuts: rebuilt from the voxels and the cuts
+    // replayed, the same model node for node.
+    m_sim.reset();
+    m_grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(m_scene, *m_labels, m_grid_levels));
+    m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
+    m_cuts.resize(std::min(m_cuts.size(), c.cuts));
+    for (const CutRecord& r : m_cuts) m_sim->apply_cut(*m_grid, r.removed, r.faces);
+    fem::ImplicitSolver& s = m_sim->solver();
+    if (s.positions().size() == c.positions.size()) {
+        s.positions() = c.positions;
+        s.velocities() = c.velocities;
+        for (std::uint32_t e = 0; e < c.water.size() && e < m_sim->model().elements().size(); ++e) {
+            s.set_water(e, c.water[e]);
+            s.set_plastic_strain(e, c.plastic[e]);
+        }
+    }
+    m_separated = c.separated;
+    for (auto& section : m_previous_section) section.clear();
+    for (auto& section : m_marked_from) section.clear();
+}
+
+} // namespace vox::sim

@@ -1,0 +1,98 @@
+#pragma once
+// The branched grid (`"solver": {"type": "dbg"}`) behind the method interface: the scene's grid
+// and its simulation at one level (sim/dbg_simulation.hpp), what the tools do to it (penalty
+// contact on the embedded surface, voxels removed inside a cutting tool or faces opened where its
+// section swept, water where a wetting tool touches), and every cut kept in order so that a
+// checkpoint can rebuild the same grid node for node.
+
+#include "cut/surface_contact.hpp"
+#include "sim/dbg_simulation.hpp"
+#include "sim/method.hpp"
+
+#include <memory>
+#include <unordered_set>
+#include <vector>
+
+namespace vox::sim {
+
+/// The voxels one cut removed and the faces it opened, in the order the cuts were made: replaying
+/// them on the same object rebuilds the same grid.
+struct CutRecord {
+    std::vector<grid::Coord> removed;
+    std::vector<std::pair<grid::Coord, int>> faces;
+};
+
+class DbgMethod final : public Method {
+public:
+    /// Builds the grid of `labels` with levels up to `grid_levels` (at least `level`; coarser ones
+    /// serve the multigrid preconditioner) and the simulation at `level`. Throws the scene's
+    /// InputError when a constraint or load box catches no node.
+    DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, int level, int grid_levels);
+    /// The same, on a grid already built (levels chosen by "levels": "auto" were measured on it).
+    DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, std::unique_ptr<grid::BranchedGrid> grid, int level);
+    ~DbgMethod() override;
+
+    [[nodiscard]] const char* name() const override { return "dbg"; }
+    [[nodiscard]] int level() const override { return m_level; }
+    [[nodiscard]] std::size_t element_count() const override { return m_sim->model().elements().size(); }
+    [[nodiscard]] std::size_t dof_count() const override { return m_sim->solver().dof_count(); }
+    [[nodiscard]] std::string linear_solver() const override;
+    [[nodiscard]] std::string description() const override;
+
+    void begin_tools(std::size_t tool_count) override;
+    const contact::ContactResult& touch(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at,
+                                        const contact::PlacedShape* from) override;
+    CutFigures follow(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
+                      const CutOrder& order) override;
+    void lift(std::size_t) override {}
+    void wet(std::size_t tool, double water) override;
+    void end_tools() override;
+    StepFigures step() override;
+
+    [[nodiscard]] surface::SurfaceMesh surface_mesh() const override;
+    [[nodiscard]] std::vector<SurfaceMark> surface_marks() const override;
+    [[nodiscard]] std::vector<float> surface_wetness() const override;
+    [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements_mm() const override;
+    [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override;
+    void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
+    [[nodiscard]] std::size_t piece_count() const override;
+    void add_summary_figures(nlohmann::json& summary) const override;
+
+    [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
+    [[nodiscard]] std::unique_ptr<Checkpoint> checkpoint() const override;
+    void restore(const Checkpoint& checkpoint) override;
+
+    /// What only the branched grid has: its grid, simulation (pictures of voxels and elements,
+    /// level choice, benchmarks) and the cuts so far.
+    [[nodiscard]] const grid::BranchedGrid& grid() const { return *m_grid; }
+    [[nodiscard]] DbgSimulation& simulation() { return *m_sim; }
+    [[nodiscard]] const DbgSimulation& simulation() const { return *m_sim; }
+    [[nodiscard]] const std::vector<CutRecord>& cuts() const { return m_cuts; }
+    /// Voxels that have had a face opened since the start.
+    [[nodiscard]] std::size_t separated_voxels() const { return m_separated.size(); }
+
+private:
+    /// Applies one cut, logging it; the tools' contacts are carried over to the rebuilt model.
+    CutFigures apply(std::vector<grid::Coord> removed, std::vector<std::pair<grid::Coord, int>> faces);
+
+    io::Scene m_scene;
+    std::shared_ptr<const grid::LabelGrid> m_labels;
+    int m_level = 1;
+    int m_grid_levels = 1;
+    std::unique_ptr<grid::BranchedGrid> m_grid;
+    std::unique_ptr<DbgSimulation> m_sim;
+    std::vector<CutRecord> m_cuts;
+    std::unordered_set<std::uint32_t> m_separated; ///< voxel slots with an opened face
+    std::unordered_set<std::uint64_t> m_uncut;     ///< surface vertex keys before any cut
+    // Per tool, this frame and across frames.
+    std::vector<cut::SurfaceContact> m_touch;
+    std::vector<bool> m_touched;  ///< placed (and touched) this frame
+    std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
+    /// A separating tool's cutting section at the previous frame, in rest space: a frame's cut
+    /// opens what the section swept since.
+    std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
+    /// Two-phase tools: the section where the marking began (rest space).
+    std::vector<std::vector<Eigen::Vector3d>> m_marked_from;
+};
+
+} // namespace vox::sim

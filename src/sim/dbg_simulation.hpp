@@ -1,0 +1,78 @@
+#pragma once
+// A scene made ready to simulate at one level: the mechanical model, the solver with the scene's
+// constraints, loads, gravity, materials (plasticity, wetting) and wet regions, its
+// preconditioner, and the surface it moves. The branched-grid method (sim/dbg_method.hpp), the level choice and the
+// benchmarks all build their simulations here, so they simulate the same thing. A cut changes the grid and
+// the surface locally, then rebuilds the model at the same level carrying the state over.
+
+#include "cut/model_surface.hpp"
+#include "fem/implicit_solver.hpp"
+#include "io/scene.hpp"
+#include "io/scene_object.hpp"
+
+#include <memory>
+#include <span>
+#include <string>
+#include <utility>
+
+namespace vox::sim {
+
+/// The grid of a scene's object, with levels up to `max_level` (coarser levels than the simulated
+/// one serve the multigrid preconditioner).
+[[nodiscard]] grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGrid& labels, int max_level);
+
+/// Whether simulating `scene` at `level` of `grid` would pick the multigrid preconditioner, which
+/// needs the grid's coarser levels; without it a grid up to `level` is enough (and cuts update
+/// fewer levels).
+[[nodiscard]] bool wants_multigrid(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+
+/// The nodes of `model` (at `level` of `grid`) inside the box [lo, hi] (world mm) that a scene's
+/// constraint or load box holds. Superimposed elements share their cell's corner positions: a box
+/// catches a node of one only when that element's own material reaches into the box, so holding
+/// one arm of a U-tube does not hold the other arm's element in the same cell.
+[[nodiscard]] std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
+                                                      const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
+/// Milliseconds spent applying one cut.
+struct CutTimings {
+    double grid_update_ms = 0.0; ///< BranchedGrid::update
+    double remesh_ms = 0.0;      ///< EmbeddedSurface::update
+    double fem_update_ms = 0.0;  ///< the model, solver and surface embedding rebuilt, state carried over
+};
+
+class DbgSimulation {
+public:
+    /// Throws the scene's InputError when a constraint or load box catches no node at `level`.
+    /// Keeps a reference to `grid`.
+    DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+
+    [[nodiscard]] const fem::HexModel& model() const { return *m_model; }
+    [[nodiscard]] fem::ImplicitSolver& solver() { return *m_solver; }
+    [[nodiscard]] const fem::ImplicitSolver& solver() const { return *m_solver; }
+    [[nodiscard]] const cut::ModelSurface& surface() const { return *m_model_surface; }
+    /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
+    [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
+
+    /// Removes fine voxels and disconnects faces of `grid` (the grid this simulation was built
+    /// on), updates the surface locally and rebuilds the model, carrying positions, velocities,
+    /// water and plastic strain over (cut/state_transfer.hpp).
+    CutTimings apply_cut(grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
+                         std::span<const std::pair<grid::Coord, int>> faces);
+
+private:
+    /// Model, solver, preconditioner, materials, constraints and loads at m_level; `first`: also
+    /// the wet regions, and boxes that catch no node are errors (after a cut they may catch none).
+    /// After a cut, `previous` and `report` let unchanged elements keep their matrices.
+    void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr);
+
+    io::Scene m_scene;
+    const grid::BranchedGrid* m_grid;
+    int m_level;
+    std::unique_ptr<fem::HexModel> m_model;
+    std::unique_ptr<fem::ImplicitSolver> m_solver;
+    std::unique_ptr<surface::EmbeddedSurface> m_surface;
+    std::unique_ptr<cut::ModelSurface> m_model_surface;
+    std::string m_linear_solver;
+};
+
+} // namespace vox::sim

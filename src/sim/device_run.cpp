@@ -1,0 +1,135 @@
+#include "sim/device_run.hpp"
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "haptics/virtual_device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace vox::sim {
+namespace {
+
+constexpr double k_tick_s = 1e-3;
+/// Surface points the snapshot can hold: a tool's neighbourhood on a fine scan is a few
+/// thousand; beyond this the snapshot says it was truncated.
+constexpr std::size_t k_snapshot_points = 50000;
+/// How far beyond the tool's pushing shape the snapshot reaches, mm: what the device can move
+/// into during one frame.
+constexpr double k_snapshot_margin_mm = 5.0;
+
+} // namespace
+
+DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options)
+    : m_scene(scene), m_snapshot(k_snapshot_points)
+{
+    if (scene.tools.empty()) throw scene.error("tools", "a device needs a tool to drive; the scene has none");
+    if (!options.tool.empty()) {
+        const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == options.tool; });
+        if (found == scene.tools.end()) throw InputError("--tool: the scene has no tool named \"" + options.tool + "\"");
+        m_tool = static_cast<std::size_t>(found - scene.tools.begin());
+    }
+    if (options.replay) {
+        m_device = std::make_unique<haptics::ReplayDevice>(haptics::read_recording(*options.replay));
+    } else {
+        std::vector<haptics::KeyFrame> frames;
+        for (const io::ScriptEntry& e : scene.script)
+            if (e.tool_index == m_tool) frames.push_back({e.t_s, e.position_mm, e.orientation});
+        if (frames.empty())
+            throw scene.error("script", "the device follows the script of tool \"" + scene.tools[m_tool].name + "\", which has no entry");
+        m_device = std::make_unique<haptics::VirtualDevice>(std::move(frames));
+    }
+    const io::ToolSpec& spec = scene.tools[m_tool];
+    // The device's own limits where it declares them: its force, and a coupling it renders stably.
+    const haptics::DeviceLimits& limits = m_device->limits();
+    haptics::CouplingSettings coupling;
+    if (limits.max_stiffness_n_per_mm > 0.0) coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, limits.max_stiffness_n_per_mm);
+    haptics::SafetySettings safety;
+    if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
+    m_coupled = std::make_unique<haptics::CoupledTool>(tools.shape(m_tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
+                                                       coupling, m_snapshot.capacity());
+    m_loop = std::make_unique<haptics::HapticLoop>(
+        *m_device,
+        [this](const haptics::DeviceState& state, double& age) {
+            age = state.t_s - m_snapshot.t_s;
+            return m_coupled->update(state, m_snapshot, m_tick_s);
+        },
+        safety, 0);
+}
+
+void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, double dt_s)
+{
+    // The snapshot: the surface around where the tool is, as the simulation has it at the frame's start.
+    if (!m_started) { // the proxy starts at the device; the reading is recorded so a replay starts alike
+        haptics::DeviceState first;
+        m_device->read(t0_s, first);
+        m_coupled->update(first, m_snapshot, k_tick_s);
+        m_recording.push_back({first, Eigen::Vector3d::Zero()});
+        m_started = true;
+    }
+    const io::ToolSpec& spec = m_scene.tools[m_tool];
+    method.sample_surface(m_coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), spec, m_snapshot);
+    m_snapshot.t_s = t0_s;
+    if (m_snapshot.truncated && !m_warned_truncated) {
+        log::warn("the surface near the tool has more than {} points; the haptic snapshot keeps the first ones", m_snapshot.capacity());
+        m_warned_truncated = true;
+    }
+    const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
+    m_tick_s = dt_s / ticks;
+    for (int i = 1; i <= ticks; ++i) {
+        const double t = t0_s + i * dt_s / ticks;
+        const Eigen::Vector3d f = m_loop->tick(t);
+        m_recording.push_back({m_loop->state(), f});
+        m_forces.push_back({t, m_coupled->proxy().position, f});
+    }
+    tools.drive(m_tool, m_coupled->proxy().position, m_coupled->proxy().orientation);
+}
+
+void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title)
+{
+    write_atomically(dir / "forces.csv", [&](const std::filesystem::path& tmp) {
+        std::FILE* f = std::fopen(tmp.c_str(), "w");
+        if (!f) throw file_error(tmp.string(), "cannot be written");
+        std::fprintf(f, "t_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n\n");
+        for (const ForceSample& s : samples)
+            std::fprintf(f, "%.6f,%.6f,%.6f,%.6f,%.9g,%.9g,%.9g\n", s.t_s, s.position_mm.x(), s.position_mm.y(), s.position_mm.z(),
+                         s.force_n.x(), s.force_n.y(), s.force_n.z());
+        if (std::fclose(f) != 0) throw file_error(tmp.string(), "cannot be written");
+    });
+    // The magnitude against time, with a few labelled ticks on each axis.
+    const double w = 720, h = 360, left = 60, right = 20, top = 30, bottom = 45;
+    double t_max = 1e-9, f_max = 1e-9;
+    for (const ForceSample& s : samples) {
+        t_max = std::max(t_max, s.t_s);
+        f_max = std::max(f_max, s.force_n.norm());
+    }
+    f_max *= 1.1;
+    auto x = [&](double t) { return left + (w - left - right) * t / t_max; };
+    auto y = [&](double f) { return h - bottom - (h - top - bottom) * f / f_max; };
+    std::ostringstream o;
+    o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << w << "' height='" << h << "' font-family='sans-serif' font-size='12'>\n"
+      << "<rect width='100%' height='100%' fill='white'/>\n"
+      << "<text x='" << w / 2 << "' y='18' text-anchor='middle'>" << title << "</text>\n"
+      << "<line x1='" << left << "' y1='" << h - bottom << "' x2='" << w - right << "' y2='" << h - bottom << "' stroke='black'/>\n"
+      << "<line x1='" << left << "' y1='" << top << "' x2='" << left << "' y2='" << h - bottom << "' stroke='black'/>\n";
+    for (int k = 0; k <= 5; ++k) {
+        const double t = t_max * k / 5, f = f_max * k / 5;
+        char label[32];
+        std::snprintf(label, sizeof label, "%.2f", t);
+        o << "<text x='" << x(t) << "' y='" << h - bottom + 16 << "' text-anchor='middle'>" << label << "</text>\n";
+        std::snprintf(label, sizeof label, "%.3g", f);
+        o << "<text x='" << left - 6 << "' y='" << y(f) + 4 << "' text-anchor='end'>" << label << "</text>\n";
+    }
+    o << "<text x='" << (left + w - right) / 2 << "' y='" << h - 8 << "' text-anchor='middle'>time (s)</text>\n"
+      << "<text x='14' y='" << (top + h - bottom) / 2 << "' transform='rotate(-90 14 " << (top + h - bottom) / 2
+      << ")' text-anchor='middle'>force (N)</text>\n<polyline fill='none' stroke='#c0392b' stroke-width='1.5' points='";
+    for (const ForceSample& s : samples) o << x(s.t_s) << ',' << y(s.force_n.norm()) << ' ';
+    o << "'/>\n</svg>\n";
+    write_atomically(dir / "forces.svg", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << o.str(); });
+}
+
+} // namespace vox::sim

@@ -1,0 +1,49 @@
+#pragma once
+// The one frame loop: a device's haptic ticks (when a device drives a tool), the tools (contact,
+// cuts, wetting: sim/tool_policy.hpp), then the method's step, unless a two-phase tool holds the
+// object while it marks its cut. `voxsculpt run`, the viewer, device runs, every bench and the
+// tests step through it, so they simulate the same thing.
+
+#include "sim/method.hpp"
+#include "sim/tool_policy.hpp"
+
+namespace vox::sim {
+
+class DeviceRun;
+
+/// One frame, as every method reports it.
+struct FrameStats {
+    int frame = 0;   ///< from 1
+    double t_s = 0.0; ///< simulated time at its end
+    ToolsFrame tools;
+    StepFigures step; ///< zero (and converged) while the object is held
+};
+
+/// The message of a step that still created energy at 1/32 of dt: the loads or the time step are
+/// beyond what this object and level can follow.
+[[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
+
+class FrameLoop {
+public:
+    /// Keeps references to all four (`device` may be null: the tools follow the script).
+    FrameLoop(const io::Scene& scene, Method& method, ToolPolicy& tools, DeviceRun* device = nullptr);
+
+    /// The next frame. Throws the scene's InputError when its step diverged or created energy
+    /// even split into 32 substeps: what follows could not be trusted.
+    FrameStats next();
+
+    /// Frames done so far.
+    [[nodiscard]] int frames() const { return m_frame; }
+    /// After the method was replaced (the viewer's level keys) or restored: the loop goes on with it.
+    void set_method(Method& method) { m_method = &method; }
+    [[nodiscard]] Method& method() { return *m_method; }
+
+private:
+    const io::Scene& m_scene;
+    Method* m_method;
+    ToolPolicy& m_tools;
+    DeviceRun* m_device;
+    int m_frame = 0;
+};
+
+} // namespace vox::sim

@@ -1,0 +1,297 @@
+#include "sim/isxfem_simulation.hpp"
+
+#include "sim/dbg_simulation.hpp"
+#include "cut/model_surface.hpp"
+#include "fem/hex_model.hpp"
+#include "fem/rest_cholesky.hpp"
+
+#include <algorithm>
+
+namespace vox::sim {
+
+IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level) : m_grid(grid)
+{
+    if (scene.solver.mode != io::SolverMode::dynamic)
+        throw scene.error("solver.mode", "\"isxfem\" simulates dynamically only so far; use \"dynamic\" or \"type\": \"dbg\"");
+    if (!scene.loads.empty()) throw scene.error("loads", "\"isxfem\" does not apply loads yet; use \"type\": \"dbg\"");
+    if (!scene.wet_regions.empty()) throw scene.error("wet_regions", "\"isxfem\" does not wet yet; use \"type\": \"dbg\"");
+    const io::MaterialTable table = io::material_table(scene);
+    for (std::size_t m = 0; m < table.scene_materials.size(); ++m)
+        if (table.scene_materials[m].plasticity)
+            throw scene.error("materials", "\"isxfem\" has no plasticity yet; use \"type\": \"dbg\"");
+
+    const fem::HexModel hex(grid, level);
+    isxfem::GridTets tets = isxfem::tets_from_model(grid, hex);
+    m_model = std::make_unique<isxfem::XfemModel>(tets.mesh, std::move(tets.materials), std::move(tets.material), scene.solver.isxfem_k);
+    isxfem::XfemOptions o;
+    o.dt_s = scene.solver.dt_s;
+    o.cg_tolerance = scene.solver.cg_tolerance;
+    o.cg_max_iterations = scene.solver.cg_max_iterations;
+    o.rayleigh_mass_per_s = scene.solver.rayleigh_mass_per_s;
+    o.rayleigh_stiffness_s = scene.solver.rayleigh_stiffness_s;
+    o.regularisation_lambda = scene.solver.isxfem_regularisation_lambda;
+    o.regularisation_threshold = scene.solver.isxfem_regularisation_threshold;
+    m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, o);
+    m_closure = std::make_unique<isxfem::CutClosure>(*m_model);
+    switch (scene.solver.preconditioner) {
+    case io::PreconditionerChoice::multigrid:
+        throw scene.error("solver.preconditioner", "\"isxfem\" has no multigrid; use \"auto\", \"cholesky\" or \"jacobi\"");
+    case io::PreconditionerChoice::jacobi:
+        break;
+    default: // the warped factor, patched across cuts and taken again when that or the turning costs more
+        m_solver->set_preconditioner(std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity()));
+    }
+    m_solver->set_gravity(scene.gravity_m_s2);
+    for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
+        const io::Constraint& c = scene.constraints[k];
+        const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
+        const std::vector<std::uint32_t> nodes = nodes_in_box(grid, hex, level, c.box_min_mm, c.box_max_mm);
+        if (nodes.empty())
+            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
+        for (std::uint32_t n : nodes) m_solver->fix(n, axes);
+    }
+
+    // The surface, each used vertex located in a tetrahedron of its element.
+    m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
+    const cut::ModelSurface embedding(grid, hex, *m_surface);
+    for (std::uint32_t v = 0; v < m_surface->vertices().size(); ++v) {
+        if (m_surface->vertices()[v].users == 0) continue;
+        Embedded e;
+        e.rest_m = embedding.vertex_rest_mm(v) * 1e-3;
+        e.key = m_surface->vertices()[v].key;
+        std::tie(e.tet, e.bary) = isxfem::locate(m_model->mesh(), embedding.vertex_element(v), e.rest_m);
+        m_vertices.push_back(e);
+    }
+    m_rest = m_surface->mesh(grid); // the used vertices in slot order, as m_vertices
+}
+
+isxfem::CutReport IsxfemSimulation::cut(const isxfem::CutSurface& surface, std::size_t new_from, int extend)
+{
+    const isxfem::CutReport r = m_model->cut(surface, new_from, extend);
+    if (r.cut_tets > 0) m_solver->model_changed();
+    return r;
+}
+
+std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
+{
+    std::vector<Eigen::Vector3d> u;
+    u.reserve(m_vertices.size());
+    for (const Embedded& v : m_vertices) {
+        u.push_back(m_solver->position(v.tet, v.bary, side_of(v.tet, v.bary)) - v.rest_m);
+    }
+    return u;
+}
+
+int IsxfemSimulation::side_of(std::size_t tet, const std::array<double, 4>& bary) const
+{
+    return static_cast<int>(m_model->elements()[tet].region_at(bary));
+}
+
+Eigen::Vector3d IsxfemSimulation::mean_displacement_mm(const Eigen::AlignedBox3d& box) const
+{
+    const auto& rest = m_model->mesh().nodes;
+    const auto& x = m_solver->state();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t count = 0;
+    for (const isxfem::XfemElement& el : m_model->elements()) {
+        Eigen::AlignedBox3d deformed;
+        deformed.setEmpty();
+        for (std::uint32_t n : el.node) deformed.extend(1e3 * x[n]);
+        if (!deformed.intersects(box)) continue;
+        for (std::uint32_t n : el.node) sum += 1e3 * (x[n] - rest[n]);
+        count += 4;
+    }
+    return count ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
+}
+
+std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
+{
+    std::vector<std::uint64_t> keys;
+    keys.reserve(m_vertices.size());
+    for (const Embedded& v : m_vertices) keys.push_back(v.key);
+    return keys;
+}
+
+
+IsxfemSimulation::~IsxfemSimulation() = default;
+
+void IsxfemSimulation::refresh_closed_surface() const
+{
+    // It depends on the cuts only (material points and rest triangles): rebuilt when they change.
+    if (m_closed_revision == m_model->revision() && !m_closed_vertices.empty()) return;
+    m_closed_vertices.clear();
+    m_closed_vertices.reserve(m_vertices.size());
+    for (std::size_t k = 0; k < m_vertices.size(); ++k) {
+        const Embedded& e = m_vertices[k];
+        m_closed_vertices.push_back({e.tet, e.bary, side_of(e.tet, e.bary), e.rest_m, m_rest.labels[k]});
+    }
+    m_closed_triangles = m_rest.triangles;
+    m_closed_crack.assign(m_closed_triangles.size(), -1);
+    m_closure_counts = {};
+    for (int cut = 0; cut < m_model->cut_count(); ++cut)
+        m_closure_counts += m_closure->close(cut, m_closed_vertices, m_closed_triangles, &m_closed_crack);
+    m_closed_revision = m_model->revision();
+}
+
+isxfem::ClosureCounts IsxfemSimulation::closure_counts() const
+{
+    refresh_closed_surface();
+    return m_closure_counts;
+}
+
+surface::SurfaceMesh IsxfemSimulation::surface_mesh() const
+{
+    refresh_closed_surface();
+    surface::SurfaceMesh out;
+    out.triangles = m_closed_triangles;
+    for (const isxfem::SurfacePoint& v : m_closed_vertices) {
+        out.positions.push_back(1e3 * m_solver->position(v.tet, v.bary, v.side));
+        out.labels.push_back(v.label);
+    }
+    return out;
+}
+
+std::vector<IsxfemSimulation::Mark> IsxfemSimulation::surface_marks() const
+{
+    refresh_closed_surface();
+    // Around such a tetrahedron (its nodes' tetrahedra): one alone is a speck in a picture.
+    std::vector<unsigned char> coupled_node(m_model->node_count(), 0);
+    for (const isxfem::XfemElement& el : m_model->elements())
+        if (el.crossed || el.cut_left_out)
+            for (std::uint32_t n : el.node) coupled_node[n] = 1;
+    std::vector<Mark> out;
+    out.reserve(m_closed_vertices.size());
+    for (std::size_t v = 0; v < m_closed_vertices.size(); ++v) { // the closure appends what it makes after the object's own
+        const isxfem::XfemElement& el = m_model->elements()[m_closed_vertices[v].tet];
+        const bool coupled = std::any_of(el.node.begin(), el.node.end(), [&](std::uint32_t n) { return coupled_node[n] != 0; });
+        out.push_back(coupled ? Mark::coupled : v >= m_vertices.size() ? Mark::cut : Mark::surface);
+    }
+    return out;
+}
+
+/// The closed surface's vertices within a box: their material points, deformed positions (mm),
+/// areas and normals, and the triangles with all three corners among them.
+struct IsxfemSimulation::NearSurface {
+    const std::vector<isxfem::SurfacePoint>* vertices = nullptr; ///< all of the closed surface's
+    std::vector<std::uint32_t> near;              ///< the ones in the box
+    std::vector<Eigen::Vector3d> positions, normals;
+    std::vector<double> areas;
+    std::vector<Eigen::Vector3i> triangles;       ///< among `near` (indices into it)
+};
+
+IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::AlignedBox3d& reach, double closed_walls_mm) const
+{
+    NearSurface out;
+    refresh_closed_surface();
+    out.vertices = &m_closed_vertices;
+    const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
+    const std::vector<Eigen::Vector3i>& triangles = m_closed_triangles;
+    // Only the vertices of tetrahedra whose deformed box (every region of a cut one) meets the reach
+    // are placed: a large surface is mostly far from the tool.
+    const auto& x = m_solver->state();
+    std::vector<unsigned char> tet_near(m_model->elements().size(), 0);
+    for (std::size_t t = 0; t < m_model->elements().size(); ++t) {
+        const isxfem::XfemElement& el = m_model->elements()[t];
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        double jump = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) {
+            box.extend(1e3 * x[el.node[c]]);
+            for (unsigned pattern = 0; el.is_cut() && pattern < (1u << el.cuts.size()); ++pattern) // each region's corner
+                box.extend(1e3 * el.region_node(c, pattern, x));
+            for (const isxfem::ElementCut& cut : el.cuts) jump += 1e3 * x[cut.enriched[c]].norm();
+        }
+        // For k > 0 a side's field is the linear one plus k gamma-weighted jumps, at most k sum |a|.
+        const Eigen::Vector3d pad = Eigen::Vector3d::Constant(m_model->k() * jump);
+        tet_near[t] = Eigen::AlignedBox3d(box.min() - pad, box.max() + pad).intersects(reach);
+    }
+    std::vector<Eigen::Vector3d> position(vertices.size(), Eigen::Vector3d::Constant(INFINITY));
+    std::vector<unsigned char> is_near(vertices.size(), 0);
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+        if (!tet_near[vertices[v].tet]) continue;
+        position[v] = 1e3 * m_solver->position(vertices[v].tet, vertices[v].bary, vertices[v].side);
+        if (reach.contains(position[v])) is_near[v] = 1;
+    }
+    // Each near vertex carries a third of its triangles' area and their area-weighted normal.
+    std::vector<Eigen::Vector3d> normal(vertices.size(), Eigen::Vector3d::Zero());
+    std::vector<double> area(vertices.size(), 0.0);
+    std::vector<Eigen::Vector3i> touching;
+    // A crack face whose corners lie within `closed_walls_mm` of their own points across the crack:
+    // its walls have not opened. Each corner's gap is measured once (a corner has several faces).
+    std::vector<float> gap(closed_walls_mm > 0.0 ? vertices.size() : 0, -1.0f);
+    auto closed = [&](const Eigen::Vector3i& t, int cut) {
+        for (int c = 0; c < 3; ++c) {
+            const auto k = static_cast<std::size_t>(t[c]);
+            if (gap[k] < 0.0f) {
+                const isxfem::SurfacePoint& v = vertices[k];
+                const int j = m_model->elements()[v.tet].cut_index(cut); // < 0 on the crack's front: one point for both walls
+                gap[k] = j < 0 ? 0.0f : static_cast<float>((1e3 * m_solver->position(v.tet, v.bary, v.side ^ (1 << j)) - position[k]).norm());
+            }
+            if (gap[k] >= closed_walls_mm) return false;
+        }
+        return true;
+    };
+    for (std::size_t i = 0; i < triangles.size(); ++i) {
+        const Eigen::Vector3i& t = triangles[i];
+        if (!is_near[static_cast<std::size_t>(t[0])] && !is_near[static_cast<std::size_t>(t[1])] && !is_near[static_cast<std::size_t>(t[2])]) continue;
+        for (int c = 0; c < 3; ++c) // a corner outside the tetrahedra near the tool is placed now
+            if (!std::isfinite(position[static_cast<std::size_t>(t[c])].x())) {
+                const isxfem::SurfacePoint& v = vertices[static_cast<std::size_t>(t[c])];
+                position[static_cast<std::size_t>(t[c])] = 1e3 * m_solver->position(v.tet, v.bary, v.side);
+            }
+        if (closed_walls_mm > 0.0 && m_closed_crack[i] >= 0 && closed(t, m_closed_crack[i])) continue;
+        const Eigen::Vector3d n = (position[static_cast<std::size_t>(t[1])] - position[static_cast<std::size_t>(t[0])])
+                                      .cross(position[static_cast<std::size_t>(t[2])] - position[static_cast<std::size_t>(t[0])]);
+        for (int c = 0; c < 3; ++c) {
+            normal[static_cast<std::size_t>(t[c])] += n;
+            area[static_cast<std::size_t>(t[c])] += n.norm() / 6.0;
+        }
+        touching.push_back(t);
+    }
+    std::vector<int> index(vertices.size(), -1);
+    for (std::size_t v = 0; v < vertices.size(); ++v)
+        if (is_near[v] && area[v] > 0.0) {
+            index[v] = static_cast<int>(out.near.size());
+            out.near.push_back(static_cast<std::uint32_t>(v));
+            out.positions.push_back(position[v]);
+            out.areas.push_back(area[v]);
+            out.normals.push_back(normal[v].normalized());
+        }
+    for (const Eigen::Vector3i& t : touching)
+        if (index[static_cast<std::size_t>(t[0])] >= 0 && index[static_cast<std::size_t>(t[1])] >= 0 && index[static_cast<std::size_t>(t[2])] >= 0)
+            out.triangles.emplace_back(index[static_cast<std::size_t>(t[0])], index[static_cast<std::size_t>(t[1])], index[static_cast<std::size_t>(t[2])]);
+    return out;
+}
+
+IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
+                                                const contact::PlacedShape* from, double closed_walls_mm) const
+{
+    // Only the surface within the tool's reach (at both poses) is measured.
+    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
+    if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
+    const NearSurface s = near_surface(reach, closed_walls_mm);
+    Touch out;
+    out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
+    for (const contact::PointContact& c : out.contact.points) {
+        const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
+        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
+    }
+    return out;
+}
+
+void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, double closed_walls_mm) const
+{
+    const NearSurface s = near_surface(box, closed_walls_mm);
+    out.count = std::min(s.positions.size(), out.capacity());
+    out.truncated = s.positions.size() > out.capacity();
+    std::copy_n(s.positions.begin(), out.count, out.positions_mm.begin());
+    std::copy_n(s.normals.begin(), out.count, out.normals.begin());
+    std::copy_n(s.areas.begin(), out.count, out.areas_mm2.begin());
+    out.triangles.clear();
+    for (const Eigen::Vector3i& t : s.triangles)
+        if (t.maxCoeff() < static_cast<int>(out.count)) out.triangles.push_back(t);
+    const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
+    out.triangle_tree.rebuild(positions, positions, out.triangles);
+}
+
+} // namespace vox::sim

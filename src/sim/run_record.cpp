@@ -1,0 +1,112 @@
+#include "sim/run_record.hpp"
+
+#include "core/sample_stats.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace vox::sim {
+
+std::string frame_file_name(int frame, const char* extension)
+{
+    char name[48];
+    std::snprintf(name, sizeof name, "frame_%05d.%s", frame, extension);
+    return name;
+}
+
+nlohmann::json tool_frames_json(const std::vector<ToolFrame>& tools)
+{
+    nlohmann::json out = nlohmann::json::array();
+    for (const ToolFrame& t : tools) {
+        if (!t.placed) {
+            out.push_back(nullptr);
+            continue;
+        }
+        out.push_back({{"position_mm", {t.position_mm.x(), t.position_mm.y(), t.position_mm.z()}},
+                       {"force_n", {t.force_n.x(), t.force_n.y(), t.force_n.z()}},
+                       {"torque_n_mm", {t.torque_n_mm.x(), t.torque_n_mm.y(), t.torque_n_mm.z()}},
+                       {"pressure_pa", t.pressure_pa},
+                       {"contact_area_mm2", t.contact_area_mm2},
+                       {"cut", t.cut}});
+    }
+    return out;
+}
+
+RunRecord::RunRecord(const std::string& scene_path, const Method& method, double dt_s)
+{
+    m_document = {{"scene", scene_path},
+                  {"method", method.name()},
+                  {"level", method.level()},
+                  {"elements", method.element_count()},
+                  {"dofs", method.dof_count()},
+                  {"dt_s", dt_s},
+                  {"linear_solver", method.linear_solver()},
+                  {"frames", nlohmann::json::array()}};
+}
+
+void RunRecord::add(const FrameStats& f, const Method& method)
+{
+    const StepFigures& s = f.step;
+    const ToolsFrame& t = f.tools;
+    ++m_frames;
+    m_total_ms += s.step_ms;
+    m_max_ms = std::max(m_max_ms, s.step_ms);
+    m_converged += s.converged;
+    m_removed += t.cut.removed_voxels;
+    m_separated_faces += t.cut.separated_faces;
+    m_separated_voxels += t.cut.separated_voxels;
+    if (t.cut.changed()) m_cutting_ms.push_back(t.cutting_ms());
+    m_last = s;
+    nlohmann::json frame{{"frame", f.frame},
+                         {"t_s", f.t_s},
+                         {"step_ms", s.step_ms},
+                         {"assembly_ms", s.assembly_ms},
+                         {"solve_ms", s.solve_ms},
+                         {"cg_iterations", s.cg_iterations},
+                         {"newton_iterations", s.newton_iterations},
+                         {"residual", s.residual},
+                         {"converged", s.converged},
+                         {"substeps", s.substeps},
+                         {"kinetic_energy_j", s.kinetic_energy_j},
+                         {"elastic_energy_j", s.elastic_energy_j ? nlohmann::json(*s.elastic_energy_j) : nlohmann::json()},
+                         {"max_displacement_mm", s.max_displacement_mm},
+                         {"collision_ms", t.collision_ms},
+                         {"propagation_ms", t.propagation_ms},
+                         {"grid_update_ms", t.cut.grid_update_ms},
+                         {"remesh_ms", t.cut.remesh_ms},
+                         {"fem_update_ms", t.cut.fem_update_ms},
+                         {"removed_voxels", t.cut.removed_voxels},
+                         {"separated_faces", t.cut.separated_faces},
+                         {"separated_voxels", t.cut.separated_voxels},
+                         {"elements", method.element_count()},
+                         {"dofs", method.dof_count()},
+                         {"object_held", t.hold_object},
+                         {"tools", tool_frames_json(t.tools)}};
+    method.add_frame_figures(frame);
+    m_document["frames"].push_back(std::move(frame));
+}
+
+void RunRecord::finish(const Method& method)
+{
+    nlohmann::json summary{{"frames", m_frames},
+                           {"total_step_ms", m_total_ms},
+                           {"mean_step_ms", m_frames ? m_total_ms / m_frames : 0.0},
+                           {"max_step_ms", m_max_ms},
+                           {"converged_frames", m_converged},
+                           {"removed_voxels", m_removed},
+                           {"separated_faces", m_separated_faces},
+                           {"separated_voxels", m_separated_voxels},
+                           {"cutting_frames", m_cutting_ms.size()},
+                           {"cutting_ms_p95", quantile(m_cutting_ms, 0.95)},
+                           {"final_elements", method.element_count()},
+                           {"final_dofs", method.dof_count()},
+                           {"pieces", method.piece_count()},
+                           {"final_max_displacement_mm", m_last.max_displacement_mm},
+                           {"final_elastic_energy_j", m_last.elastic_energy_j ? nlohmann::json(*m_last.elastic_energy_j) : nlohmann::json()},
+                           {"final_kinetic_energy_j", m_last.kinetic_energy_j}};
+    method.add_summary_figures(summary);
+    m_document["summary"] = std::move(summary);
+    m_document["linear_solver"] = method.linear_solver(); // after a fallback: what took over and why
+}
+
+} // namespace vox::sim

@@ -1,0 +1,108 @@
+// The one tool policy on both methods, without the program: when a tool cuts (pressure at its
+// edge, only while it holds), two-phase marking (the object held, the marked path cut whole,
+// then no further cut until the tool lets go), and tools driven by a device.
+
+#include "io/scene.hpp"
+#include "io/scene_object.hpp"
+#include "sim/frame_loop.hpp"
+#include "sim/method_factory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+namespace vox::sim {
+namespace {
+
+io::Scene bundled(const char* name, io::SolverType type)
+{
+    io::Scene scene = io::load_scene(std::string(VOX_SOURCE_DIR "/data/scenes/") + name);
+    io::use_method(scene, type);
+    return scene;
+}
+
+struct Simulated {
+    std::unique_ptr<Method> method;
+    std::vector<FrameStats> frames;
+};
+
+Simulated simulate(const io::Scene& scene, int frames)
+{
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    Simulated r;
+    r.method = open_method(scene, labels).method;
+    ToolPolicy tools(scene);
+    FrameLoop loop(scene, *r.method, tools);
+    for (int f = 0; f < frames; ++f) r.frames.push_back(loop.next());
+    return r;
+}
+
+class EachMethod : public ::testing::TestWithParam<io::SolverType> {};
+
+TEST_P(EachMethod, ABladeCutsOnlyWhereAndWhileItsPressureReachesTheThreshold)
+{
+    io::Scene scene = bundled("bar_cut_isxfem.json", GetParam());
+    const Simulated r = simulate(scene, 12);
+    int cut_frames = 0;
+    for (const FrameStats& f : r.frames) {
+        const ToolFrame& blade = f.tools.tools[0];
+        ASSERT_TRUE(blade.placed);
+        if (!blade.cut) continue;
+        ++cut_frames;
+        EXPECT_GE(blade.pressure_pa, scene.tools[0].cut_pressure_pa) << "frame " << f.frame;
+        EXPECT_TRUE(f.tools.cut.changed());
+    }
+    EXPECT_GE(cut_frames, 2) << r.method->name();
+
+    // The same stroke against a threshold it never reaches: the blade only pushes.
+    scene.tools[0].cut_pressure_pa = 1e9;
+    const Simulated pushed = simulate(scene, 12);
+    for (const FrameStats& f : pushed.frames) {
+        EXPECT_FALSE(f.tools.tools[0].cut) << "frame " << f.frame;
+        EXPECT_FALSE(f.tools.cut.changed());
+    }
+    EXPECT_EQ(pushed.method->piece_count(), 1u);
+}
+
+TEST_P(EachMethod, ATwoPhaseKnifeHoldsTheObjectWhileItMarksThenCutsOnceAndLetsItMove)
+{
+    const io::Scene scene = bundled("press_and_cut_two_phase.json", GetParam());
+    const Simulated r = simulate(scene, 200);
+    int held = 0, cuts = 0, held_after_cut = 0;
+    for (const FrameStats& f : r.frames) {
+        if (f.tools.hold_object) {
+            ++held;
+            EXPECT_EQ(f.step.cg_iterations, 0) << "no step while the object is held, frame " << f.frame;
+            EXPECT_EQ(f.step.step_ms, 0.0);
+            if (cuts > 0) ++held_after_cut;
+        }
+        cuts += f.tools.tools[0].cut;
+    }
+    EXPECT_GT(held, 10) << r.method->name();
+    EXPECT_EQ(cuts, 1) << "one marked path, cut whole, in one frame (" << r.method->name() << ")";
+    EXPECT_EQ(held_after_cut, 0) << "the object moves again after the cut while the knife still touches";
+}
+
+TEST_P(EachMethod, ADrivenToolIsWhereTheDeviceSaysAndTheScriptAgainOnceReleased)
+{
+    const io::Scene scene = bundled("bar_cut_isxfem.json", GetParam());
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    std::unique_ptr<Method> method = open_method(scene, labels).method;
+    ToolPolicy tools(scene);
+    FrameLoop loop(scene, *method, tools);
+    const Eigen::Vector3d away(50, 5, 60); // well above the bar
+    tools.drive(0, away, Eigen::Quaterniond::Identity());
+    const FrameStats driven = loop.next();
+    EXPECT_TRUE(driven.tools.tools[0].position_mm.isApprox(away));
+    EXPECT_EQ(driven.tools.tools[0].force_n.norm(), 0.0);
+    tools.release(0);
+    const FrameStats scripted = loop.next();
+    EXPECT_NEAR(scripted.tools.tools[0].position_mm.x(), 50.3, 1e-9);
+    EXPECT_LT(scripted.tools.tools[0].position_mm.z(), 20.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, EachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
+                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
+
+} // namespace
+} // namespace vox::sim
