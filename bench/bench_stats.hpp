@@ -22,8 +22,7 @@ inline Summary summarize(std::vector<double> samples)
     Summary s;
     s.runs = samples.size();
     if (samples.empty()) return s;
-    const std::size_t n = samples.size();
-    s.median = n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+    s.median = quantile(samples, 0.5); // the one median of every table (core/sample_stats.hpp)
     s.min = samples.front();
     s.max = samples.back();
     return s;

@@ -4,7 +4,7 @@
 // label).
 
 #include "app/commands.hpp"
-#include "app/scene_pictures.hpp"
+#include "view/scene_pictures.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/tool_policy.hpp"
 #include "app/selection_options.hpp"
@@ -19,6 +19,14 @@
 #include <CLI/CLI.hpp>
 
 namespace vox::app {
+
+using view::PictureOptions;
+using view::ScenePictures;
+using view::add_tool_drawings;
+using view::parse_size;
+using view::scene_up;
+using view::surface_drawing;
+using view::surface_picture;
 namespace {
 
 bool ends_with(const std::string& s, const std::string& suffix)

@@ -6,7 +6,7 @@
 // --render-every pictures.
 
 #include "app/commands.hpp"
-#include "app/scene_pictures.hpp"
+#include "view/scene_pictures.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -27,6 +27,11 @@
 #include <optional>
 
 namespace vox::app {
+
+using view::PictureOptions;
+using view::ScenePictures;
+using view::parse_size;
+using view::scene_up;
 namespace {
 
 void write_surface(const std::filesystem::path& path, const sim::Method& method)

@@ -1,13 +1,17 @@
-// voxsculpt view: sculpt a scene interactively in a window (see app/view_session.hpp).
+// voxsculpt view: sculpt a scene interactively in a window (see view/view_session.hpp).
 
 #include "app/commands.hpp"
-#include "app/scene_pictures.hpp"
-#include "app/view_session.hpp"
+#include "view/scene_pictures.hpp"
+#include "view/view_session.hpp"
 #include "core/error.hpp"
 
 #include <CLI/CLI.hpp>
 
 namespace vox::app {
+
+using view::ViewOptions;
+using view::parse_size;
+using view::run_view;
 
 void add_view_command(CLI::App& app)
 {

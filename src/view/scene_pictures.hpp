@@ -15,7 +15,7 @@
 #include <memory>
 #include <optional>
 
-namespace vox::app {
+namespace vox::view {
 
 struct PictureOptions {
     render::CameraSpec camera;
@@ -66,4 +66,4 @@ private:
     std::optional<render::Camera> m_camera;
 };
 
-} // namespace vox::app
+} // namespace vox::view

@@ -11,7 +11,7 @@
 
 #include <string>
 
-namespace vox::app {
+namespace vox::view {
 
 struct ViewOptions {
     std::string camera = "iso";
@@ -32,4 +32,4 @@ struct ViewOptions {
 /// option, render::NoOpenGL without a display.
 void run_view(const std::string& scene_path, const ViewOptions& options);
 
-} // namespace vox::app
+} // namespace vox::view

@@ -1,9 +1,10 @@
-#include "app/view_session.hpp"
+#include "view/view_session.hpp"
 
-#include "app/scene_pictures.hpp"
+#include "view/scene_pictures.hpp"
 #include "sim/dbg_method.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/isxfem_method.hpp"
+#include "sim/undo_history.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "haptics/coupled_tool.hpp"
@@ -28,7 +29,7 @@
 #include <cmath>
 #include <thread>
 
-namespace vox::app {
+namespace vox::view {
 namespace {
 
 using clock_type = std::chrono::steady_clock;
@@ -177,7 +178,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             int driven = -1, simulated = level;
             contact::PlacedShape pose{&tools.shape(0), start, Eigen::Quaterniond::Identity()};
             Eigen::Vector3d heading = start;
-            std::vector<std::unique_ptr<sim::Checkpoint>> checkpoints;
+            sim::UndoHistory history; // the state before each stroke
             // The device lets go of its tool: after the object changed under it.
             auto let_go = [&] {
                 tools.reset();
@@ -195,19 +196,17 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                         sim_loop.set_method(*method);
                         let_go();
                         simulated = at;
-                        checkpoints.clear(); // the deformation restarts from rest at the new level
+                        history.clear(); // the deformation restarts from rest at the new level
                         log::info("level {}: {} elements ({}the deformation from rest)", at, method->element_count(),
                                   method->name() == std::string("dbg") ? "the cuts kept, " : "uncut: Is-XFEM cannot carry cuts across levels yet; ");
                     }
                 }
                 if (undo.exchange(false)) {
-                    if (checkpoints.empty()) {
-                        log::info("{}", method->checkpoint() ? "undo: nothing to undo" : "undo: not available with this method yet (docs/viewer.md)");
-                    } else {
-                        method->restore(*checkpoints.back());
-                        checkpoints.pop_back();
+                    if (history.undo(*method)) {
                         let_go();
                         log::info("undo: back to before the last stroke");
+                    } else {
+                        log::info("{}", method->checkpoint() ? "undo: nothing to undo" : "undo: not available with this method yet (docs/viewer.md)");
                     }
                 }
                 if (const int a = set_action.exchange(-1); a >= 0) {
@@ -233,11 +232,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                 }
                 // A stroke's checkpoint before any of its cuts: the window flags the stroke before it
                 // moves the pointer, so a pose read above that belongs to the stroke sees the flag.
-                if (stroke_started.exchange(false))
-                    if (std::unique_ptr<sim::Checkpoint> c = method->checkpoint()) {
-                        checkpoints.push_back(std::move(c));
-                        if (checkpoints.size() > 20) checkpoints.erase(checkpoints.begin());
-                    }
+                if (stroke_started.exchange(false)) history.before_stroke(*method);
                 if (driven >= 0) tools.drive(static_cast<std::size_t>(driven), pose.position, pose.orientation);
                 try {
                     sim_loop.next();
@@ -486,4 +481,4 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     if (!failure.empty()) throw InputError(scene_path + ": the simulation stopped: " + failure);
 }
 
-} // namespace vox::app
+} // namespace vox::view

@@ -1,10 +1,10 @@
-#include "app/scene_pictures.hpp"
+#include "view/scene_pictures.hpp"
 
 #include "core/error.hpp"
 
 #include <sstream>
 
-namespace vox::app {
+namespace vox::view {
 namespace {
 
 /// Cut surfaces are drawn lighter, as freshly cut tissue or clay looks.
@@ -153,4 +153,4 @@ render::DrawMesh element_cage(const sim::DbgSimulation& sim)
     return d;
 }
 
-} // namespace vox::app
+} // namespace vox::view
