@@ -40,6 +40,16 @@ XfemSolver::XfemSolver(const XfemModel& model, const XfemOptions& options) : m_m
     model_changed();
 }
 
+void XfemSolver::set_state(std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3d> v)
+{
+    if (x.size() != m_model.block_count() || v.size() != x.size())
+        throw std::invalid_argument("XfemSolver::set_state: " + std::to_string(x.size()) + " blocks given, the model has " +
+                                    std::to_string(m_model.block_count()));
+    m_x = std::move(x);
+    m_v = std::move(v);
+    m_previous_v.resize(0); // no extrapolation from before the jump
+}
+
 void XfemSolver::fix(std::uint32_t node, unsigned axes)
 {
     for (unsigned a = 0; a < 3; ++a)

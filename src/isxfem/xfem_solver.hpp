@@ -90,6 +90,9 @@ public:
     [[nodiscard]] const std::vector<Eigen::Vector3d>& state() const { return m_x; }
     [[nodiscard]] std::vector<Eigen::Vector3d>& velocities() { return m_v; }
     [[nodiscard]] const std::vector<Eigen::Vector3d>& velocities() const { return m_v; }
+    /// Puts the state back to `x` and `v` (per dof block, as state() and velocities(); sizes as the
+    /// model's blocks now): an undo. Throws std::invalid_argument when the sizes differ.
+    void set_state(std::vector<Eigen::Vector3d> x, std::vector<Eigen::Vector3d> v);
     /// Forces at material points for the following steps (replacing the last ones), taken
     /// implicitly with their stiffness. Throws std::out_of_range for a tetrahedron that is not there.
     void set_point_loads(std::vector<PointLoad> loads);

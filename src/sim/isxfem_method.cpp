@@ -258,8 +258,40 @@ void IsxfemMethod::add_summary_figures(nlohmann::json& summary) const
 
 std::unique_ptr<Method> IsxfemMethod::at_level(int level) const { return std::make_unique<IsxfemMethod>(m_scene, m_labels, level); }
 
-std::unique_ptr<Checkpoint> IsxfemMethod::checkpoint() const { return nullptr; }
+namespace {
 
-void IsxfemMethod::restore(const Checkpoint&) {}
+struct IsxfemCheckpoint final : Checkpoint {
+    explicit IsxfemCheckpoint(IsxfemSimulation::State s) : state(std::move(s)) {}
+    IsxfemSimulation::State state;
+    std::size_t cut_tets = 0, recut = 0, crossed = 0, beside = 0, frames_left_whole = 0;
+};
+
+} // namespace
+
+std::unique_ptr<Checkpoint> IsxfemMethod::checkpoint() const
+{
+    auto c = std::make_unique<IsxfemCheckpoint>(m_sim->state());
+    c->cut_tets = m_cut_tets;
+    c->recut = m_recut;
+    c->crossed = m_crossed;
+    c->beside = m_beside;
+    c->frames_left_whole = m_frames_left_whole;
+    return c;
+}
+
+void IsxfemMethod::restore(const Checkpoint& checkpoint)
+{
+    const auto& c = dynamic_cast<const IsxfemCheckpoint&>(checkpoint);
+    m_sim->restore(c.state);
+    for (auto& stroke : m_strokes) // their cuts may be gone: the next touch begins anew
+        if (stroke) stroke->end();
+    m_cut_tets = c.cut_tets;
+    m_recut = c.recut;
+    m_crossed = c.crossed;
+    m_beside = c.beside;
+    m_frames_left_whole = c.frames_left_whole;
+    m_loads.clear();
+    m_cuts_known.clear();
+}
 
 } // namespace vox::sim

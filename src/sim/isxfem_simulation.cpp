@@ -23,7 +23,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     const fem::HexModel hex(grid, level);
     isxfem::GridTets tets = isxfem::tets_from_model(grid, hex);
     m_model = std::make_unique<isxfem::XfemModel>(tets.mesh, std::move(tets.materials), std::move(tets.material), scene.solver.isxfem_k);
-    isxfem::XfemOptions o;
+    isxfem::XfemOptions& o = m_options;
     o.dt_s = scene.solver.dt_s;
     o.cg_tolerance = scene.solver.cg_tolerance;
     o.cg_max_iterations = scene.solver.cg_max_iterations;
@@ -31,25 +31,22 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     o.rayleigh_stiffness_s = scene.solver.rayleigh_stiffness_s;
     o.regularisation_lambda = scene.solver.isxfem_regularisation_lambda;
     o.regularisation_threshold = scene.solver.isxfem_regularisation_threshold;
-    m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, o);
     m_closure = std::make_unique<isxfem::CutClosure>(*m_model);
-    switch (scene.solver.preconditioner) {
-    case io::PreconditionerChoice::multigrid:
+    if (scene.solver.preconditioner == io::PreconditionerChoice::multigrid)
         throw scene.error("solver.preconditioner", "\"isxfem\" has no multigrid; use \"auto\", \"cholesky\" or \"jacobi\"");
-    case io::PreconditionerChoice::jacobi:
-        break;
-    default: // the warped factor, patched across cuts and taken again when that or the turning costs more
-        m_solver->set_preconditioner(std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity()));
-    }
-    m_solver->set_gravity(scene.gravity_m_s2);
+    // The warped factor (patched across cuts and taken again when that or the turning costs more)
+    // unless the scene asks for Jacobi.
+    m_factor = scene.solver.preconditioner != io::PreconditionerChoice::jacobi;
+    m_gravity = scene.gravity_m_s2;
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
         const std::vector<std::uint32_t> nodes = nodes_in_box(grid, hex, level, c.box_min_mm, c.box_max_mm);
         if (nodes.empty())
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
-        for (std::uint32_t n : nodes) m_solver->fix(n, axes);
+        for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
     }
+    make_solver();
 
     // The surface, each used vertex located in a tetrahedron of its element.
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
@@ -114,6 +111,28 @@ std::vector<std::uint64_t> IsxfemSimulation::surface_keys() const
 
 
 IsxfemSimulation::~IsxfemSimulation() = default;
+
+void IsxfemSimulation::make_solver()
+{
+    m_solver = std::make_unique<isxfem::XfemSolver>(*m_model, m_options);
+    if (m_factor) m_solver->set_preconditioner(std::make_unique<fem::RestCholesky>(Eigen::Matrix3d::Identity()));
+    m_solver->set_gravity(m_gravity);
+    for (const auto& [node, axes] : m_fixed) m_solver->fix(node, axes);
+}
+
+IsxfemSimulation::State IsxfemSimulation::state() const { return {*m_model, m_solver->state(), m_solver->velocities()}; }
+
+void IsxfemSimulation::restore(const State& s)
+{
+    // The model as it was (its cuts), a solver built anew on it (its matrix pattern, enriched
+    // blocks and factor follow the model), and the state; the closed surface is made again.
+    m_solver.reset();
+    *m_model = s.model; // in place: the closure keeps its reference
+    m_closure = std::make_unique<isxfem::CutClosure>(*m_model);
+    make_solver();
+    m_solver->set_state(s.x, s.v);
+    m_closed_vertices.clear();
+}
 
 void IsxfemSimulation::refresh_closed_surface() const
 {

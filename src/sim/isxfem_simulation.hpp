@@ -81,13 +81,28 @@ public:
     /// (world mm): how far the material there has moved from rest.
     [[nodiscard]] Eigen::Vector3d mean_displacement_mm(const Eigen::AlignedBox3d& box) const;
 
+    /// The cut model and the solver's state at one moment (the viewer's undo).
+    struct State {
+        isxfem::XfemModel model;
+        std::vector<Eigen::Vector3d> x, v;
+    };
+    [[nodiscard]] State state() const;
+    /// Back to `s`: the model's cuts, a solver built anew on it, positions and velocities.
+    void restore(const State& s);
+
 private:
+    /// The solver on m_model with the scene's options, preconditioner, gravity and supports.
+    void make_solver();
     struct NearSurface;
     [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box, double closed_walls_mm) const;
     /// The closed surface's vertices (material points) and triangles, kept until the next cut.
     void refresh_closed_surface() const;
 
     const grid::BranchedGrid& m_grid;
+    isxfem::XfemOptions m_options;
+    bool m_factor = true; ///< the warped factor, else Jacobi
+    Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
+    std::vector<std::pair<std::uint32_t, unsigned>> m_fixed; ///< supported node, held axes (1 x, 2 y, 4 z)
     std::unique_ptr<isxfem::XfemModel> m_model;
     std::unique_ptr<isxfem::XfemSolver> m_solver;
     std::unique_ptr<isxfem::CutClosure> m_closure;

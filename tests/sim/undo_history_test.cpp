@@ -1,6 +1,6 @@
-// The viewer's undo history driven without a window: strokes cut, undo puts the object back
-// stroke by stroke, the oldest states drop beyond the capacity, and a method that cannot go back
-// keeps nothing.
+// The viewer's undo history driven without a window, on both methods: strokes cut, undo puts
+// the object back stroke by stroke, the oldest states drop beyond the capacity, and the
+// simulation goes on from the state restored.
 
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -21,45 +21,44 @@ io::Scene bar(io::SolverType type)
     return scene;
 }
 
-TEST(UndoHistory, UndoPutsTheObjectBackStrokeByStroke)
+class UndoOnEachMethod : public ::testing::TestWithParam<io::SolverType> {};
+
+TEST_P(UndoOnEachMethod, UndoPutsTheObjectBackStrokeByStroke)
 {
-    const io::Scene scene = bar(io::SolverType::dbg);
-    DbgMethod method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene)), 2, 2);
+    const io::Scene scene = bar(GetParam());
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    std::unique_ptr<Method> method;
+    if (GetParam() == io::SolverType::dbg) method = std::make_unique<DbgMethod>(scene, labels, 2, 2);
+    else method = std::make_unique<IsxfemMethod>(scene, labels, 2);
     ToolPolicy tools(scene);
-    FrameLoop loop(scene, method, tools);
+    FrameLoop loop(scene, *method, tools);
     UndoHistory history(2);
-    EXPECT_FALSE(history.undo(method)); // nothing yet
-    std::vector<std::size_t> cuts;
+    EXPECT_FALSE(history.undo(*method)); // nothing yet
+    std::vector<std::size_t> dofs;
     std::vector<surface::SurfaceMesh> surfaces;
-    for (int stroke = 0; stroke < 3; ++stroke) { // three "strokes" of four frames each
-        ASSERT_TRUE(history.before_stroke(method));
-        cuts.push_back(method.cuts().size());
-        surfaces.push_back(method.surface_mesh());
+    for (int stroke = 0; stroke < 3; ++stroke) { // three "strokes" of four frames each, the blade cutting down
+        ASSERT_TRUE(history.before_stroke(*method));
+        dofs.push_back(method->dof_count());
+        surfaces.push_back(method->surface_mesh());
         for (int f = 0; f < 4; ++f) loop.next();
     }
-    ASSERT_GT(method.cuts().size(), cuts.front()) << "the blade cut";
+    ASSERT_GT(method->dof_count(), dofs.front()) << "the blade cut (elements or enriched blocks added)";
     EXPECT_EQ(history.size(), 2u); // the first stroke's state dropped
     for (int k = 2; k >= 1; --k) {
-        ASSERT_TRUE(history.undo(method));
+        ASSERT_TRUE(history.undo(*method));
         tools.reset();
-        EXPECT_EQ(method.cuts().size(), cuts[static_cast<std::size_t>(k)]);
-        const surface::SurfaceMesh now = method.surface_mesh();
+        EXPECT_EQ(method->dof_count(), dofs[static_cast<std::size_t>(k)]);
+        const surface::SurfaceMesh now = method->surface_mesh();
         ASSERT_EQ(now.positions.size(), surfaces[static_cast<std::size_t>(k)].positions.size());
         for (std::size_t v = 0; v < now.positions.size(); ++v)
-            ASSERT_TRUE(now.positions[v].isApprox(surfaces[static_cast<std::size_t>(k)].positions[v], 1e-12));
+            ASSERT_TRUE(now.positions[v].isApprox(surfaces[static_cast<std::size_t>(k)].positions[v], 1e-12)) << v;
     }
-    EXPECT_FALSE(history.undo(method));
+    EXPECT_FALSE(history.undo(*method));
+    for (int f = 0; f < 8; ++f) EXPECT_TRUE(loop.next().step.converged); // and it goes on from there
 }
 
-TEST(UndoHistory, AMethodThatCannotGoBackKeepsNothing)
-{
-    const io::Scene scene = bar(io::SolverType::isxfem);
-    IsxfemMethod method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene)), 2);
-    UndoHistory history;
-    EXPECT_FALSE(history.before_stroke(method));
-    EXPECT_EQ(history.size(), 0u);
-    EXPECT_FALSE(history.undo(method));
-}
+INSTANTIATE_TEST_SUITE_P(Methods, UndoOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
+                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
 
 } // namespace
 } // namespace vox::sim
