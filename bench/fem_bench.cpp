@@ -81,7 +81,7 @@ void liver_rows(int runs, bool quick)
     io::Selection selection;
     selection.labels = {255};
     const grid::LabelGrid liver = io::select_voxels(io::read_volume(VOX_SOURCE_DIR "/data/liver.inr.gz"), selection);
-    const std::vector<grid::VoxelMaterial> tissue{{grid::lame_from_young_poisson(3e4, 0.45), 1060.0}};
+    const std::vector<grid::ElasticMaterial> tissue{{grid::lame_from_young_poisson(3e4, 0.45), 1060.0}};
     const grid::BranchedGrid g(grid::FineVoxels(liver, [](std::int32_t) { return 0; }), tissue, 6);
     enum { multigrid, cholesky, jacobi };
     const char* const names[] = {"multigrid", "warped Cholesky", "Jacobi, matrix-free"};
@@ -122,7 +122,7 @@ void beam_rows(int runs)
 {
     grid::PhantomSpec beam = grid::default_phantom(grid::PhantomShape::beam);
     beam.size_mm = {75, 15, 15};
-    const std::vector<grid::VoxelMaterial> rubber{{grid::lame_from_young_poisson(1e6, 0.45), 1000.0}};
+    const std::vector<grid::ElasticMaterial> rubber{{grid::lame_from_young_poisson(1e6, 0.45), 1000.0}};
     const grid::BranchedGrid bg(grid::FineVoxels(grid::make_phantom(beam), [](std::int32_t) { return 0; }), rubber, 1);
     const fem::HexModel model(bg, 0);
     for (bool matrix_free : {false, true}) {

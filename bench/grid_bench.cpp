@@ -20,7 +20,7 @@ using namespace vox::grid;
 
 namespace {
 
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0}};
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0}};
 
 /// Evaluates every element matrix of the level (full cells share theirs); returns a checksum so
 /// the work cannot be optimised away, and counts partial elements.

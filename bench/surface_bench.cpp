@@ -24,7 +24,7 @@ int main(int argc, char** argv)
     io::Selection selection;
     selection.labels = {255};
     const LabelGrid liver = io::select_voxels(io::read_volume(VOX_SOURCE_DIR "/data/liver.inr.gz"), selection);
-    const std::vector<VoxelMaterial> materials{{lame_from_young_poisson(3e4, 0.45), 1060.0}};
+    const std::vector<ElasticMaterial> materials{{lame_from_young_poisson(3e4, 0.45), 1060.0}};
     BranchedGrid grid(FineVoxels(liver, [](std::int32_t) { return 0; }), materials, level);
 
     std::printf("machine: %s\n\n| what | median | min - max | runs |\n|---|---|---|---|\n", bench::machine().c_str());

@@ -72,9 +72,9 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
                 if ((c >> axis) & 1) sets.unite(8 * a + static_cast<std::uint32_t>(c), 8 * b + static_cast<std::uint32_t>(c ^ (1 << axis)));
         }
     }
-    for (const grid::VoxelMaterial& m : grid.materials()) m_full_stiffness.push_back(grid::hex8_stiffness(h, m.lame));
+    for (const grid::ElasticMaterial& m : grid.materials()) m_full_stiffness.push_back(grid::hex8_stiffness(h, m.lame));
     std::vector<Matrix8d> mass;
-    for (const grid::VoxelMaterial& m : grid.materials()) mass.push_back(grid::hex8_mass(h, m.density_kg_m3));
+    for (const grid::ElasticMaterial& m : grid.materials()) mass.push_back(grid::hex8_mass(h, m.density_kg_m3));
     const Eigen::Matrix<double, 8, 3> gradient = corner_gradients(Eigen::Vector3d::Constant(0.5), h);
 
     std::vector<std::uint32_t> dense(8 * std::size_t{v.slots()}, grid::no_index);
@@ -140,7 +140,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     for (std::size_t i = 0; i < m_grid_node.size(); ++i) m_rest_world[i] = grid_rest[m_grid_node[i]] * 1e-3;
     m_nodal_mass.assign(m_grid_node.size(), 0.0);
 
-    for (const grid::VoxelMaterial& m : grid.materials())
+    for (const grid::ElasticMaterial& m : grid.materials())
         m_full_stiffness.push_back(cell * grid::hex8_stiffness(h, m.lame));
     m_partial_stiffness.reserve(partial); // elements point into it: no reallocation allowed
     m_elements.reserve(alive);
@@ -202,7 +202,7 @@ void HexModel::add_mass_floor(const grid::BranchedGrid& grid)
     const Eigen::Vector3d h = grid.voxels().voxel_size_m();
     const double cell = static_cast<double>(1 << m_level);
     double density = 0.0;
-    for (const grid::VoxelMaterial& m : grid.materials()) density = std::max(density, m.density_kg_m3);
+    for (const grid::ElasticMaterial& m : grid.materials()) density = std::max(density, m.density_kg_m3);
     const double floor = k_fictitious_fraction * density * (cell * cell * cell) * h.prod() / 8.0;
     m_added_mass.assign(m_nodal_mass.size(), 0.0);
     for (std::size_t n = 0; n < m_nodal_mass.size(); ++n)

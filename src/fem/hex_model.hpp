@@ -58,7 +58,7 @@ public:
     [[nodiscard]] const std::vector<double>& added_mass() const { return m_added_mass; }
     [[nodiscard]] double total_mass() const;
     /// The grid's materials (index = HexElement::material).
-    [[nodiscard]] const std::vector<grid::VoxelMaterial>& materials() const { return m_materials; }
+    [[nodiscard]] const std::vector<grid::ElasticMaterial>& materials() const { return m_materials; }
 
 private:
     void build_voxel_level(const grid::BranchedGrid& grid);
@@ -75,7 +75,7 @@ private:
     std::vector<double> m_nodal_mass;
     std::vector<double> m_added_mass;
     Eigen::Matrix3d m_frame = Eigen::Matrix3d::Identity();
-    std::vector<grid::VoxelMaterial> m_materials;
+    std::vector<grid::ElasticMaterial> m_materials;
 };
 
 } // namespace vox::fem

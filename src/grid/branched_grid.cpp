@@ -81,7 +81,7 @@ std::vector<std::uint32_t> Level::cell_elements(std::uint64_t code) const
     return out;
 }
 
-BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level,
+BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<ElasticMaterial> materials, int max_level,
                            const Options& options)
     : m_voxels(std::move(voxels)), m_materials(std::move(materials))
 {
@@ -95,7 +95,7 @@ BranchedGrid::BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materia
         m_maps[l] = std::make_unique<MomentMatrices>(static_cast<int>(l), m_voxels.voxel_size_m());
         // Equations 2 and 3: a full cell of level l is the voxel element scaled by 2^l (K), 2^3l (M).
         const double s = static_cast<double>(1 << l);
-        for (const VoxelMaterial& m : m_materials) {
+        for (const ElasticMaterial& m : m_materials) {
             m_full_stiffness[l].push_back(s * hex8_stiffness(m_voxels.voxel_size_m(), m.lame));
             m_full_mass[l].push_back(s * s * s * hex8_mass(m_voxels.voxel_size_m(), m.density_kg_m3));
         }

@@ -15,7 +15,7 @@
 #include "core/eigen_types.hpp"
 #include "grid/element_moments.hpp"
 #include "grid/fine_voxels.hpp"
-#include "grid/voxel_material.hpp"
+#include "grid/elastic_material.hpp"
 
 #include <array>
 #include <cstdint>
@@ -93,14 +93,14 @@ public:
 
     /// Builds levels 1 .. max_level (at most 6) from the fine voxels, each from the one below.
     /// `materials` is indexed by FineVoxels::material().
-    BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level, const Options& options);
-    BranchedGrid(FineVoxels voxels, std::vector<VoxelMaterial> materials, int max_level)
+    BranchedGrid(FineVoxels voxels, std::vector<ElasticMaterial> materials, int max_level, const Options& options);
+    BranchedGrid(FineVoxels voxels, std::vector<ElasticMaterial> materials, int max_level)
         : BranchedGrid(std::move(voxels), std::move(materials), max_level, Options{})
     {
     }
 
     [[nodiscard]] const FineVoxels& voxels() const { return m_voxels; }
-    [[nodiscard]] const std::vector<VoxelMaterial>& materials() const { return m_materials; }
+    [[nodiscard]] const std::vector<ElasticMaterial>& materials() const { return m_materials; }
     [[nodiscard]] int max_level() const { return static_cast<int>(m_levels.size()) - 1; }
     /// Level 1 .. max_level(); level 0 is described by level0_stats() (its elements are the voxels).
     [[nodiscard]] const Level& level(int l) const { return m_levels.at(static_cast<std::size_t>(l)); }
@@ -141,7 +141,7 @@ private:
     void number_all_nodes(int l);
 
     FineVoxels m_voxels;
-    std::vector<VoxelMaterial> m_materials;
+    std::vector<ElasticMaterial> m_materials;
     std::vector<Level> m_levels; ///< [0] holds level 0's stats only
     std::vector<std::unique_ptr<MomentMatrices>> m_maps;
     /// Per level and material: the matrices of a full cell, shared by all full cells.

@@ -38,11 +38,11 @@ struct VoxelMatrices {
     Matrix8d mass;
 };
 
-std::vector<VoxelMatrices> voxel_matrices(const Eigen::Vector3d& voxel_size_m, std::span<const VoxelMaterial> materials)
+std::vector<VoxelMatrices> voxel_matrices(const Eigen::Vector3d& voxel_size_m, std::span<const ElasticMaterial> materials)
 {
     std::vector<VoxelMatrices> out;
     out.reserve(materials.size());
-    for (const VoxelMaterial& m : materials)
+    for (const ElasticMaterial& m : materials)
         out.push_back({hex8_stiffness(voxel_size_m, m.lame), hex8_mass(voxel_size_m, m.density_kg_m3)});
     return out;
 }
@@ -84,7 +84,7 @@ Matrix8d subnode_interpolation(const Eigen::Vector3i& origin, int size, int cell
 }
 
 CondensedElement condense_direct(std::span<const CellVoxel> voxels, int cell_level, const Eigen::Vector3d& voxel_size_m,
-                                 std::span<const VoxelMaterial> materials)
+                                 std::span<const ElasticMaterial> materials)
 {
     const auto base = voxel_matrices(voxel_size_m, materials);
     const int cell_size = 1 << cell_level;
@@ -103,7 +103,7 @@ CondensedElement condense_direct(std::span<const CellVoxel> voxels, int cell_lev
 }
 
 CondensedElement condense_recursive(std::span<const CellVoxel> voxels, int cell_level,
-                                    const Eigen::Vector3d& voxel_size_m, std::span<const VoxelMaterial> materials)
+                                    const Eigen::Vector3d& voxel_size_m, std::span<const ElasticMaterial> materials)
 {
     const auto base = voxel_matrices(voxel_size_m, materials);
     Matrix8d child_to_parent[8];
@@ -149,7 +149,7 @@ CondensedElement condense_recursive(std::span<const CellVoxel> voxels, int cell_
 }
 
 CondensedElement condense_brute_force(std::span<const CellVoxel> voxels, int cell_level,
-                                      const Eigen::Vector3d& voxel_size_m, std::span<const VoxelMaterial> materials)
+                                      const Eigen::Vector3d& voxel_size_m, std::span<const ElasticMaterial> materials)
 {
     const auto base = voxel_matrices(voxel_size_m, materials);
     const int cell_size = 1 << cell_level;

@@ -11,7 +11,7 @@
 // Multi-material cells: a sub-node merges voxels of one material only, so all three stay exact.
 
 #include "core/eigen_types.hpp"
-#include "grid/voxel_material.hpp"
+#include "grid/elastic_material.hpp"
 
 #include <cstdint>
 #include <span>
@@ -56,13 +56,13 @@ struct CondensedElement {
 /// `voxel_size_m` the fine voxel's edges (anisotropic allowed).
 [[nodiscard]] CondensedElement condense_direct(std::span<const CellVoxel> voxels, int cell_level,
                                                const Eigen::Vector3d& voxel_size_m,
-                                               std::span<const VoxelMaterial> materials);
+                                               std::span<const ElasticMaterial> materials);
 [[nodiscard]] CondensedElement condense_recursive(std::span<const CellVoxel> voxels, int cell_level,
                                                   const Eigen::Vector3d& voxel_size_m,
-                                                  std::span<const VoxelMaterial> materials);
+                                                  std::span<const ElasticMaterial> materials);
 [[nodiscard]] CondensedElement condense_brute_force(std::span<const CellVoxel> voxels, int cell_level,
                                                     const Eigen::Vector3d& voxel_size_m,
-                                                    std::span<const VoxelMaterial> materials);
+                                                    std::span<const ElasticMaterial> materials);
 
 /// Number of recursive condensation steps without computing matrices: the non-empty octree
 /// (dimensions 3) or quadtree (2) nodes of levels 0 .. L-1.

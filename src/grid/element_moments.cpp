@@ -101,7 +101,7 @@ MomentMatrices::MomentMatrices(int level, const Eigen::Vector3d& h)
         }
 }
 
-Matrix24d MomentMatrices::stiffness(const ElementContent& content, std::span<const VoxelMaterial> materials) const
+Matrix24d MomentMatrices::stiffness(const ElementContent& content, std::span<const ElasticMaterial> materials) const
 {
     Matrix24d k = Matrix24d::Zero();
     for (const MaterialMoments& mm : content) {
@@ -121,7 +121,7 @@ Matrix24d MomentMatrices::stiffness(const ElementContent& content, std::span<con
     return k;
 }
 
-Matrix8d MomentMatrices::mass(const ElementContent& content, std::span<const VoxelMaterial> materials) const
+Matrix8d MomentMatrices::mass(const ElementContent& content, std::span<const ElasticMaterial> materials) const
 {
     Matrix8d m = Matrix8d::Zero();
     for (const MaterialMoments& mm : content)

@@ -8,7 +8,7 @@
 // The factor 216 = 6^3 makes every moment an integer; cells up to 64 voxels per axis fit in 64 bits.
 
 #include "core/eigen_types.hpp"
-#include "grid/voxel_material.hpp"
+#include "grid/elastic_material.hpp"
 
 #include <array>
 #include <cstdint>
@@ -43,8 +43,8 @@ public:
     MomentMatrices(int level, const Eigen::Vector3d& voxel_size_m);
 
     /// Stiffness (N/m) and scalar consistent mass (kg) of an element holding `content`.
-    [[nodiscard]] Matrix24d stiffness(const ElementContent& content, std::span<const VoxelMaterial> materials) const;
-    [[nodiscard]] Matrix8d mass(const ElementContent& content, std::span<const VoxelMaterial> materials) const;
+    [[nodiscard]] Matrix24d stiffness(const ElementContent& content, std::span<const ElasticMaterial> materials) const;
+    [[nodiscard]] Matrix8d mass(const ElementContent& content, std::span<const ElasticMaterial> materials) const;
 
 private:
     /// For corner pair (c, d) and derivative axes (i, j): the 27 coefficients of

@@ -91,7 +91,7 @@ MaterialCoverage material_coverage(const Scene& scene, const grid::LabelGrid& la
 
 namespace vox::io {
 
-grid::VoxelMaterial to_voxel_material(const Material& m)
+grid::ElasticMaterial to_voxel_material(const Material& m)
 {
     return {grid::lame_from_young_poisson(m.youngs_modulus_pa, m.poisson_ratio), m.density_kg_m3};
 }

@@ -2,7 +2,7 @@
 // Builds the object a scene describes, and checks the parts of the scene that need it.
 
 #include "grid/label_grid.hpp"
-#include "grid/voxel_material.hpp"
+#include "grid/elastic_material.hpp"
 #include "io/scene.hpp"
 
 #include <map>
@@ -35,7 +35,7 @@ namespace vox::io {
 /// The grid's material table for a scene: index 0 is the default material, then one entry per
 /// label with its own material; `index_of(label)` maps a voxel label to its entry.
 struct MaterialTable {
-    std::vector<grid::VoxelMaterial> materials;
+    std::vector<grid::ElasticMaterial> materials;
     std::vector<Material> scene_materials; ///< the scene's entries, in the same order
     std::map<std::int32_t, std::int32_t> label_index;
     [[nodiscard]] std::int32_t index_of(std::int32_t label) const
@@ -44,7 +44,7 @@ struct MaterialTable {
         return it == label_index.end() ? 0 : it->second;
     }
 };
-[[nodiscard]] grid::VoxelMaterial to_voxel_material(const Material& m);
+[[nodiscard]] grid::ElasticMaterial to_voxel_material(const Material& m);
 [[nodiscard]] MaterialTable material_table(const Scene& scene);
 /// The table of scenes without a materials entry (and of files given without a scene).
 [[nodiscard]] MaterialTable default_material_table();

@@ -72,7 +72,7 @@ GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& mo
             const std::vector<double>& c = count[static_cast<std::size_t>(p)];
             const double held = std::accumulate(c.begin(), c.end(), 0.0);
             const double fill = std::clamp(held / capacity, k_fill_floor, 1.0);
-            TetMaterial m{{0.0, 0.0}, 0.0};
+            grid::ElasticMaterial m{{0.0, 0.0}, 0.0};
             const std::size_t dominant = held > 0.0 ? static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin())
                                                     : static_cast<std::size_t>(el.material);
             for (std::size_t k = 0; k < c.size(); ++k) {
@@ -80,7 +80,7 @@ GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& mo
                 const double share = held > 0.0 ? c[k] / held : (k == dominant ? 1.0 : 0.0);
                 m.lame.lambda += fill * share * grid_materials[k].lame.lambda;
                 m.lame.mu += fill * share * grid_materials[k].lame.mu;
-                m.density += fill * share * grid_materials[k].density_kg_m3;
+                m.density_kg_m3 += fill * share * grid_materials[k].density_kg_m3;
             }
             out.material.push_back(static_cast<std::uint32_t>(out.materials.size()));
             out.materials.push_back(m);

@@ -15,7 +15,7 @@ namespace vox::isxfem {
 
 struct GridTets {
     TetMesh mesh;                          ///< nodes: the model's rest positions, world m
-    std::vector<TetMaterial> materials;    ///< one per tetrahedron
+    std::vector<grid::ElasticMaterial> materials;    ///< one per tetrahedron
     std::vector<std::uint32_t> material;   ///< per tetrahedron: its index in `materials`
     std::vector<double> fill;              ///< per tetrahedron: share of its volume holding material
     /// Tetrahedra 6 e .. 6 e + 5 split model element e.

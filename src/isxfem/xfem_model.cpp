@@ -28,7 +28,7 @@ bool sliver_between(const std::vector<Region>& regions, double volume)
 
 } // namespace
 
-XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vector<std::uint32_t> material, double k)
+XfemModel::XfemModel(TetMesh mesh, std::vector<grid::ElasticMaterial> materials, std::vector<std::uint32_t> material, double k)
     : m_mesh(std::move(mesh)), m_materials(std::move(materials)), m_k(k)
 {
     if (!(k >= 0.0 && k <= 1.0)) throw std::invalid_argument("XfemModel: k must be in [0, 1], got " + std::to_string(k));
@@ -41,9 +41,9 @@ XfemModel::XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vect
         if (material[t] >= m_materials.size()) throw std::invalid_argument("XfemModel: material index out of range");
         e.material = material[t];
         e.geometry = tet_geometry(m_mesh.corners(t));
-        const TetMaterial& m = m_materials[e.material];
+        const grid::ElasticMaterial& m = m_materials[e.material];
         e.stiffness = tet_stiffness(e.geometry, m.lame);
-        e.mass = tet_mass(e.geometry, m.density);
+        e.mass = tet_mass(e.geometry, m.density_kg_m3);
         for (std::uint32_t n : e.node) m_support[n] += e.geometry.volume;
         for (std::size_t a = 0; a < 4; ++a)
             for (std::size_t b = a + 1; b < 4; ++b)
@@ -165,10 +165,10 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
             const XfemElement& e = m_elements[candidates[i]];
-            const TetMaterial& m = m_materials[e.material];
+            const grid::ElasticMaterial& m = m_materials[e.material];
             const auto corners = m_mesh.corners(candidates[i]);
             if (e.cuts.empty()) {
-                const CutTet c = cut_tet(corners, candidate_phi[i], m_k, m.lame, m.density, m_fitting);
+                const CutTet c = cut_tet(corners, candidate_phi[i], m_k, m.lame, m.density_kg_m3, m_fitting);
                 for (unsigned side = 0; side < 2; ++side)
                     if (c.side_volume[side] > 0.0) matrices[i].regions.push_back({side, c.side_volume[side], c.side_stiffness[side]});
                 matrices[i].mass = c.mass;
@@ -177,7 +177,7 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
                 std::vector<std::array<double, 4>> phi;
                 for (const ElementCut& earlier : e.cuts) phi.push_back(earlier.phi);
                 phi.push_back(candidate_phi[i]);
-                matrices[i] = multi_cut_tet(corners, phi, m_k, m.lame, m.density);
+                matrices[i] = multi_cut_tet(corners, phi, m_k, m.lame, m.density_kg_m3);
             }
         }
     });

@@ -22,6 +22,7 @@
 #include "isxfem/moment_fitting.hpp"
 #include "isxfem/plane_cut_system.hpp"
 #include "isxfem/tet_mesh.hpp"
+#include "grid/elastic_material.hpp"
 #include "isxfem/xfem_tetrahedron.hpp"
 
 #include <functional>
@@ -29,11 +30,6 @@
 #include <vector>
 
 namespace vox::isxfem {
-
-struct TetMaterial {
-    grid::Lame lame;
-    double density = 1000.0; ///< kg/m^3
-};
 
 /// The most cuts a tetrahedron takes (its dof blocks: 4 per node set, 4 + 4 k_max_cuts in all).
 constexpr std::size_t k_max_cuts = 2;
@@ -119,7 +115,7 @@ class XfemModel {
 public:
     /// `material`: per tetrahedron an index into `materials`. `k`: the Is-XFEM parameter in [0, 1]
     /// (0: standard XFEM).
-    XfemModel(TetMesh mesh, std::vector<TetMaterial> materials, std::vector<std::uint32_t> material, double k);
+    XfemModel(TetMesh mesh, std::vector<grid::ElasticMaterial> materials, std::vector<std::uint32_t> material, double k);
 
     /// Cuts by the plane where it crosses a tetrahedron whole within the region `inside` (a
     /// point of the plane, world m; all of the plane when null). `extend`: the id of an earlier
@@ -135,7 +131,7 @@ public:
 
     [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
     [[nodiscard]] const std::vector<XfemElement>& elements() const { return m_elements; }
-    [[nodiscard]] const std::vector<TetMaterial>& materials() const { return m_materials; }
+    [[nodiscard]] const std::vector<grid::ElasticMaterial>& materials() const { return m_materials; }
     [[nodiscard]] double k() const { return m_k; }
     [[nodiscard]] std::size_t node_count() const { return m_mesh.nodes.size(); }
     /// Dof blocks (3 dofs each): the nodes', then the enriched ones.
@@ -171,7 +167,7 @@ public:
 
 private:
     TetMesh m_mesh;
-    std::vector<TetMaterial> m_materials;
+    std::vector<grid::ElasticMaterial> m_materials;
     double m_k;
     MomentFitting m_fitting;
     std::vector<XfemElement> m_elements;

@@ -17,7 +17,7 @@ using namespace vox::grid;
 
 namespace {
 
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0},
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0},
                                              {lame_from_young_poisson(1e5, 0.3), 1200.0}};
 
 BranchedGrid build(const LabelGrid& labels, int levels)

@@ -24,7 +24,7 @@ bool operator==(const MaterialMoments& a, const MaterialMoments& b)
 
 namespace {
 
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0},
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0},
                                              {lame_from_young_poisson(1e5, 0.3), 1200.0}};
 std::int32_t material_of(std::int32_t label) { return label == 2 ? 1 : 0; }
 

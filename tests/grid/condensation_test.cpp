@@ -15,7 +15,7 @@ using namespace vox::grid;
 namespace {
 
 const Eigen::Vector3d k_voxel(0.617188e-3, 0.617188e-3, 1.33333e-3); // the liver's spacing, m
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0},
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0},
                                              {lame_from_young_poisson(1e5, 0.3), 1200.0}};
 
 /// A random voxel set of a level-L cell: each voxel present with probability `fill`; material 1

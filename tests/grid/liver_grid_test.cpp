@@ -16,7 +16,7 @@ using namespace vox::grid;
 
 namespace {
 
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0},
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1060.0},
                                              {lame_from_young_poisson(1e5, 0.45), 1100.0}};
 
 LabelGrid liver_labels(std::vector<std::int32_t> labels)

@@ -74,7 +74,7 @@ struct Closed {
 Closed closed_box(const std::function<std::vector<CutReport>(XfemModel&)>& cuts, double step = 0.39, bool cavity = false)
 {
     Closed out;
-    out.model = std::make_shared<XfemModel>(cube_lattice({6, 4, 4}, 1.0), std::vector<TetMaterial>{TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
+    out.model = std::make_shared<XfemModel>(cube_lattice({6, 4, 4}, 1.0), std::vector<vox::grid::ElasticMaterial>{vox::grid::ElasticMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}},
                                             std::vector<std::uint32_t>(6 * 96, 0), 0.1);
     XfemModel& model = *out.model;
     std::vector<Eigen::Vector3d> x;

@@ -29,7 +29,7 @@ CutPatch square_at_x(double x, double y0, double y1, double z0, double z1)
 
 XfemModel lattice_model()
 {
-    return {cube_lattice({6, 4, 4}, 1.0), {TetMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}}, std::vector<std::uint32_t>(6 * 96, 0), 0.1};
+    return {cube_lattice({6, 4, 4}, 1.0), {vox::grid::ElasticMaterial{vox::grid::lame_from_young_poisson(1e5, 0.3), 1000.0}}, std::vector<std::uint32_t>(6 * 96, 0), 0.1};
 }
 
 } // namespace

@@ -19,11 +19,11 @@ grid::BranchedGrid block_grid(const Eigen::Vector3d& size_mm, int levels)
 {
     grid::PhantomSpec spec = grid::default_phantom(grid::PhantomShape::beam);
     spec.size_mm = size_mm;
-    const std::vector<grid::VoxelMaterial> clay{{grid::lame_from_young_poisson(1e5, 0.3), 1500.0}};
+    const std::vector<grid::ElasticMaterial> clay{{grid::lame_from_young_poisson(1e5, 0.3), 1500.0}};
     return grid::BranchedGrid(grid::FineVoxels(grid::make_phantom(spec), [](std::int32_t) { return 0; }), clay, levels);
 }
 
-double tet_mass(const GridTets& t, std::size_t k) { return t.materials[t.material[k]].density * signed_volume(t.mesh.corners(k)); }
+double tet_mass(const GridTets& t, std::size_t k) { return t.materials[t.material[k]].density_kg_m3 * signed_volume(t.mesh.corners(k)); }
 
 } // namespace
 

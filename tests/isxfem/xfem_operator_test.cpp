@@ -28,7 +28,7 @@ Deformed deformed_bar(bool twice = false)
 {
     TetMesh bar = cube_lattice({4, 2, 2}, 0.01);
     const std::size_t tets = bar.tets.size();
-    Deformed d{XfemModel(std::move(bar), {TetMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}},
+    Deformed d{XfemModel(std::move(bar), {grid::ElasticMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}},
                          std::vector<std::uint32_t>(tets, 0), 0.1),
                {},
                {}};
@@ -152,7 +152,7 @@ TEST(XfemOperator, AtRestHasNoForceAndTheRotationsStayIdentity)
 {
     TetMesh bar = cube_lattice({3, 1, 1}, 0.01);
     const std::size_t tets = bar.tets.size();
-    XfemModel model(std::move(bar), {TetMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), 0.1);
+    XfemModel model(std::move(bar), {grid::ElasticMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), 0.1);
     model.cut(PlaneCut{Eigen::Vector3d::UnitX(), 0.013});
     XfemOperator op(model);
     std::vector<Eigen::Vector3d> x = model.mesh().nodes;

@@ -28,7 +28,7 @@ XfemModel bar_model(double k)
 {
     TetMesh bar = cube_lattice({8, 2, 2}, k_h);
     const std::size_t tets = bar.tets.size();
-    return XfemModel(std::move(bar), {TetMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), k);
+    return XfemModel(std::move(bar), {grid::ElasticMaterial{grid::lame_from_young_poisson(1e6, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), k);
 }
 
 /// The bar under gravity, held at its end x = 0.
@@ -276,7 +276,7 @@ TEST(XfemSolver, ACutKeepsTheWarpedFactorAndSolvesThePatchBesideIt)
     auto slab = [] {
         TetMesh mesh = cube_lattice({20, 4, 2}, k_h);
         const std::size_t tets = mesh.tets.size();
-        return XfemModel(std::move(mesh), {TetMaterial{grid::lame_from_young_poisson(1e5, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), 0.1);
+        return XfemModel(std::move(mesh), {grid::ElasticMaterial{grid::lame_from_young_poisson(1e5, 0.3), 1000.0}}, std::vector<std::uint32_t>(tets, 0), 0.1);
     };
     const PlaneCut plane{Eigen::Vector3d::UnitX(), 0.1003};
     auto upper = [](const Eigen::Vector3d& q) { return q.z() > 0.0099; };

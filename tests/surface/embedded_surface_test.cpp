@@ -17,7 +17,7 @@ using vox::surface::SurfaceMesh;
 
 namespace {
 
-const std::vector<VoxelMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0}};
+const std::vector<ElasticMaterial> k_materials{{lame_from_young_poisson(3e4, 0.45), 1000.0}};
 
 BranchedGrid make_grid(const LabelGrid& labels, int levels = 2)
 {
