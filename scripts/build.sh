@@ -5,6 +5,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 jobs=${JOBS:-$(nproc)}
+# ccache keys on paths relative to the checkout, so another clone of the project reuses the cache.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}
 
 bash "$root/scripts/install-deps.sh"
 generator=()
