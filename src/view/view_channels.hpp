@@ -1,0 +1,59 @@
+#pragma once
+// What the three threads of a viewer session share, and nothing else: triple buffers (the newest
+// complete value, no lock) for the surface near the tool (simulation -> haptics), the proxy's pose
+// (haptics -> simulation) and the picture (simulation -> window); and the requests the window
+// queues for the simulation thread as atomics it takes once each.
+
+#include "contact/surface_points.hpp"
+#include "contact/tool_shape.hpp"
+#include "haptics/triple_buffer.hpp"
+#include "render/renderer.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vox::view {
+
+/// What the simulation thread shows the window.
+struct RenderState {
+    std::vector<render::DrawMesh> meshes; ///< the surface first, then the tools (and the cage)
+    double t_s = 0.0;
+    std::size_t elements = 0;
+    int level = 0;
+    std::string tool;                     ///< the active tool and what it does
+    int smooth = 0;                       ///< display smoothing the window is to give the surface
+};
+
+/// The tool the haptic thread moved, where, and where the device is heading (the surface
+/// snapshot must reach that far).
+struct ProxyPose {
+    int tool = 0;
+    contact::PlacedShape pose;
+    Eigen::Vector3d heading = Eigen::Vector3d::Zero();
+};
+
+/// The window's requests to the simulation thread (the keys), each taken once by it.
+struct ViewRequests {
+    std::atomic<bool> stop{false}, paused{false}, step_once{false};
+    std::atomic<bool> show_cage{false}, show_voxels{false};
+    std::atomic<bool> save_object{false}, undo{false}, toggle_cut_mode{false};
+    /// A stroke begins (the mouse button went down): the state before it is kept for undo.
+    std::atomic<bool> stroke_started{false};
+    std::atomic<bool> picture_taken{true}; ///< the window has the last picture: make the next
+    std::atomic<int> active{0};            ///< the tool the device drives
+    std::atomic<int> level_change{0};      ///< +1 coarser, -1 finer
+    std::atomic<int> set_action{-1};       ///< 0 push, 1 cut, 2 wet for the active tool
+    std::atomic<std::uint64_t> ticks{0}, frames{0}; ///< counts for the rates the window shows
+};
+
+struct ViewChannels {
+    explicit ViewChannels(std::size_t snapshot_capacity) : snapshots(contact::SurfacePoints(snapshot_capacity)) {}
+    haptics::TripleBuffer<contact::SurfacePoints> snapshots;
+    haptics::TripleBuffer<ProxyPose> proxies;
+    haptics::TripleBuffer<RenderState> pictures;
+    ViewRequests requests;
+};
+
+} // namespace vox::view

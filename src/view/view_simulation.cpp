@@ -1,0 +1,145 @@
+#include "view/view_simulation.hpp"
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/mesh_writer.hpp"
+#include "sim/dbg_method.hpp"
+#include "view/scene_pictures.hpp"
+
+#include <algorithm>
+
+namespace vox::view {
+
+ViewSimulation::ViewSimulation(io::Scene& scene, std::unique_ptr<sim::Method> method, sim::ToolPolicy& tools, ViewChannels& channels,
+                               const ViewSimulationOptions& options)
+    : m_scene(scene), m_method(std::move(method)), m_tools(tools), m_channels(channels), m_options(options),
+      m_loop(scene, *m_method, tools), m_level(m_method->level())
+{
+    m_pose.shape = &tools.shape(0);
+    m_pose.position = m_heading = options.start_mm;
+}
+
+void ViewSimulation::let_go()
+{
+    m_tools.reset();
+    if (m_driven >= 0) m_tools.release(static_cast<std::size_t>(m_driven));
+    m_driven = -1;
+}
+
+void ViewSimulation::take_requests()
+{
+    ViewRequests& r = m_channels.requests;
+    if (const int d = r.level_change.exchange(0); d != 0) {
+        const int at = std::clamp(m_level + d, 1, m_options.grid_levels);
+        if (at != m_level) {
+            m_method = m_method->at_level(at);
+            m_loop.set_method(*m_method);
+            let_go();
+            m_level = at;
+            m_history.clear(); // the deformation restarts from rest at the new level
+            log::info("level {}: {} elements ({}the deformation from rest)", at, m_method->element_count(),
+                      m_method->name() == std::string("dbg") ? "the cuts kept, " : "uncut: Is-XFEM cannot carry cuts across levels yet; ");
+        }
+    }
+    if (r.undo.exchange(false)) {
+        if (m_history.undo(*m_method)) {
+            let_go();
+            log::info("undo: back to before the last stroke");
+        } else {
+            log::info("{}", m_method->checkpoint() ? "undo: nothing to undo" : "undo: not available with this method yet (docs/viewer.md)");
+        }
+    }
+    io::ToolSpec& active = m_scene.tools[static_cast<std::size_t>(r.active.load())];
+    if (const int a = r.set_action.exchange(-1); a >= 0)
+        active.action = a == 0 ? io::ToolAction::push : a == 1 ? io::ToolAction::cut : io::ToolAction::wet;
+    if (r.toggle_cut_mode.exchange(false)) {
+        if (m_scene.solver.type == io::SolverType::isxfem) log::info("Is-XFEM cuts by separating only (it cannot remove material)");
+        else active.cut_mode = active.cut_mode == io::CutMode::remove ? io::CutMode::separate : io::CutMode::remove;
+    }
+}
+
+bool ViewSimulation::step(double now_s)
+{
+    ViewRequests& r = m_channels.requests;
+    take_requests();
+    if (r.paused.load() && !r.step_once.exchange(false)) return false;
+    if (m_channels.proxies.update()) {
+        const ProxyPose& p = m_channels.proxies.read_slot();
+        if (p.tool != m_driven && m_driven >= 0) m_tools.release(static_cast<std::size_t>(m_driven));
+        m_driven = p.tool;
+        m_pose = p.pose;
+        m_heading = p.heading;
+    }
+    // A stroke's checkpoint before any of its cuts: the window flags the stroke before it moves
+    // the pointer, so a pose read above that belongs to the stroke sees the flag.
+    if (r.stroke_started.exchange(false)) m_history.before_stroke(*m_method);
+    if (m_driven >= 0) m_tools.drive(static_cast<std::size_t>(m_driven), m_pose.position, m_pose.orientation);
+    try {
+        m_loop.next();
+    } catch (const InputError& e) { // a step that cannot be trusted: said, and the session paused to keep it
+        log::warn("{}; paused (SPACE runs on, U undoes the last stroke)", e.what());
+        r.paused = true;
+    }
+    // The surface near the tool and where the device is heading, for the haptic thread.
+    contact::SurfacePoints& out = m_channels.snapshots.write_slot();
+    const io::ToolSpec& held = m_scene.tools[static_cast<std::size_t>(std::max(m_driven, 0))];
+    Eigen::AlignedBox3d near = m_pose.world_bounds(held.push_margin_mm + 5.0);
+    near.extend(contact::PlacedShape{m_pose.shape, m_heading, m_pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
+    m_method->sample_surface(near, held, out);
+    out.t_s = now_s;
+    m_channels.snapshots.publish();
+    if (r.save_object.exchange(false)) save();
+    if (r.picture_taken.exchange(false)) make_picture();
+    r.frames.fetch_add(1, std::memory_order_relaxed);
+    return true;
+}
+
+void ViewSimulation::save() const
+{
+    try {
+        const std::filesystem::path& dir = m_options.out_dir;
+        const surface::SurfaceMesh m = m_method->surface_mesh();
+        for (const char* name : {"view_surface.obj", "view_surface.ply", "view_surface.stl"})
+            io::write_mesh((dir / name).string(), m.positions, m.triangles, m.labels);
+        log::info("saved the deformed surface to {}.obj, .ply and .stl ({} triangles)", (dir / "view_surface").string(), m.triangles.size());
+        if (const auto* dbg = dynamic_cast<const sim::DbgMethod*>(m_method.get())) { // the voxels left, as the branched grid has them
+            const grid::FineVoxels& voxels = dbg->grid().voxels();
+            grid::LabelGrid kept(voxels.index_to_world());
+            for (std::uint32_t v = 0; v < voxels.slots(); ++v)
+                if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
+            kept.save(dir / "view_object.vdb");
+            log::info("saved the object's {} voxels to {}", voxels.alive_count(), (dir / "view_object.vdb").string());
+        }
+    } catch (const std::exception& e) {
+        log::warn("not saved: {}", e.what()); // the session goes on
+    }
+}
+
+void ViewSimulation::make_picture()
+{
+    const ViewRequests& q = m_channels.requests;
+    RenderState& r = m_channels.pictures.write_slot();
+    r.meshes.clear();
+    const auto* dbg = dynamic_cast<const sim::DbgMethod*>(m_method.get()); // voxels and cages are the branched grid's
+    if (q.show_voxels.load() && dbg) {
+        r.meshes.push_back(voxel_boxes(dbg->simulation()));
+        r.smooth = 0;
+    } else {
+        r.meshes.push_back(surface_picture(*m_method, 0)); // smoothed by the window's thread
+        r.smooth = m_options.smooth;
+    }
+    for (std::size_t k = 0; k < m_scene.tools.size(); ++k) add_tool_drawings(m_tools.placed(k), m_scene.tools[k].push_margin_mm, r.meshes);
+    if (q.show_cage.load() && dbg) r.meshes.push_back(element_cage(dbg->simulation()));
+    r.t_s = m_loop.frames() * m_scene.solver.dt_s;
+    r.elements = m_method->element_count();
+    r.level = m_level;
+    const io::ToolSpec& tool = m_scene.tools[static_cast<std::size_t>(q.active.load())];
+    r.tool = tool.name + " (" +
+             (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")
+              : tool.action == io::ToolAction::wet ? std::string("wet")
+                                                   : std::string("push")) +
+             ")";
+    m_channels.pictures.publish();
+}
+
+} // namespace vox::view

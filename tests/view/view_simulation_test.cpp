@@ -1,0 +1,81 @@
+// The viewer's simulation thread driven without threads or a window, as the window and the
+// haptic thread drive it: the proxy's pose through its triple buffer, the keys as requests. On
+// both methods: a stroke cuts, U undoes it, pausing stops the frames, + changes the level, S saves.
+
+#include "io/scene.hpp"
+#include "io/scene_object.hpp"
+#include "sim/dbg_method.hpp"
+#include "sim/isxfem_method.hpp"
+#include "test_support.hpp"
+#include "view/view_simulation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace vox::view {
+namespace {
+
+class ViewSimulationOnEachMethod : public ::testing::TestWithParam<io::SolverType> {};
+
+TEST_P(ViewSimulationOnEachMethod, AStrokeCutsUndoPutsItBackAndTheKeysAreTaken)
+{
+    io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json");
+    io::use_method(scene, GetParam());
+    scene.script.clear(); // the device moves the tool, as in the viewer
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    std::unique_ptr<sim::Method> method;
+    if (GetParam() == io::SolverType::dbg) method = std::make_unique<sim::DbgMethod>(scene, labels, 2, 3);
+    else method = std::make_unique<sim::IsxfemMethod>(scene, labels, 2);
+    sim::ToolPolicy tools(scene);
+    ViewChannels channels(20000);
+    ViewSimulationOptions options;
+    options.grid_levels = 3;
+    options.out_dir = vox::test::fresh_dir(std::string("view_simulation_") + (GetParam() == io::SolverType::dbg ? "dbg" : "isxfem"));
+    ViewSimulation simulation(scene, std::move(method), tools, channels, options);
+    ViewRequests& keys = channels.requests;
+    const std::size_t dofs = simulation.method().dof_count();
+
+    // The blade down through the bar, 1.2 mm a frame, as the haptic thread would report it.
+    keys.stroke_started = true;
+    const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
+    for (int f = 0; f < 30; ++f) {
+        channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
+        channels.proxies.publish();
+        ASSERT_TRUE(simulation.step(0.01 * f));
+    }
+    EXPECT_GT(simulation.method().dof_count(), dofs) << "the stroke cut";
+    EXPECT_EQ(simulation.history().size(), 1u);
+    EXPECT_GT(channels.snapshots.latest().count, 0u) << "the surface near the blade went to the haptic thread";
+    EXPECT_TRUE(channels.pictures.update());
+    EXPECT_FALSE(channels.pictures.read_slot().meshes.empty());
+
+    keys.undo = true;
+    ASSERT_TRUE(simulation.step(0.5));
+    EXPECT_EQ(simulation.method().dof_count(), dofs) << "back to before the stroke";
+    EXPECT_EQ(simulation.history().size(), 0u);
+
+    keys.paused = true;
+    EXPECT_FALSE(simulation.step(0.6)); // no frame while paused
+    keys.step_once = true;
+    EXPECT_TRUE(simulation.step(0.61)); // N: one
+    keys.paused = false;
+
+    keys.save_object = true;
+    ASSERT_TRUE(simulation.step(0.7));
+    EXPECT_TRUE(std::filesystem::exists(options.out_dir / "view_surface.obj"));
+
+    keys.level_change = 1;
+    ASSERT_TRUE(simulation.step(0.8));
+    EXPECT_EQ(simulation.level(), 3);
+    EXPECT_EQ(simulation.method().level(), 3);
+    keys.level_change = 1; // beyond the grid's levels: stays
+    ASSERT_TRUE(simulation.step(0.9));
+    EXPECT_EQ(simulation.level(), 3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, ViewSimulationOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
+                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
+
+} // namespace
+} // namespace vox::view
