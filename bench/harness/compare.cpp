@@ -15,6 +15,8 @@
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -157,10 +159,29 @@ void run_compare(const std::string& scene_path, std::optional<int> frame_count, 
                       n ? std::sqrt(sum_d / n) : 0.0, worst);
         md << line;
     }
+    // The same figures as data, for scripts and for rendering tables elsewhere.
+    nlohmann::json data{{"scene", scene_path}, {"frames", frames}, {"dt_s", dt}, {"level", scene.object.levels},
+                        {"machine", machine_description()}, {"methods", nlohmann::json::array()}};
+    for (const Run& r : runs)
+        data["methods"].push_back({{"method", r.method},
+                                   {"dofs_start", r.dofs_start},
+                                   {"dofs_end", r.dofs_end},
+                                   {"frame_ms", r.frame_ms},
+                                   {"step_ms", r.step_ms},
+                                   {"cut_update_ms", r.cut_ms},
+                                   {"cg_iterations", r.iterations},
+                                   {"converged_steps", r.converged},
+                                   {"frames_held", r.held},
+                                   {"diverged", !r.finite},
+                                   {"volume_before_mm3", r.volume_before_mm3},
+                                   {"volume_after_mm3", r.volume_after_mm3},
+                                   {"surface_triangles", r.triangles},
+                                   {"pieces", r.pieces}});
     std::filesystem::create_directories(out);
-    const std::filesystem::path file = out / ("compare-" + std::filesystem::path(scene_path).stem().string() + ".md");
-    write_atomically(file, [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
-    std::printf("%s\nwrote %s\n", md.str().c_str(), file.c_str());
+    const std::string stem = "compare-" + std::filesystem::path(scene_path).stem().string();
+    write_atomically(out / (stem + ".md"), [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
+    write_atomically(out / (stem + ".json"), [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << data.dump(1) << '\n'; });
+    std::printf("%s\nwrote %s and %s\n", md.str().c_str(), (out / (stem + ".md")).c_str(), (out / (stem + ".json")).c_str());
 }
 
 } // namespace vox::bench

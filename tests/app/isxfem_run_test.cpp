@@ -260,4 +260,16 @@ TEST(IsxfemRun, CompareRunsBothMethodsOnTheSameScene)
         const std::string line = md.str().substr(row, md.str().find('\n', row) - row);
         EXPECT_NE(line.find("12 of 12"), std::string::npos) << line; // every frame of each method converged
     }
+    // Every column measured for every method, by the same code: the same figures, none missing.
+    std::ifstream json_in(out / "compare-bar_cut_isxfem.json");
+    const nlohmann::json data = nlohmann::json::parse(json_in);
+    ASSERT_EQ(data["methods"].size(), 3u);
+    for (const nlohmann::json& m : data["methods"]) {
+        EXPECT_EQ(m.size(), data["methods"][0].size()) << m["method"];
+        for (const auto& [key, value] : m.items()) EXPECT_FALSE(value.is_null()) << m["method"] << " " << key;
+        EXPECT_EQ(m["frame_ms"].size(), 12u) << m["method"];
+        EXPECT_GT(m["cut_update_ms"].size(), 0u) << m["method"] << ": the blade cut";
+        EXPECT_NEAR(m["volume_before_mm3"].get<double>(), 1e4, 100.0) << m["method"]; // the 100 x 10 x 10 mm bar
+        EXPECT_NEAR(m["volume_after_mm3"].get<double>(), m["volume_before_mm3"].get<double>(), 200.0) << m["method"]; // separating keeps it
+    }
 }
