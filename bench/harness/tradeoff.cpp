@@ -9,7 +9,8 @@
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
 #include "io/scene_object.hpp"
-#include "sim/dbg_simulation.hpp"
+#include "sim/dbg_method.hpp"
+#include "sim/frame_loop.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -21,12 +22,10 @@
 
 namespace vox::bench {
 
-using sim::build_scene_grid;
 using sim::DbgSimulation;
 
 
 using sim::DbgSimulation;
-using sim::build_scene_grid;
 namespace {
 
 constexpr int k_liver_reference = 1;
@@ -59,11 +58,14 @@ nlohmann::json static_scene(nlohmann::json object, double youngs_modulus_pa, dou
 Solution solve_static(const nlohmann::json& document)
 {
     const io::Scene scene = io::parse_scene(document, std::filesystem::current_path(), "bench scene");
-    const grid::LabelGrid labels = io::build_scene_object(scene);
+    auto labels = std::make_shared<const grid::LabelGrid>(io::build_scene_object(scene));
     const int level = scene.object.levels;
-    const grid::BranchedGrid g = build_scene_grid(scene, labels, std::min(6, std::max(level, 1) + 3));
-    DbgSimulation sim(scene, g, level);
-    const fem::StepStats s = sim.solver().step();
+    // One frame of the frame loop every command uses: a static scene's frame is its equilibrium.
+    sim::DbgMethod method(scene, labels, level, std::min(6, std::max(level, 1) + 3));
+    sim::ToolPolicy tools(scene);
+    const sim::StepFigures s = sim::FrameLoop(scene, method, tools).next().step;
+    const DbgSimulation& sim = method.simulation();
+    const grid::BranchedGrid& g = method.grid();
 
     Solution out;
     out.level = level;

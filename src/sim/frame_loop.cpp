@@ -31,7 +31,7 @@ FrameStats FrameLoop::next()
     const StepFigures& s = out.step;
     if (s.energy_guarded) throw InputError(energy_guard_message(m_scene, m_frame));
     if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)))
-        throw InputError(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
+        throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
                          " (non-finite energy); reduce solver.dt_s or check the materials");
     return out;
 }

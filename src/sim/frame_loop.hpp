@@ -4,6 +4,7 @@
 // object while it marks its cut. `voxsculpt run`, the viewer, device runs, every bench and the
 // tests step through it, so they simulate the same thing.
 
+#include "core/error.hpp"
 #include "sim/method.hpp"
 #include "sim/tool_policy.hpp"
 
@@ -19,6 +20,13 @@ struct FrameStats {
     StepFigures step; ///< zero (and converged) while the object is held
 };
 
+/// A step whose state is no longer finite: what follows cannot be computed (an InputError, so a
+/// command reports it as bad input; benches tell it from other refusals).
+class Diverged : public InputError {
+public:
+    using InputError::InputError;
+};
+
 /// The message of a step that still created energy at 1/32 of dt: the loads or the time step are
 /// beyond what this object and level can follow.
 [[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
@@ -28,8 +36,8 @@ public:
     /// Keeps references to all four (`device` may be null: the tools follow the script).
     FrameLoop(const io::Scene& scene, Method& method, ToolPolicy& tools, DeviceRun* device = nullptr);
 
-    /// The next frame. Throws the scene's InputError when its step diverged or created energy
-    /// even split into 32 substeps: what follows could not be trusted.
+    /// The next frame. Throws Diverged when its state is no longer finite, InputError when its
+    /// step created energy even split into 32 substeps: what follows could not be trusted.
     FrameStats next();
 
     /// Frames done so far.
