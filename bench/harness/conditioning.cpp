@@ -4,7 +4,9 @@
 #include "isxfem/plane_cut_system.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -128,9 +130,22 @@ void write_conditioning(const std::filesystem::path& dir, const std::vector<Cond
         for (double c : r.regularised) md << " | " << number(c);
         md << " |\n";
     }
+    // The same rows as data (infinite condition numbers, "singular" above, as null).
+    auto finite_or_null = [](double c) { return std::isfinite(c) ? nlohmann::json(c) : nlohmann::json(); };
+    nlohmann::json data = nlohmann::json::array();
+    for (const ConditioningRow& r : rows) {
+        nlohmann::json k = nlohmann::json::array(), a = nlohmann::json::array(), reg = nlohmann::json::array();
+        for (double c : r.k) k.push_back(finite_or_null(c));
+        for (double c : r.a) a.push_back(finite_or_null(c));
+        for (double c : r.regularised) reg.push_back(finite_or_null(c));
+        data.push_back({{"method", r.method}, {"theta", r.theta}, {"free_dofs", r.dofs}, {"min_volume_ratio", r.min_volume_ratio},
+                        {"k_plain_volume_ratio_weighted_jacobi", k}, {"a_plain_volume_ratio_weighted_jacobi", a},
+                        {"regularised_dofs", r.regularised_dofs}, {"a_regularised_plain_jacobi", reg}});
+    }
     std::filesystem::create_directories(dir);
     write_atomically(dir / "conditioning.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
-    std::printf("%s\nwrote %s\n", md.str().c_str(), (dir / "conditioning.md").c_str());
+    write_atomically(dir / "conditioning.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << data.dump(1) << '\n'; });
+    std::printf("%s\nwrote %s and conditioning.json\n", md.str().c_str(), (dir / "conditioning.md").c_str());
 }
 
 } // namespace vox::bench

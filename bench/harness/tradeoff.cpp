@@ -221,8 +221,21 @@ void run_tradeoff(const std::filesystem::path& out, bool liver)
         errors.push_back(liver_errors);
     }
     md << "\n![error against solve time](tradeoff.svg)\n";
+    // The same rows as data.
+    nlohmann::json data = nlohmann::json::object();
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        nlohmann::json rows = nlohmann::json::array();
+        for (std::size_t i = 0; i < series[k].second.size(); ++i) {
+            const Solution& s = series[k].second[i];
+            rows.push_back({{"level", s.level}, {"elements", s.elements}, {"dofs", s.dofs}, {"solve_ms", s.solve_ms},
+                            {"cg_iterations", s.cg_iterations}, {"surface_error", errors[k][i]}});
+        }
+        data[series[k].first] = rows;
+    }
+    data["beam_euler_bernoulli_tip_mm"] = euler_bernoulli_mm;
     std::filesystem::create_directories(out);
     write_atomically(out / "tradeoff.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
+    write_atomically(out / "tradeoff.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << data.dump(1) << '\n'; });
     write_atomically(out / "tradeoff.svg", [&](const std::filesystem::path& tmp) {
         std::ofstream(tmp) << svg_plot(series, errors);
     });
