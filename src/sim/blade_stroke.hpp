@@ -8,10 +8,9 @@
 // as it goes (a curved incision, however far it comes round) by up to 10 degrees a frame, and
 // waver across its plane by up to 1 mm in all (that motion dropped, so the crack does not step
 // sideways); past that a new stroke, a new cut, begins. A tetrahedron the blade crosses whole
-// only over several frames is cut once it has been. The caller says which frames count (from the
-// break-in, or from the first touch when the tool marks its cut in two phases) and when to cut
-// what they swept
-// (app/isxfem_tools.hpp).
+// only over several frames is cut once it has been. The caller says what each frame's patch is for
+// (cut now, marked for a two-phase cut, or only carrying the stroke on: sim/isxfem_method.cpp, as
+// the tool policy decides).
 
 #include "sim/isxfem_simulation.hpp"
 #include "io/tool_script.hpp"
