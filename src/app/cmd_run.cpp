@@ -3,7 +3,8 @@
 // contact, cut and wet it; the object deforms under gravity, loads, constraints and the tools, one
 // frame at a time through the frame loop every command shares (sim/frame_loop.hpp). Writes
 // DIR/stats.json (sim/run_record.hpp), DIR/final.obj and DIR/frame_NNNNN.obj, and with
-// --render-every pictures.
+// --render-every pictures: all into a staging folder moved into DIR when the run completes, so
+// a run that fails leaves nothing behind.
 
 #include "app/commands.hpp"
 #include "view/scene_pictures.hpp"
@@ -11,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "core/staging_dir.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -119,7 +121,8 @@ void add_run_command(CLI::App& app)
         const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
         const int frames = args->frames.value_or(duration > 0 ? static_cast<int>(std::ceil(duration / dt)) : 100);
         const std::filesystem::path out = args->out.empty() ? scene.output.dir : std::filesystem::path(args->out);
-        std::filesystem::create_directories(out);
+        StagingDir staging(out); // a run that fails leaves nothing behind
+        const std::filesystem::path& dir = staging.path();
         log::info("{}: {}, {} frames of {} s ({}; {})", args->scene, method.description(), frames, dt,
                   scene.solver.mode == io::SolverMode::static_equilibrium ? "quasi-static" : "implicit Euler", method.linear_solver());
 
@@ -138,22 +141,23 @@ void add_run_command(CLI::App& app)
                         tool_forces.push_back({frame.t_s, t.position_mm, t.force_n});
                         break;
                     }
-            if (pictures && f % args->render_every == 0) pictures->write(out / sim::frame_file_name(f, "png"), method, tools, scene);
-            if (f % scene.output.mesh_every_n_frames == 0) write_surface(out / sim::frame_file_name(f, "obj"), method);
+            if (pictures && f % args->render_every == 0) pictures->write(dir / sim::frame_file_name(f, "png"), method, tools, scene);
+            if (f % scene.output.mesh_every_n_frames == 0) write_surface(dir / sim::frame_file_name(f, "obj"), method);
             progress.update(static_cast<std::uint64_t>(f));
         }
         progress.finish();
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
-        write_surface(out / "final.obj", method);
-        if (pictures) pictures->write(out / "final.png", method, tools, scene);
+        write_surface(dir / "final.obj", method);
+        if (pictures) pictures->write(dir / "final.png", method, tools, scene);
         if (device) {
-            sim::write_forces(out, device->forces(), "force on the device, " + scene.tools[device->tool()].name);
+            sim::write_forces(dir, device->forces(), "force on the device, " + scene.tools[device->tool()].name);
             if (!args->record.empty()) haptics::write_recording(args->record, device->recording());
         } else if (!tool_forces.empty()) {
-            sim::write_forces(out, tool_forces, "contact force on the tool");
+            sim::write_forces(dir, tool_forces, "contact force on the tool");
         }
-        write_atomically(out / "stats.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << record.document().dump(1) << '\n'; });
+        write_atomically(dir / "stats.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << record.document().dump(1) << '\n'; });
+        staging.commit();
         log::info("wrote {}: stats.json, final.obj and {} frame meshes; mean step {:.2f} ms, max displacement {:.3f} mm", out.string(),
                   frames / scene.output.mesh_every_n_frames, record.total_step_ms() / std::max(frames, 1),
                   record.last_step().max_displacement_mm);

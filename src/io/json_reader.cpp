@@ -81,13 +81,27 @@ private:
 
 } // namespace
 
+/// How deep a JSON value may nest (a scene nests four or five levels).
+constexpr int k_max_json_depth = 64;
+
 json parse_json(const std::string& text, const std::string& source)
 {
     try {
         DuplicateKeyCheck check(source);
         return json::parse(
-            text, [&check](int depth, json::parse_event_t event, json& parsed) { return check(depth, event, parsed); },
+            text,
+            [&](int depth, json::parse_event_t event, json& parsed) {
+                // A hostile file nests arrays 100,000 deep (gigabytes, minutes): no scene nests deeper than a few levels.
+                if (depth > k_max_json_depth)
+                    throw file_error(source, "values nested deeper than " + std::to_string(k_max_json_depth) + " levels (the limit)");
+                return check(depth, event, parsed);
+            },
             /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    } catch (const json::out_of_range& e) {
+        // nlohmann: "[json.exception.out_of_range.406] number overflow parsing '1e999'"
+        const std::string what = e.what();
+        const std::size_t quote = what.find('\'');
+        throw file_error(source, "a number too large for a double" + (quote == std::string::npos ? std::string() : ": " + what.substr(quote)));
     } catch (const json::parse_error& e) {
         // nlohmann: "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..."
         static const std::regex located(R"(line (\d+), column (\d+): (.*))");

@@ -351,7 +351,7 @@ SolverSettings read_solver(JsonReader r)
     if (const std::optional<JsonNode> node = r.optional_node("mode")) {
         s.mode = choose_enum(*node, solver_modes);
     }
-    s.dt_s = r.optional("dt_s", s.dt_s, positive);
+    s.dt_s = r.optional("dt_s", s.dt_s, half_open_range(0.0, 10.0)); // beyond 10 s no interactive scene means it
     s.cg_tolerance = r.optional("cg_tolerance", s.cg_tolerance, open_range(0.0, 1.0));
     s.cg_max_iterations = r.optional("cg_max_iterations", s.cg_max_iterations, at_least(1));
     s.rayleigh_mass_per_s = r.optional("rayleigh_mass_per_s", s.rayleigh_mass_per_s, at_least(0.0));
@@ -557,6 +557,8 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     }
     if (gravity) {
         scene.gravity_m_s2 = finite_vector(*gravity);
+        if (scene.gravity_m_s2.norm() > 1e3) // 100 g: beyond that no scene means it, and steps only create energy
+            gravity->fail("is stronger than 1000 m/s^2 (about 100 g), the most a scene may ask");
     }
     if (constraints) {
         for (const JsonNode& node : constraints->elements()) {

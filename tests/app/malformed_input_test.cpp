@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
@@ -71,4 +72,20 @@ TEST(MalformedInput, UsualMistakes)
     expect_clean_refusal(run_voxsculpt("import " + quote(VOX_SOURCE_DIR "/data/cylinder.off") + " -o " + o),
                          "cylinder.off", out);
     expect_clean_refusal(run_voxsculpt("phantom block --voxel-mm 3 -o " + o), "not a whole number", out);
+}
+
+TEST(MalformedInput, ARunThatFailsMidwayLeavesNothingBehind)
+{
+    // Loads far beyond what the beam can follow: the run stops at its first frame. Its output
+    // folder must not appear (it is written in a staging folder moved into place at the end), and
+    // no staging folder may be left either.
+    const fs::path d = fresh_dir("bad_run_midway");
+    std::ofstream(d / "scene.json") << R"({"object": {"phantom": {"shape": "beam"}, "levels": 2},
+        "loads": [{"box_mm": [[190, -1, -1], [201, 11, 11]], "force_n": [0, 0, -1e9]}],
+        "output": {"mesh_every_n_frames": 1}})";
+    const auto r = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 5 --out " + quote((d / "out").string()));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("frame 1"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out"));
+    for (const auto& entry : fs::directory_iterator(d)) EXPECT_EQ(entry.path().filename(), "scene.json") << "left behind: " << entry.path();
 }

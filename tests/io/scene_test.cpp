@@ -775,7 +775,9 @@ const BadScene bad_scenes[] = {
              "unknown key for a beam phantom (known keys: shape, voxel_mm, size_mm)"},
     BadScene{"wrong_type", "object.select.label[0]", "expected an integer, got \"abc\""},
     BadScene{"missing_file", "object.volume", "file not found: "},
-    BadScene{"negative_dt", "solver.dt_s", "must be > 0, got -0.01"},
+    BadScene{"negative_dt", "solver.dt_s", "must be in (0, 10], got -0.01"},
+    BadScene{"dt_huge", "solver.dt_s", "must be in (0, 10], got 1e+300"},
+    BadScene{"gravity_huge", "gravity_m_s2", "is stronger than 1000 m/s^2"},
     BadScene{"empty_tool_name", "tools[0].name", "a tool needs a name"},
     BadScene{"duplicate_tool_name", "tools[1].name", "a tool named \"blade\" is already declared (tools[0])"},
     BadScene{"undeclared_tool", "script[1].tool", "no tool named \"blad\" in tools (declared: \"blade\")"},
@@ -831,7 +833,9 @@ const BadScene bad_scenes[] = {
     BadScene{"plastic_yield", "materials.default.plasticity.yield_strain", "must be > 0, got -0.1"},
     BadScene{"wet_ratio_zero", "materials.default.wetting.stiffness_ratio", "must be in (0, 1], got 0"},
     BadScene{"water_above_one", "wet_regions[0].water", "must be in [0, 1], got 1.5"},
-    BadScene{"preconditioner", "solver.preconditioner", "expected one of \"auto\", \"jacobi\""}};
+    BadScene{"preconditioner", "solver.preconditioner", "expected one of \"auto\", \"jacobi\""},
+    BadScene{"number_overflow", "", "a number too large for a double: '1e999'"},
+    BadScene{"deep_nesting", "", "values nested deeper than 64 levels (the limit)"}};
 
 class SceneBadFile : public testing::TestWithParam<BadScene> {};
 
