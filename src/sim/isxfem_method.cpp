@@ -189,7 +189,7 @@ std::vector<SurfaceMark> IsxfemMethod::surface_marks() const
     return out;
 }
 
-std::vector<float> IsxfemMethod::surface_wetness() const { return std::vector<float>(m_sim->surface_marks().size(), 0.0f); }
+std::vector<float> IsxfemMethod::surface_wetness() const { return std::vector<float>(m_sim->surface_vertex_count(), 0.0f); }
 
 std::vector<Eigen::Vector3d> IsxfemMethod::surface_displacements_mm() const
 {

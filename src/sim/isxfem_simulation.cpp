@@ -152,6 +152,12 @@ void IsxfemSimulation::refresh_closed_surface() const
     m_closed_revision = m_model->revision();
 }
 
+std::size_t IsxfemSimulation::surface_vertex_count() const
+{
+    refresh_closed_surface();
+    return m_closed_vertices.size();
+}
+
 isxfem::ClosureCounts IsxfemSimulation::closure_counts() const
 {
     refresh_closed_surface();

@@ -44,6 +44,8 @@ public:
     /// separate (two cuts crossing inside it, or a further cut left out there).
     enum class Mark : unsigned char { surface, cut, coupled };
     [[nodiscard]] std::vector<Mark> surface_marks() const;
+    /// How many vertices surface_mesh() has (without placing them).
+    [[nodiscard]] std::size_t surface_vertex_count() const;
     /// What closing the surface along the cuts made, and what it had to leave open.
     [[nodiscard]] isxfem::ClosureCounts closure_counts() const;
     /// Displacement (m) of every used surface vertex, in the order of surface_mesh()'s vertices.

@@ -3,6 +3,7 @@
 
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
+#include "sim/bundled_scene.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/run_record.hpp"
@@ -15,17 +16,8 @@
 namespace vox::sim {
 namespace {
 
-io::Scene bundled(const char* name, io::SolverType type)
-{
-    io::Scene scene = io::load_scene(std::string(VOX_SOURCE_DIR "/data/scenes/") + name);
-    io::use_method(scene, type);
-    return scene;
-}
-
-std::unique_ptr<Method> open(const io::Scene& scene)
-{
-    return open_method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene))).method;
-}
+using test::bundled;
+using test::open;
 
 std::set<std::string> keys(const nlohmann::json& object)
 {

@@ -4,6 +4,7 @@
 
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
+#include "sim/bundled_scene.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
 
@@ -14,12 +15,8 @@
 namespace vox::sim {
 namespace {
 
-io::Scene bundled(const char* name, io::SolverType type)
-{
-    io::Scene scene = io::load_scene(std::string(VOX_SOURCE_DIR "/data/scenes/") + name);
-    io::use_method(scene, type);
-    return scene;
-}
+using test::bundled;
+using test::open;
 
 struct Simulated {
     std::unique_ptr<Method> method;
@@ -28,9 +25,8 @@ struct Simulated {
 
 Simulated simulate(const io::Scene& scene, int frames)
 {
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     Simulated r;
-    r.method = open_method(scene, labels).method;
+    r.method = open(scene);
     ToolPolicy tools(scene);
     FrameLoop loop(scene, *r.method, tools);
     for (int f = 0; f < frames; ++f) r.frames.push_back(loop.next());
@@ -86,8 +82,7 @@ TEST_P(EachMethod, ATwoPhaseKnifeHoldsTheObjectWhileItMarksThenCutsOnceAndLetsIt
 TEST_P(EachMethod, ADrivenToolIsWhereTheDeviceSaysAndTheScriptAgainOnceReleased)
 {
     const io::Scene scene = bundled("bar_cut_isxfem.json", GetParam());
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-    std::unique_ptr<Method> method = open_method(scene, labels).method;
+    std::unique_ptr<Method> method = open(scene);
     ToolPolicy tools(scene);
     FrameLoop loop(scene, *method, tools);
     const Eigen::Vector3d away(50, 5, 60); // well above the bar

@@ -4,6 +4,7 @@
 
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
+#include "sim/bundled_scene.hpp"
 #include "sim/dbg_method.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/isxfem_method.hpp"
@@ -14,12 +15,7 @@
 namespace vox::sim {
 namespace {
 
-io::Scene bar(io::SolverType type)
-{
-    io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json");
-    io::use_method(scene, type);
-    return scene;
-}
+io::Scene bar(io::SolverType type) { return test::bundled("bar_cut_isxfem.json", type); }
 
 class UndoOnEachMethod : public ::testing::TestWithParam<io::SolverType> {};
 
