@@ -1,11 +1,16 @@
 #include "grid/label_grid_vdb.hpp"
 
 #include "core/atomic_file.hpp"
+#include "core/child_process.hpp"
 #include "core/error.hpp"
+#include "core/memory_limit.hpp"
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 
+#include <fstream>
 #include <mutex>
+#include <sstream>
 
 namespace vox::grid {
 
@@ -139,27 +144,86 @@ void LabelGrid::save(const std::filesystem::path& path) const
     });
 }
 
+namespace {
+
+/// The label grid of an OpenVDB file's grids: the int32 grid named "labels", else the first int32
+/// grid; null when there is none.
+openvdb::Int32Grid::Ptr label_grid_of(const openvdb::GridPtrVec& grids)
+{
+    openvdb::Int32Grid::Ptr found;
+    for (const auto& g : grids) {
+        auto ig = openvdb::gridPtrCast<openvdb::Int32Grid>(g);
+        if (!ig) continue;
+        if (!found || ig->getName() == "labels") found = ig;
+    }
+    return found;
+}
+
+/// The wall time a child may take to read `bytes` of .vdb: far more than a sound file needs (tens of
+/// milliseconds for the bundled ones; OpenVDB reads hundreds of MB a second).
+double read_seconds_allowed(std::uint64_t bytes) { return 3.0 + 0.1 * static_cast<double>(bytes >> 20); }
+
+/// Reads the file in a child process first: OpenVDB's reader trusts the counts in a file, so a
+/// corrupt one can crash it, spin for ever or allocate gigabytes. Only when the child read it
+/// cleanly, within the memory limit and in time, does this process read the same bytes.
+void check_in_child(std::istringstream& in, const std::string& name, std::uint64_t bytes)
+{
+    const ChildLimits limits{memory_limit_bytes(), read_seconds_allowed(bytes), true};
+    const ChildOutcome outcome = run_in_child(
+        [&] {
+            openvdb::io::Stream stream(in);
+            const openvdb::Int32Grid::Ptr grid = label_grid_of(*stream.getGrids());
+            if (grid) static_cast<void>(grid->activeVoxelCount()); // walks every node of the tree
+        },
+        limits);
+    const std::string corrupt = "not a readable OpenVDB file: ";
+    switch (outcome.kind) {
+    case ChildOutcome::Kind::ok: return;
+    case ChildOutcome::Kind::failed:
+        throw file_error(name, "not a readable OpenVDB file (" + outcome.message + ")");
+    case ChildOutcome::Kind::out_of_memory:
+        throw file_error(name, corrupt + "reading it needs more than the memory limit of " +
+                                   std::to_string(memory_limit_bytes() >> 20) +
+                                   " MiB (corrupt, or set --max-memory-mb to raise it)");
+    case ChildOutcome::Kind::timed_out:
+        throw file_error(name, corrupt + "OpenVDB's reader did not finish within " +
+                                   std::to_string(static_cast<int>(limits.seconds)) + " s (the file is corrupt)");
+    case ChildOutcome::Kind::crashed:
+        throw file_error(name, corrupt + "OpenVDB's reader crashed on it (" + signal_name(outcome.signal) +
+                                   "; the file is corrupt)");
+    }
+}
+
+} // namespace
+
 LabelGrid LabelGrid::load(const std::filesystem::path& path)
 {
     ensure_openvdb_initialized();
     const std::string name = path.string();
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw file_error(name, "no such file");
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) throw file_error(name, "cannot read its size: " + ec.message());
+    check_allocation(name, size, 1);
+    std::string bytes(size, '\0');
+    {
+        std::ifstream file(path, std::ios::binary);
+        file.read(bytes.data(), static_cast<std::streamsize>(size));
+        if (!file || static_cast<std::uint64_t>(file.gcount()) != size) throw file_error(name, "cannot read it");
+    }
+    // One copy of the bytes serves both reads, so the file cannot change between them.
+    std::istringstream in(std::move(bytes));
+    check_in_child(in, name, size);
+    in.clear();
+    in.seekg(0);
     openvdb::GridPtrVecPtr grids;
     try {
-        openvdb::io::File file(name);
-        file.open(false); // no delayed loading: the file may be replaced while we run
-        grids = file.getGrids();
-        file.close();
+        openvdb::io::Stream stream(in);
+        grids = stream.getGrids();
     } catch (const std::exception& e) {
         throw file_error(name, std::string("not a readable OpenVDB file (") + e.what() + ")");
     }
-    openvdb::Int32Grid::Ptr found;
-    for (const auto& g : *grids) {
-        auto ig = openvdb::gridPtrCast<openvdb::Int32Grid>(g);
-        if (!ig) continue;
-        if (!found || ig->getName() == "labels") found = ig;
-    }
+    openvdb::Int32Grid::Ptr found = label_grid_of(*grids);
     if (!found) throw file_error(name, "holds no int32 label grid (found " + std::to_string(grids->size()) + " grid(s) of other types)");
     if (!found->transform().isLinear()) throw file_error(name, "the grid's transform is not affine");
     found->setName("labels");

@@ -139,6 +139,10 @@ std::vector<std::byte> inflate_exact(const std::byte* data, std::size_t size, st
     if (produced != expected)
         throw file_error(what, "compressed data holds " + std::to_string(produced) + (produced > expected ? "+" : "") +
                                    " bytes, expected " + std::to_string(expected));
+    // All the voxels but no end of stream: the checksum and size trailer was cut off, so nothing
+    // vouches for the data.
+    if (rc != Z_STREAM_END)
+        throw file_error(what, "compressed data is truncated: it ends before its checksum (the gzip or zlib trailer)");
     out.resize(expected);
     return out;
 }

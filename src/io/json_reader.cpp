@@ -1,5 +1,6 @@
 #include "io/json_reader.hpp"
 
+#include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
 #include "io/text_parsing.hpp"
 
@@ -83,9 +84,49 @@ private:
 
 /// How deep a JSON value may nest (a scene nests four or five levels).
 constexpr int k_max_json_depth = 64;
+/// How long one string (key or value) may be: a file path is at most 4096 bytes on Linux.
+constexpr std::size_t k_max_json_string = 4096;
+/// What parsing may cost per byte of text: a parsed value takes 16 bytes and needs at least two
+/// characters ("0,"), so 8 bytes per character bounds the document's size in memory.
+constexpr std::uint64_t k_parsed_bytes_per_char = 8;
 
-json parse_json(const std::string& text, const std::string& source)
+namespace {
+
+/// Refuses a string longer than k_max_json_string before the parser reads it: the parser would hold
+/// all of it (a hostile file's 100 MB name) before any callback could look, and messages would
+/// quote it. Skips comments as the parser does.
+void check_string_lengths(std::string_view text, const std::string& source)
 {
+    std::size_t line = 1;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '\n') {
+            ++line;
+        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
+            i = std::min(text.find('\n', i), text.size()) - 1;
+        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+            const std::size_t end = std::min(text.find("*/", i + 2), text.size());
+            line += static_cast<std::size_t>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i),
+                                                        text.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
+            i = end + 1;
+        } else if (c == '"') {
+            const std::size_t start = i++;
+            while (i < text.size() && text[i] != '"' && text[i] != '\n') i += text[i] == '\\' ? 2 : 1;
+            if (i - start - 1 > k_max_json_string)
+                throw file_error(source, "line " + std::to_string(line) + ": a string of " + std::to_string(i - start - 1) +
+                                             " bytes, more than the " + std::to_string(k_max_json_string) +
+                                             " a string may have");
+            if (i < text.size() && text[i] == '\n') --i; // the parser will refuse the open string
+        }
+    }
+}
+
+} // namespace
+
+json parse_json(std::string_view text, const std::string& source)
+{
+    check_allocation(source + " (parsed)", text.size(), k_parsed_bytes_per_char);
+    check_string_lengths(text, source);
     try {
         DuplicateKeyCheck check(source);
         return json::parse(
@@ -118,13 +159,39 @@ json read_json_file(const std::filesystem::path& path)
 {
     const std::string source = path.string();
     const std::vector<std::byte> bytes = read_file_bytes(source);
-    return parse_json(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()), source);
+    return parse_json(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), source);
 }
+
+namespace {
+
+/// Appends `value` as JSON text to `out`, stopping soon after `out` reaches `limit` characters:
+/// a hostile document's array of millions of numbers is not written out only to be cut. The same
+/// text as nlohmann's dump() up to the cut.
+void append_shown(const json& value, std::string& out, std::size_t limit)
+{
+    if (value.is_array() || value.is_object()) {
+        out += value.is_array() ? '[' : '{';
+        bool first = true;
+        for (const auto& [key, member] : value.items()) {
+            if (out.size() > limit) return;
+            if (!first) out += ',';
+            first = false;
+            if (value.is_object()) out += json(key).dump() + ':';
+            append_shown(member, out, limit);
+        }
+        out += value.is_array() ? ']' : '}';
+        return;
+    }
+    out += value.dump();
+}
+
+} // namespace
 
 std::string show(const json& value)
 {
     constexpr std::size_t max_length = 48;
-    std::string text = value.dump();
+    std::string text;
+    append_shown(value, text, max_length);
     if (text.size() > max_length) {
         text = text.substr(0, max_length - 3) + "...";
     }

@@ -32,7 +32,9 @@ namespace vox::io {
 /// refused, since nlohmann would silently keep the last one. `source` names the document in
 /// messages. Throws InputError "SOURCE: key.path: key given twice", or "SOURCE: line L column C:
 /// problem" for text that is not JSON.
-[[nodiscard]] nlohmann::json parse_json(const std::string& text, const std::string& source);
+/// Refused too: strings longer than 4096 bytes, values nested deeper than 64 levels, and text whose
+/// parsed form could pass the memory limit (8 bytes per character).
+[[nodiscard]] nlohmann::json parse_json(std::string_view text, const std::string& source);
 
 /// Reads a JSON file (plain or gzip) and parses it with parse_json; messages start with the path
 /// as given. Throws InputError also when the file is missing or unreadable.

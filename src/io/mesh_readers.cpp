@@ -3,6 +3,7 @@
 #include "io/mesh_readers.hpp"
 
 #include "core/log.hpp"
+#include "io/text_parsing.hpp"
 
 #include <sstream>
 #include <utility>
@@ -19,6 +20,12 @@ void MeshBuilder::add_polygon(const std::vector<int>& corners)
         kept = true;
     }
     if (!kept) ++skipped_faces;
+}
+
+std::string too_many_corners(double corners)
+{
+    return "a face of " + number_text(corners) + " corners, more than the " + std::to_string(k_max_face_corners) +
+           " a face may have";
 }
 
 TriangleMesh MeshBuilder::finish(const std::string& path)

@@ -36,6 +36,13 @@ namespace vox::io::detail {
 /// face has fewer than 3 corners, or there is no face.
 [[nodiscard]] TriangleMesh read_ply(const std::string& path);
 
+/// The most corners one face may have. Scanners and modellers write triangles and quads; a face of
+/// thousands of corners is a corrupt file, and its fan of overlapping triangles would make
+/// voxelising it take minutes.
+inline constexpr std::size_t k_max_face_corners = 256;
+/// "face of N corners, more than the 256 a face may have", for the readers' messages.
+[[nodiscard]] std::string too_many_corners(double corners);
+
 /// Accumulates polygons as triangle fans, skipping triangles that repeat a vertex (zero area).
 struct MeshBuilder {
     TriangleMesh mesh;

@@ -198,14 +198,32 @@ RawHeader check_header(const std::string& path)
     return raw;
 }
 
-/// Refuses a plain (not gzip) file too short for the voxels its header declares; libnifti would
-/// only say that it cannot load them.
+/// Bytes of decompressed data in a gzip file, counted up to `enough` (no further: a legitimate
+/// file need not be inflated to its end twice).
+std::uint64_t gzip_size_up_to(const std::string& path, std::uint64_t enough)
+{
+    gzFile gz = gzopen(path.c_str(), "rb");
+    if (!gz) throw file_error(path, "cannot open");
+    std::vector<char> chunk(1 << 16);
+    std::uint64_t total = 0;
+    while (total < enough) {
+        const int got = gzread(gz, chunk.data(), static_cast<unsigned>(chunk.size()));
+        if (got <= 0) break;
+        total += static_cast<std::uint64_t>(got);
+    }
+    gzclose(gz);
+    return total;
+}
+
+/// Refuses a file too short for the voxels its header declares. libnifti would only say that it
+/// cannot load them, and a gzip file whose vox_offset points past its data it reads from the wrong
+/// place without complaint: so a gzip file's decompressed size is counted here.
 void check_data_size(const std::string& path, const RawHeader& raw)
 {
-    if (is_gzip_file(path)) return;
-    std::error_code ec;
-    const std::uint64_t size = std::filesystem::file_size(path, ec);
     const auto offset = static_cast<std::uint64_t>(raw.vox_offset);
+    std::error_code ec;
+    const std::uint64_t size = is_gzip_file(path) ? gzip_size_up_to(path, offset + raw.voxel_bytes)
+                                                  : std::filesystem::file_size(path, ec);
     if (ec || size >= offset + raw.voxel_bytes) return;
     throw file_error(path, "truncated: holds " + std::to_string(size > offset ? size - offset : 0) +
                                " bytes of voxel data after vox_offset " + std::to_string(offset) +

@@ -195,6 +195,7 @@ private:
     {
         if (words.size() < 4)
             throw at_line("a face needs at least 3 vertices, this one has " + std::to_string(words.size() - 1));
+        if (words.size() - 1 > k_max_face_corners) throw at_line(too_many_corners(double(words.size() - 1)));
         m_corners.clear();
         for (std::size_t w = 1; w < words.size(); ++w) m_corners.push_back(corner_vertex(words[w]));
         m_builder.add_polygon(m_corners);

@@ -109,6 +109,8 @@ TriangleMesh parse_off(const std::string& path, std::string_view text)
         if (!n || *n < 3 || static_cast<std::size_t>(*n) >= words.size())
             throw at_line("face " + std::to_string(f) +
                           ": expected a corner count of at least 3 and that many indices");
+        if (static_cast<std::size_t>(*n) > k_max_face_corners)
+            throw at_line("face " + std::to_string(f) + ": " + too_many_corners(double(*n)));
         corners.clear();
         for (long long c = 1; c <= *n; ++c) {
             const auto i = parse_integer(words[static_cast<std::size_t>(c)]);

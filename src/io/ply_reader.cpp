@@ -370,6 +370,8 @@ TriangleMesh read_elements(const std::string& path, const Header& h, const Layou
                     if (*n < 3)
                         throw file_error(path, src.where() + "face " + std::to_string(k) + " has " +
                                                    number_text(*n) + " vertices; a face needs at least 3");
+                    if (*n > static_cast<double>(k_max_face_corners))
+                        throw file_error(path, src.where() + "face " + std::to_string(k) + ": " + too_many_corners(*n));
                     corners.clear();
                 }
                 for (double m = 0; m < *n; ++m) {

@@ -1,6 +1,7 @@
 #include "io/volume.hpp"
 
 #include "core/error.hpp"
+#include "io/text_parsing.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -79,6 +80,17 @@ void validate(const Volume& v)
         if (!(s[a] > 0.0)) throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is zero");
     if (std::abs(v.index_to_world.topLeftCorner<3, 3>().determinant()) <= 1e-12 * s.prod())
         throw file_error(v.source, "the voxel axes are degenerate (direction matrix is singular)");
+    // Far beyond any scanner or studio; past it the grid's transforms lose their precision, and
+    // near 1e308 they overflow.
+    constexpr double k_max_world_mm = 1e6;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector4d index((corner & 1) ? v.dims[0] : 0, (corner & 2) ? v.dims[1] : 0,
+                                    (corner & 4) ? v.dims[2] : 0, 1.0);
+        const double far = (v.index_to_world * index).head<3>().cwiseAbs().maxCoeff();
+        if (!(far <= k_max_world_mm))
+            throw file_error(v.source, "its voxels lie up to " + detail::number_text(far) +
+                                           " mm from the origin, beyond the 1e6 mm (1 km) limit: check its origin and spacing");
+    }
     if (!std::isfinite(v.scale_slope) || !std::isfinite(v.scale_intercept))
         throw file_error(v.source, "the value scaling (slope/intercept) is not finite");
     const auto expect = static_cast<std::size_t>(v.voxel_count()) * scalar_size(v.type);

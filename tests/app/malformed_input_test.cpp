@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 
@@ -37,13 +40,80 @@ TEST(MalformedInput, EveryCorpusFileIsRefusedCleanly)
         SCOPED_TRACE(name);
         const fs::path out = fresh_dir("bad_" + name);
         const std::string file = entry.path().string();
+        // Under a memory limit: the corrupt .vdb files would otherwise grow to gigabytes before
+        // their reader is stopped.
         const auto r = name.starts_with("scene_")
-                           ? run_voxsculpt("check " + quote(file))
-                           : run_voxsculpt("import " + quote(file) + " -o " + quote((out / "o.vdb").string()));
+                           ? run_voxsculpt("--max-memory-mb 512 check " + quote(file))
+                           : run_voxsculpt("--max-memory-mb 512 import " + quote(file) + " -o " + quote((out / "o.vdb").string()));
         expect_clean_refusal(r, file, out);
         ++checked;
     }
     EXPECT_GE(checked, 10);
+}
+
+TEST(MalformedInput, FuzzFindingsAnswerInSecondsWithinTheMemoryLimit)
+{
+    // The commands of ../shared/data/fuzz-findings/README.md on the corpus copies of its inputs:
+    // each crashed, hung, grew to gigabytes or left an empty folder behind.
+    struct Finding {
+        const char* file;
+        const char* command; ///< FILE and OUT are replaced
+        const char* reason;
+    };
+    const std::vector<Finding> findings = {
+        {"vdb_segfault.vdb", "--max-memory-mb 512 info FILE --json", "not a readable OpenVDB file"},
+        {"vdb_hang_memory_a.vdb", "--max-memory-mb 512 info FILE", "memory limit of 512 MiB"},
+        {"vdb_hang_memory_b.vdb", "--max-memory-mb 512 import FILE -o OUT/out.vdb", "memory limit of 512 MiB"},
+        {"vdb_hang_spin.vdb", "--max-memory-mb 512 import FILE -o OUT/out.vdb", "did not finish within 3 s"},
+        {"nii_gz_vox_offset_past_end.nii.gz", "import FILE -o OUT/out.vdb", "truncated"},
+        {"nrrd_gzip_trailer_cut.nrrd", "info FILE", "ends before its checksum"},
+        {"nrrd_huge_origin.nrrd", "info FILE", "beyond the 1e6 mm (1 km) limit"},
+        {"obj_huge_polygon.obj", "import FILE -o OUT/out.vdb", "more than the 256 a face may have"},
+        {"scene_deep_nesting.json", "--max-memory-mb 512 check FILE", "nested deeper than 64 levels"},
+        {"scene_dt_huge.json", "run FILE --frames 3 --out OUT/outdir", "solver.dt_s"},
+        {"scene_gravity_huge.json", "run FILE --frames 3 --out OUT/outdir", "gravity_m_s2"},
+    };
+    for (const Finding& f : findings) {
+        SCOPED_TRACE(f.file);
+        const fs::path out = fresh_dir(std::string("finding_") + f.file);
+        const std::string file = VOX_TEST_DATA_DIR "/bad/" + std::string(f.file);
+        std::string command = f.command;
+        command.replace(command.find("FILE"), 4, quote(file));
+        if (const std::size_t at = command.find("OUT"); at != std::string::npos) command.replace(at, 3, quote(out.string()));
+        const auto start = std::chrono::steady_clock::now();
+        const auto r = run_voxsculpt(command);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        expect_clean_refusal(r, file + ": ", out);
+        EXPECT_NE(r.err.find(f.reason), std::string::npos) << r.err;
+        EXPECT_LT(seconds, 10.0);
+    }
+    // The largest resident size of any process these commands ran (the reader's child included).
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    EXPECT_LT(usage.ru_maxrss, 600L * 1024) << "KiB";
+}
+
+TEST(MalformedInput, AHundredMegabyteNameIsNeitherEchoedNorHeld)
+{
+    // A scene whose tool name is 100 MB: refused before the parser holds the string, in one short line.
+    const fs::path d = fresh_dir("bad_long_name");
+    const fs::path scene = d / "scene.json";
+    {
+        std::ofstream s(scene);
+        s << R"({"object": {"phantom": {"shape": "beam"}, "levels": 0}, "tools": [{"name": ")";
+        const std::string chunk(1 << 20, 'n');
+        for (int i = 0; i < 100; ++i) s << chunk;
+        s << R"(", "shape": "sphere", "radius_mm": 3}]})";
+    }
+    const auto r = run_voxsculpt("--max-memory-mb 1024 check " + quote(scene.string()));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(scene.string() + ": line 1: a string of 104857600 bytes, more than the 4096"), std::string::npos)
+        << r.err.substr(0, 300);
+    EXPECT_LT(r.err.size(), 300u);
+    rusage usage{};
+    getrusage(RUSAGE_CHILDREN, &usage);
+    EXPECT_LT(usage.ru_maxrss, 300L * 1024) << "KiB: the file's 100 MB once, not copies of it";
+    fs::remove(scene);
 }
 
 TEST(MalformedInput, UsualMistakes)

@@ -1,6 +1,7 @@
 #include "grid/label_grid.hpp"
 
 #include "core/error.hpp"
+#include "core/memory_limit.hpp"
 
 #include <Eigen/Geometry>
 
@@ -79,6 +80,33 @@ TEST(LabelGrid, LoadRefusesMissingAndForeignFiles)
     } catch (const vox::InputError& e) {
         EXPECT_NE(std::string(e.what()).find(junk.string()), std::string::npos);
     }
+}
+
+TEST(LabelGrid, CorruptFilesAreReadInAChildAndRefusedNamingTheFile)
+{
+    // Fuzzing found these: OpenVDB's reader crashed on the first, grew to gigabytes on the next
+    // two and spun for ever on the last. Read in a child process, each is one message.
+    const std::uint64_t saved = vox::memory_limit_bytes();
+    vox::set_memory_limit_bytes(std::uint64_t{512} << 20);
+    const std::vector<std::pair<std::string, std::string>> expected = {
+        {"vdb_segfault.vdb", "reading it needs more than the memory limit of 512 MiB"},
+        {"vdb_hang_memory_a.vdb", "reading it needs more than the memory limit of 512 MiB"},
+        {"vdb_hang_memory_b.vdb", "reading it needs more than the memory limit of 512 MiB"},
+        {"vdb_hang_spin.vdb", "OpenVDB's reader did not finish within 3 s"},
+    };
+    for (const auto& [name, reason] : expected) {
+        SCOPED_TRACE(name);
+        const std::string file = VOX_TEST_DATA_DIR "/bad/" + name;
+        try {
+            (void)LabelGrid::load(file);
+            ADD_FAILURE() << "loaded";
+        } catch (const vox::InputError& e) {
+            const std::string message = e.what();
+            EXPECT_EQ(message.rfind(file + ": not a readable OpenVDB file", 0), 0u) << message;
+            EXPECT_NE(message.find(reason), std::string::npos) << message;
+        }
+    }
+    vox::set_memory_limit_bytes(saved);
 }
 
 TEST(LabelGrid, CloneIsIndependent)

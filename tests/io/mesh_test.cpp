@@ -179,6 +179,7 @@ TEST(MeshRead, MalformedFilesThrowNamingTheFile)
     const std::map<std::string, std::string> expected = {
         {"obj_bad_index.obj", "line 4: face references vertex 7, but the file has only 3 vertices"},
         {"obj_empty.obj", ": is empty"},
+        {"obj_huge_polygon.obj", "line 21: a face of 3000 corners, more than the 256 a face may have"},
         {"obj_inf_vertex.obj", "line 4: vertex 4 has a non-finite coordinate (0, 0, inf)"},
         {"obj_nan_vertex.obj", "line 3: vertex 2 has a non-finite coordinate (nan, 10, 0)"},
         {"obj_no_faces.obj", "has no faces"},

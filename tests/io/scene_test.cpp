@@ -835,7 +835,8 @@ const BadScene bad_scenes[] = {
     BadScene{"water_above_one", "wet_regions[0].water", "must be in [0, 1], got 1.5"},
     BadScene{"preconditioner", "solver.preconditioner", "expected one of \"auto\", \"jacobi\""},
     BadScene{"number_overflow", "", "a number too large for a double: '1e999'"},
-    BadScene{"deep_nesting", "", "values nested deeper than 64 levels (the limit)"}};
+    BadScene{"deep_nesting", "", "values nested deeper than 64 levels (the limit)"},
+    BadScene{"long_tool_name", "", "line 1: a string of 5000 bytes, more than the 4096 a string may have"}};
 
 class SceneBadFile : public testing::TestWithParam<BadScene> {};
 
