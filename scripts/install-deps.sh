@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages VoxSculpt needs, only those missing (idempotent).
+# Installs the Debian packages VoxSculpt needs, and any named as arguments, only those missing
+# (idempotent).
 # Runs apt-get as root, or through sudo when not root.
 set -euo pipefail
 
@@ -12,6 +13,7 @@ packages=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev xvfb xauth
   libsuitesparse-dev libopenblas0-serial
 )
+packages+=("$@") # extra packages a caller needs (fuzz/run.sh: clang)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,10 @@
+// Fuzz target: NRRD with its data attached (.nrrd: raw, gzip or ascii), through import.
+#include "fuzz_input.hpp"
+
+#include "io/object_import.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+    return vox::fuzz::read_or_refuse(
+        [&] { (void)vox::io::import_object(vox::fuzz::input_file(data, size, "in.nrrd"), {}); });
+}
