@@ -47,6 +47,12 @@ std::size_t& refused_count()
     return count;
 }
 
+std::string& last_refusal()
+{
+    static std::string text;
+    return text;
+}
+
 bool is_gzip(const std::uint8_t* data, std::size_t size) { return size >= 2 && data[0] == 0x1f && data[1] == 0x8b; }
 
 void setup()

@@ -23,8 +23,10 @@ namespace vox::fuzz {
 /// in the program) and only errors logged.
 void setup();
 
-/// How many inputs were refused so far (the replay reports it: a seed must be accepted).
+/// How many inputs were refused so far, and the last refusal (the replay reports them: a seed must
+/// be accepted).
 [[nodiscard]] std::size_t& refused_count();
+[[nodiscard]] std::string& last_refusal();
 
 /// Runs `read`, accepting an InputError as the refusal every reader promises.
 template <class Read> int read_or_refuse(Read&& read)
@@ -32,8 +34,9 @@ template <class Read> int read_or_refuse(Read&& read)
     setup();
     try {
         read();
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
         ++refused_count();
+        last_refusal() = e.what();
     }
     return 0;
 }

@@ -41,7 +41,7 @@ int main(int argc, char** argv)
         LLVMFuzzerTestOneInput(data, bytes.size());
         // A seed is a valid file: its refusal means the seed or the reader is wrong.
         if (path.filename().string().starts_with("seed_") && vox::fuzz::refused_count() > refused_before) {
-            std::fprintf(stderr, "replay: seed %s was refused\n", path.c_str());
+            std::fprintf(stderr, "replay: seed %s was refused: %s\n", path.c_str(), vox::fuzz::last_refusal().c_str());
             ++seeds_refused;
         }
     }

@@ -17,6 +17,7 @@
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 #include "sim/device_run.hpp"
+#include "sim/journal.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/run_record.hpp"
@@ -62,7 +63,7 @@ void add_run_command(CLI::App& app)
         std::string scene;
         std::optional<int> frames;
         std::string out;
-        std::string device, replay, record, tool;
+        std::string device, replay, record, tool, resume;
         int render_every = 0;
         std::string camera = "iso", size = "960x720";
         std::string solver;
@@ -79,6 +80,8 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--replay", args->replay, "Drive the tool by replaying this recording (docs/recording-format.md)");
     cmd->add_option("--record", args->record, "Record the device and the force sent at every tick to this file");
     cmd->add_option("--tool", args->tool, "The tool the device drives (default: the scene's first tool)");
+    cmd->add_option("--resume", args->resume,
+                    "Start from the last stroke of this session journal (a device run writes OUT.journal; docs/journal.md)");
     cmd->add_option("--solver", args->solver, "Simulate with this method instead of the scene's solver.type: dbg or isxfem")
         ->check(CLI::IsMember({"dbg", "isxfem"}));
     cmd->add_option("--render-every", args->render_every,
@@ -121,6 +124,23 @@ void add_run_command(CLI::App& app)
         const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
         const int frames = args->frames.value_or(duration > 0 ? static_cast<int>(std::ceil(duration / dt)) : 100);
         const std::filesystem::path out = args->out.empty() ? scene.output.dir : std::filesystem::path(args->out);
+        // A resumed run starts where its journal's last stroke ended, the object cut as it was then.
+        const sim::JournalHeader header = sim::journal_header(args->scene, method);
+        int first_frame = 1;
+        if (!args->resume.empty()) {
+            const sim::Journal journal = sim::read_journal(args->resume, header);
+            sim::resume(method, journal);
+            if (!journal.strokes.empty()) first_frame = journal.strokes.back().frame + 1;
+            log::info("resumed {}: {} stroke(s), {} cut(s), going on from frame {} (t = {:g} s)", args->resume, journal.strokes.size(),
+                      method.cut_count(), first_frame, (first_frame - 1) * dt);
+        }
+        // Device runs (and resumed ones) keep a journal beside their output, a line per stroke.
+        std::unique_ptr<sim::JournalWriter> journal;
+        if (device || !args->resume.empty()) {
+            journal = std::make_unique<sim::JournalWriter>(sim::journal_path(out), header, method, first_frame - 1, (first_frame - 1) * dt);
+            log::info("journal: {} (each stroke synced to disk as it ends)", journal->path().string());
+        }
+        sim::StrokeEnds stroke_ends;
         StagingDir staging(out); // a run that fails leaves nothing behind
         const std::filesystem::path& dir = staging.path();
         log::info("{}: {}, {} frames of {} s ({}; {})", args->scene, method.description(), frames, dt,
@@ -131,10 +151,12 @@ void add_run_command(CLI::App& app)
         if (opened.choice) record.document()["level_choice"] = level_choice_json(*opened.choice);
         std::vector<sim::ForceSample> tool_forces; // without a device: the first placed tool's, per frame
         sim::FrameLoop loop(scene, method, tools, device.get());
+        loop.go_on_from(first_frame - 1);
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
-        for (int f = 1; f <= frames; ++f) {
+        for (int f = first_frame; f <= frames; ++f) {
             const sim::FrameStats frame = loop.next();
             record.add(frame, method);
+            if (journal && stroke_ends.after_frame(frame)) journal->end_stroke(method, frame.frame, frame.t_s);
             if (!device)
                 for (const sim::ToolFrame& t : frame.tools.tools)
                     if (t.placed) {
@@ -146,6 +168,7 @@ void add_run_command(CLI::App& app)
             progress.update(static_cast<std::uint64_t>(f));
         }
         progress.finish();
+        if (journal) journal->end_stroke(method, loop.frames(), loop.frames() * dt); // the stroke under way at the end
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
         write_surface(dir / "final.obj", method);

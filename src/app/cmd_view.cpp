@@ -35,7 +35,10 @@ void add_view_command(CLI::App& app)
         ->check(CLI::IsMember({"auto", "mouse", "hid"}));
     cmd->add_option("--solver", args->options.solver, "Simulate with this method instead of the scene's solver.type: dbg or isxfem")
         ->check(CLI::IsMember({"dbg", "isxfem"}));
-    cmd->add_option("--out", args->options.out_dir, "Folder for screenshots (P) and saved surfaces (S) (default: the current folder)");
+    cmd->add_option("--out", args->options.out_dir,
+                    "Folder for screenshots (P), saved surfaces (S) and the session journal SCENE.journal (default: the current folder)");
+    cmd->add_option("--resume", args->options.resume,
+                    "Start from the last stroke of this session journal (docs/journal.md)");
     cmd->callback([args] {
         std::tie(args->options.width, args->options.height) = parse_size(args->size);
         if (!args->options.screenshot.empty() && args->options.exit_after_s <= 0.0)

@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory_limit.hpp"
+#include "core/version.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -13,7 +14,7 @@
 int main(int argc, char** argv)
 {
     CLI::App app{"VoxSculpt: physics-based sculpting and cutting of volumetric objects"};
-    app.set_version_flag("--version", "voxsculpt 0.1.0");
+    app.set_version_flag("--version", vox::program_version());
     app.require_subcommand(1);
     app.fallthrough(); // global options may follow the subcommand's own
     app.add_flag_callback("-q,--quiet", [] { vox::log::set_verbosity(vox::log::Verbosity::quiet); },

@@ -76,8 +76,15 @@ void validate(const Volume& v)
                                            " (must be positive)");
     if (!v.index_to_world.allFinite()) throw file_error(v.source, "the index-to-world transform is not finite");
     const Eigen::Vector3d s = v.spacing();
-    for (int a = 0; a < 3; ++a)
+    // Below a tenth of a micrometre no scanner images (micro-CT reaches a micrometre), and the
+    // grid's affine transform would be singular in double precision.
+    constexpr double k_min_spacing_mm = 1e-4;
+    for (int a = 0; a < 3; ++a) {
         if (!(s[a] > 0.0)) throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is zero");
+        if (s[a] < k_min_spacing_mm)
+            throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is " + detail::number_text(s[a]) +
+                                           " mm, below the 0.0001 mm (0.1 micrometre) limit");
+    }
     if (std::abs(v.index_to_world.topLeftCorner<3, 3>().determinant()) <= 1e-12 * s.prod())
         throw file_error(v.source, "the voxel axes are degenerate (direction matrix is singular)");
     // Far beyond any scanner or studio; past it the grid's transforms lose their precision, and

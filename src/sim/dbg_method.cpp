@@ -1,5 +1,6 @@
 #include "sim/dbg_method.hpp"
 
+#include "core/error.hpp"
 #include "core/stopwatch.hpp"
 #include "cut/pieces.hpp"
 #include "cut/voxel_cut.hpp"
@@ -229,6 +230,102 @@ std::unique_ptr<Method> DbgMethod::at_level(int level) const
     for (const CutRecord& r : m_cuts) out->apply(r.removed, r.faces);
     out->m_separated = m_separated;
     return out;
+}
+
+std::size_t DbgMethod::cut_count() const { return m_cuts.size(); }
+
+nlohmann::json DbgMethod::cuts_since(std::size_t from) const
+{
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t c = from; c < m_cuts.size(); ++c) {
+        nlohmann::json removed = nlohmann::json::array(), faces = nlohmann::json::array();
+        for (const grid::Coord& v : m_cuts[c].removed) removed.push_back({v.x(), v.y(), v.z()});
+        for (const auto& [v, axis] : m_cuts[c].faces) faces.push_back({v.x(), v.y(), v.z(), axis});
+        out.push_back({{"removed", std::move(removed)}, {"faces", std::move(faces)}});
+    }
+    return out;
+}
+
+namespace {
+std::string coord_text(const grid::Coord& v)
+{
+    return "(" + std::to_string(v.x()) + ", " + std::to_string(v.y()) + ", " + std::to_string(v.z()) + ")";
+}
+} // namespace
+
+void DbgMethod::replay_cuts(const nlohmann::json& cuts)
+{
+    // A journal may be damaged: every voxel is checked against the grid before the cut is made.
+    const auto coord = [](const nlohmann::json& a, std::size_t n) {
+        if (!a.is_array() || a.size() != n) throw InputError("expected an array of " + std::to_string(n) + " integers");
+        for (const auto& x : a)
+            if (!x.is_number_integer()) throw InputError("expected an array of " + std::to_string(n) + " integers");
+        return grid::Coord(a[0].get<int>(), a[1].get<int>(), a[2].get<int>());
+    };
+    if (!cuts.is_array()) throw InputError("the cuts are not an array");
+    for (std::size_t c = 0; c < cuts.size(); ++c) {
+        const nlohmann::json& cut = cuts[c];
+        const std::string where = "cut " + std::to_string(c) + ": ";
+        try {
+            if (!cut.is_object() || !cut.contains("removed") || !cut.contains("faces") || !cut["removed"].is_array() ||
+                !cut["faces"].is_array())
+                throw InputError("expected {\"removed\": [...], \"faces\": [...]}");
+            std::vector<grid::Coord> removed;
+            for (const auto& v : cut["removed"]) {
+                removed.push_back(coord(v, 3));
+                if (m_grid->voxels().find(removed.back()) == grid::FineVoxels::missing)
+                    throw InputError("removes voxel " + coord_text(removed.back()) + ", which the object does not have");
+            }
+            std::vector<std::pair<grid::Coord, int>> faces;
+            for (const auto& f : cut["faces"]) {
+                if (!f.is_array() || f.size() != 4 || !f[3].is_number_integer() || f[3].get<int>() < 0 || f[3].get<int>() > 2)
+                    throw InputError("a face is [i, j, k, axis] with axis 0, 1 or 2");
+                const grid::Coord v = coord(nlohmann::json{f[0], f[1], f[2]}, 3);
+                const int axis = f[3].get<int>();
+                if (m_grid->voxels().find(v) == grid::FineVoxels::missing ||
+                    m_grid->voxels().find(grid::Coord(v + grid::Coord::Unit(axis))) == grid::FineVoxels::missing)
+                    throw InputError("opens a face of voxel " + coord_text(v) + " that the object does not have");
+                faces.emplace_back(v, axis);
+            }
+            (void)apply(std::move(removed), std::move(faces));
+        } catch (const InputError& e) {
+            throw InputError(where + e.what());
+        }
+    }
+}
+
+std::vector<double> DbgMethod::motion() const
+{
+    const fem::ImplicitSolver& s = m_sim->solver();
+    std::vector<double> out;
+    for (const auto* field : {&s.positions(), &s.velocities()})
+        for (const Eigen::Vector3d& p : *field) out.insert(out.end(), p.data(), p.data() + 3);
+    const auto elements = static_cast<std::uint32_t>(m_sim->model().elements().size());
+    for (std::uint32_t e = 0; e < elements; ++e) out.push_back(s.water(e));
+    for (std::uint32_t e = 0; e < elements; ++e) {
+        const Eigen::Matrix3d p = s.plastic_strain(e);
+        out.insert(out.end(), p.data(), p.data() + 9);
+    }
+    return out;
+}
+
+void DbgMethod::set_motion(const std::vector<double>& numbers)
+{
+    fem::ImplicitSolver& s = m_sim->solver();
+    const std::size_t nodes = s.positions().size();
+    const auto elements = static_cast<std::uint32_t>(m_sim->model().elements().size());
+    check_motion(numbers, 6 * nodes + 10 * std::size_t{elements});
+    const double* at = numbers.data();
+    for (auto* field : {&s.positions(), &s.velocities()})
+        for (Eigen::Vector3d& p : *field) {
+            p = Eigen::Vector3d(at[0], at[1], at[2]);
+            at += 3;
+        }
+    for (std::uint32_t e = 0; e < elements; ++e) s.set_water(e, *at++);
+    for (std::uint32_t e = 0; e < elements; ++e) {
+        s.set_plastic_strain(e, Eigen::Map<const Eigen::Matrix3d>(at));
+        at += 9;
+    }
 }
 
 std::unique_ptr<Checkpoint> DbgMethod::checkpoint() const

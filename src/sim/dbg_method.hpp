@@ -59,6 +59,11 @@ public:
     void add_summary_figures(nlohmann::json& summary) const override;
 
     [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
+    [[nodiscard]] std::size_t cut_count() const override;
+    [[nodiscard]] nlohmann::json cuts_since(std::size_t from) const override;
+    void replay_cuts(const nlohmann::json& cuts) override;
+    [[nodiscard]] std::vector<double> motion() const override;
+    void set_motion(const std::vector<double>& numbers) override;
     [[nodiscard]] std::unique_ptr<Checkpoint> checkpoint() const override;
     void restore(const Checkpoint& checkpoint) override;
 

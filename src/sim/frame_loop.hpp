@@ -42,6 +42,8 @@ public:
 
     /// Frames done so far.
     [[nodiscard]] int frames() const { return m_frame; }
+    /// A resumed session goes on after `frame` (its simulated time from frame * dt_s on).
+    void go_on_from(int frame) { m_frame = frame; }
     /// After the method was replaced (the viewer's level keys) or restored: the loop goes on with it.
     void set_method(Method& method) { m_method = &method; }
     [[nodiscard]] Method& method() { return *m_method; }

@@ -1,11 +1,13 @@
 #include "sim/isxfem_method.hpp"
 
+#include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/stopwatch.hpp"
 #include "core/union_find.hpp"
 #include "sim/dbg_simulation.hpp"
 
 #include <cstdio>
+#include <utility>
 
 namespace vox::sim {
 namespace {
@@ -267,6 +269,81 @@ struct IsxfemCheckpoint final : Checkpoint {
 };
 
 } // namespace
+
+std::size_t IsxfemMethod::cut_count() const { return m_sim->cut_log().size(); }
+
+nlohmann::json IsxfemMethod::cuts_since(std::size_t from) const
+{
+    const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+    nlohmann::json out = nlohmann::json::array();
+    const auto& log = m_sim->cut_log();
+    for (std::size_t c = from; c < log.size(); ++c) {
+        nlohmann::json patches = nlohmann::json::array();
+        for (const isxfem::CutPatch& p : log[c].patches) {
+            nlohmann::json corners = nlohmann::json::array();
+            for (const Eigen::Vector3d& x : p.corners) corners.push_back(vec(x));
+            patches.push_back({{"normal", vec(p.normal)}, {"corners", std::move(corners)}});
+        }
+        out.push_back({{"extend", log[c].extend}, {"new_from", log[c].new_from}, {"patches", std::move(patches)}});
+    }
+    return out;
+}
+
+void IsxfemMethod::replay_cuts(const nlohmann::json& cuts)
+{
+    // A journal may be damaged: its types are checked here, its geometry by the simulation.
+    const auto vec = [](const nlohmann::json& a) {
+        if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number())
+            throw InputError("expected an array of 3 numbers");
+        return Eigen::Vector3d(a[0].get<double>(), a[1].get<double>(), a[2].get<double>());
+    };
+    if (!cuts.is_array()) throw InputError("the cuts are not an array");
+    std::size_t cut_tets = 0;
+    for (std::size_t c = 0; c < cuts.size(); ++c) {
+        const nlohmann::json& j = cuts[c];
+        try {
+            if (!j.is_object() || !j.contains("extend") || !j["extend"].is_number_integer() || !j.contains("new_from") ||
+                !j["new_from"].is_number_unsigned() || !j.contains("patches") || !j["patches"].is_array())
+                throw InputError("expected {\"extend\": integer, \"new_from\": count, \"patches\": [...]}");
+            IsxfemSimulation::CutCall call;
+            call.extend = j["extend"].get<int>();
+            call.new_from = j["new_from"].get<std::size_t>();
+            for (const auto& p : j["patches"]) {
+                if (!p.is_object() || !p.contains("normal") || !p.contains("corners") || !p["corners"].is_array())
+                    throw InputError("a patch is {\"normal\": [x, y, z], \"corners\": [[x, y, z], ...]}");
+                isxfem::CutPatch patch;
+                patch.normal = vec(p["normal"]);
+                for (const auto& x : p["corners"]) patch.corners.push_back(vec(x));
+                call.patches.push_back(std::move(patch));
+            }
+            cut_tets += m_sim->replay(call).cut_tets;
+        } catch (const InputError& e) {
+            throw InputError("cut " + std::to_string(c) + ": " + e.what());
+        }
+    }
+    m_cut_tets += cut_tets;
+}
+
+std::vector<double> IsxfemMethod::motion() const
+{
+    const isxfem::XfemSolver& solver = std::as_const(*m_sim).solver();
+    std::vector<double> out;
+    for (const std::vector<Eigen::Vector3d>* field : {&solver.state(), &solver.velocities()})
+        for (const Eigen::Vector3d& p : *field) out.insert(out.end(), p.data(), p.data() + 3);
+    return out;
+}
+
+void IsxfemMethod::set_motion(const std::vector<double>& numbers)
+{
+    const std::size_t blocks = m_sim->solver().state().size();
+    check_motion(numbers, 6 * blocks);
+    std::vector<Eigen::Vector3d> x(blocks), v(blocks);
+    for (std::size_t b = 0; b < blocks; ++b) {
+        x[b] = Eigen::Vector3d(numbers[3 * b], numbers[3 * b + 1], numbers[3 * b + 2]);
+        v[b] = Eigen::Vector3d(numbers[3 * (blocks + b)], numbers[3 * (blocks + b) + 1], numbers[3 * (blocks + b) + 2]);
+    }
+    m_sim->solver().set_state(std::move(x), std::move(v));
+}
 
 std::unique_ptr<Checkpoint> IsxfemMethod::checkpoint() const
 {

@@ -1,6 +1,7 @@
 #include "sim/isxfem_simulation.hpp"
 
 #include "sim/dbg_simulation.hpp"
+#include "core/error.hpp"
 #include "cut/model_surface.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
@@ -64,9 +65,32 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
 
 isxfem::CutReport IsxfemSimulation::cut(const isxfem::CutSurface& surface, std::size_t new_from, int extend)
 {
+    CutCall call{extend, new_from, {}};
+    const std::size_t known = extend >= 0 && extend < m_model->cut_count() ? m_model->cut_surface(extend).patches().size() : 0;
+    const auto& patches = surface.patches();
+    call.patches.assign(patches.begin() + static_cast<std::ptrdiff_t>(std::min(known, patches.size())), patches.end());
     const isxfem::CutReport r = m_model->cut(surface, new_from, extend);
     if (r.cut_tets > 0) m_solver->model_changed();
+    m_cut_log.push_back(std::move(call));
     return r;
+}
+
+isxfem::CutReport IsxfemSimulation::replay(const CutCall& call)
+{
+    if (call.extend < -1 || call.extend >= m_model->cut_count())
+        throw InputError("extends cut " + std::to_string(call.extend) + ", but the object has " +
+                         std::to_string(m_model->cut_count()) + " cut(s)");
+    isxfem::CutSurface surface = call.extend >= 0 ? m_model->cut_surface(call.extend) : isxfem::CutSurface();
+    for (const isxfem::CutPatch& p : call.patches) {
+        bool finite = p.normal.allFinite() && std::abs(p.normal.norm() - 1.0) < 1e-6;
+        for (const Eigen::Vector3d& c : p.corners) finite = finite && c.allFinite();
+        if (!finite) throw InputError("a patch with a non-finite corner or a normal that is not a unit vector");
+        surface.add(p);
+    }
+    if (call.new_from > surface.patches().size())
+        throw InputError("its new patches begin at " + std::to_string(call.new_from) + ", past its " +
+                         std::to_string(surface.patches().size()) + " patches");
+    return cut(surface, call.new_from, call.extend);
 }
 
 std::vector<Eigen::Vector3d> IsxfemSimulation::surface_displacements() const
@@ -120,7 +144,10 @@ void IsxfemSimulation::make_solver()
     for (const auto& [node, axes] : m_fixed) m_solver->fix(node, axes);
 }
 
-IsxfemSimulation::State IsxfemSimulation::state() const { return {*m_model, m_solver->state(), m_solver->velocities()}; }
+IsxfemSimulation::State IsxfemSimulation::state() const
+{
+    return {*m_model, m_solver->state(), m_solver->velocities(), m_cut_log};
+}
 
 void IsxfemSimulation::restore(const State& s)
 {
@@ -131,6 +158,7 @@ void IsxfemSimulation::restore(const State& s)
     m_closure = std::make_unique<isxfem::CutClosure>(*m_model);
     make_solver();
     m_solver->set_state(s.x, s.v);
+    m_cut_log = s.cut_log;
     m_closed_vertices.clear();
 }
 

@@ -35,6 +35,19 @@ public:
     /// new one).
     isxfem::CutReport cut(const isxfem::CutSurface& surface, std::size_t new_from, int extend);
 
+    /// One call of cut(), as a session journal keeps it: the patches the surface gained since the
+    /// cut it extends last saw it (all of them for a new cut), where the new ones begin, and the cut
+    /// it extends. Every call is kept, even one that cut nothing: it moves the extended cut's surface on.
+    struct CutCall {
+        int extend = -1;
+        std::size_t new_from = 0;
+        std::vector<isxfem::CutPatch> patches;
+    };
+    [[nodiscard]] const std::vector<CutCall>& cut_log() const { return m_cut_log; }
+    /// Makes a logged call again on this model: the extended cut's surface plus the call's
+    /// patches, cut as it was. Throws InputError for a call that does not fit the model.
+    isxfem::CutReport replay(const CutCall& call);
+
     /// The deformed surface, world mm, closed along the cuts: triangles are split where a cut's
     /// crack crosses them (each piece moving with its side) and each crack is filled on both
     /// sides, through the object or, for a slit, up to its front (isxfem/cut_closure.hpp).
@@ -87,6 +100,7 @@ public:
     struct State {
         isxfem::XfemModel model;
         std::vector<Eigen::Vector3d> x, v;
+        std::vector<CutCall> cut_log;
     };
     [[nodiscard]] State state() const;
     /// Back to `s`: the model's cuts, a solver built anew on it, positions and velocities.
@@ -122,6 +136,7 @@ private:
     mutable std::vector<std::int32_t> m_closed_crack; ///< per closed triangle: the cut whose crack face it is, or -1
     mutable isxfem::ClosureCounts m_closure_counts;
     mutable std::size_t m_closed_revision = 0;
+    std::vector<CutCall> m_cut_log;
 };
 
 } // namespace vox::sim

@@ -1,5 +1,7 @@
 #include "sim/method.hpp"
 
+#include "core/error.hpp"
+
 #include <cmath>
 
 namespace vox::sim {
@@ -14,6 +16,14 @@ CutFigures& CutFigures::operator+=(const CutFigures& o)
     separated_voxels += o.separated_voxels;
     cut_elements += o.cut_elements;
     return *this;
+}
+
+void check_motion(const std::vector<double>& numbers, std::size_t expected)
+{
+    if (numbers.size() != expected)
+        throw InputError("the state holds " + std::to_string(numbers.size()) + " numbers, this object's has " + std::to_string(expected));
+    for (const double x : numbers)
+        if (!std::isfinite(x)) throw InputError("the state holds a number that is not finite");
 }
 
 double enclosed_volume_mm3(const surface::SurfaceMesh& mesh)

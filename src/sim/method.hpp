@@ -144,6 +144,27 @@ public:
     /// the new level's grid); Is-XFEM starts uncut (its cuts live in the tetrahedra of one level).
     [[nodiscard]] virtual std::unique_ptr<Method> at_level(int level) const = 0;
 
+    // --- The cuts as a record (session journals: sim/journal.hpp). ---
+
+    /// How many cuts were made so far (after an undo, fewer than before).
+    [[nodiscard]] virtual std::size_t cut_count() const = 0;
+    /// Cuts from the `from`-th on, in the order they were made, as JSON of the method's own form
+    /// (the branched grid: the voxels each removed and faces each opened; Is-XFEM: each swept
+    /// surface handed to the tetrahedra). Results, not the tool motions that made them: replaying
+    /// them needs no solve and does not depend on the deformation.
+    [[nodiscard]] virtual nlohmann::json cuts_since(std::size_t from) const = 0;
+    /// Makes the cuts of `cuts` (as cuts_since gave them) on this object, in order: on the same
+    /// object at the same level, uncut and at rest, the same voxels removed and faces opened, or
+    /// the same cracks, as when they were made. Throws InputError for a record that does not fit
+    /// the object (a voxel or tetrahedron it does not have).
+    virtual void replay_cuts(const nlohmann::json& cuts) = 0;
+    /// What the cuts do not fix, as numbers in the method's own order: positions and velocities
+    /// (and the branched grid's water and plastic strain per element). After the same cuts are
+    /// replayed, set_motion() puts the object back as it moved; it throws InputError when the
+    /// count does not fit or a number is not finite, changing nothing.
+    [[nodiscard]] virtual std::vector<double> motion() const = 0;
+    virtual void set_motion(const std::vector<double>& numbers) = 0;
+
     /// The state now (model, cuts, solver), and back to it; null where the method cannot go back
     /// yet (Is-XFEM: docs/isxfem.md).
     [[nodiscard]] virtual std::unique_ptr<Checkpoint> checkpoint() const = 0;
@@ -153,5 +174,8 @@ public:
 /// The volume enclosed by a closed surface (divergence theorem), mm^3: the same measure for every
 /// method's surface_mesh().
 [[nodiscard]] double enclosed_volume_mm3(const surface::SurfaceMesh& mesh);
+
+/// Throws InputError unless `numbers` holds `expected` finite numbers (Method::set_motion).
+void check_motion(const std::vector<double>& numbers, std::size_t expected);
 
 } // namespace vox::sim

@@ -23,6 +23,7 @@ struct RenderState {
     std::size_t elements = 0;
     int level = 0;
     std::string tool;                     ///< the active tool and what it does
+    std::string notice;                   ///< a line the window shows until it is empty again (the resume offer)
     int smooth = 0;                       ///< display smoothing the window is to give the surface
 };
 
@@ -41,6 +42,10 @@ struct ViewRequests {
     std::atomic<bool> save_object{false}, undo{false}, toggle_cut_mode{false};
     /// A stroke begins (the mouse button went down): the state before it is kept for undo.
     std::atomic<bool> stroke_started{false};
+    /// The stroke ends (the button went up): its cuts go to the session journal.
+    std::atomic<bool> stroke_ended{false};
+    /// Resume the earlier session the journal offered (J).
+    std::atomic<bool> resume{false};
     std::atomic<bool> picture_taken{true}; ///< the window has the last picture: make the next
     std::atomic<int> active{0};            ///< the tool the device drives
     std::atomic<int> level_change{0};      ///< +1 coarser, -1 finer

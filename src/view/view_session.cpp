@@ -12,6 +12,7 @@
 #include "io/tool_script.hpp"
 #include "sim/dbg_method.hpp"
 #include "sim/isxfem_method.hpp"
+#include "sim/journal.hpp"
 #include "view/scene_pictures.hpp"
 #include "view/view_channels.hpp"
 #include "view/view_simulation.hpp"
@@ -21,6 +22,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <optional>
 #include <thread>
 
 namespace vox::view {
@@ -45,6 +48,30 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     if (scene.solver.type == io::SolverType::isxfem) method = std::make_unique<sim::IsxfemMethod>(scene, labels, level);
     else method = std::make_unique<sim::DbgMethod>(scene, labels, level, grid_levels);
     sim::ToolPolicy tools(scene);
+
+    // The session journal (docs/journal.md): OUT/SCENE.journal. With --resume, the object starts as
+    // that journal's last stroke left it; otherwise the last session's journal of this scene is
+    // offered (J) until the first cut.
+    const std::filesystem::path session_journal =
+        std::filesystem::path(options.out_dir) / (std::filesystem::path(scene_path).stem().string() + ".journal");
+    const sim::JournalHeader header = sim::journal_header(scene_path, *method);
+    std::optional<sim::Journal> offered;
+    if (!options.resume.empty()) {
+        const sim::Journal journal = sim::read_journal(options.resume, header);
+        sim::resume(*method, journal);
+        log::info("resumed {}: {} stroke(s), {} cut(s)", options.resume, journal.strokes.size(), method->cut_count());
+    } else if (std::filesystem::exists(session_journal)) {
+        try {
+            sim::Journal earlier = sim::read_journal(session_journal, header);
+            if (!earlier.cuts().empty()) {
+                log::info("{}: an earlier session left {} stroke(s): press J in the window to resume them", session_journal.string(),
+                          earlier.strokes.size());
+                offered = std::move(earlier);
+            }
+        } catch (const InputError& e) {
+            log::info("an earlier journal is not offered: {}", e.what());
+        }
+    }
 
     // Where the first tool starts: where the scene's script puts it, else above the object.
     render::DrawMesh first = surface_picture(*method, 0);
@@ -110,6 +137,9 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     sim_options.smooth = options.smooth;
     sim_options.out_dir = options.out_dir;
     sim_options.start_mm = start;
+    sim_options.scene_file = scene_path;
+    sim_options.journal = session_journal;
+    sim_options.offered = std::move(offered);
     ViewSimulation simulation(scene, std::move(method), tools, channels, sim_options);
     // The simulation thread: from here on the only one to touch the method, the tools and the
     // scene's tool settings.

@@ -20,7 +20,8 @@ struct ViewOptions {
     std::size_t display_triangles = 150000; ///< draw a clustered copy above this many triangles (0: always the full surface)
     double exit_after_s = 0.0;            ///< > 0: close by itself this long after the first picture (tests, recordings)
     std::string screenshot;               ///< with exit_after_s: the last picture, PNG
-    std::string out_dir = ".";            ///< where screenshots and saved surfaces go
+    std::string out_dir = ".";            ///< where screenshots, saved surfaces and the session journal go
+    std::string resume;                   ///< a session journal to start from (empty: offer the last one, if any)
     /// "auto": a 6-DoF controller when one can be opened, else the mouse; "mouse"; "hid" (a
     /// controller, or an error saying why there is none).
     std::string device = "auto";

@@ -17,6 +17,34 @@ ViewSimulation::ViewSimulation(io::Scene& scene, std::unique_ptr<sim::Method> me
 {
     m_pose.shape = &tools.shape(0);
     m_pose.position = m_heading = options.start_mm;
+    start_journal();
+}
+
+void ViewSimulation::start_journal()
+{
+    if (m_options.journal.empty()) return;
+    m_journal.reset(); // closed before its file is set aside
+    m_journal = std::make_unique<sim::JournalWriter>(m_options.journal, sim::journal_header(m_options.scene_file, *m_method), *m_method,
+                                                     m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
+}
+
+void ViewSimulation::resume_offered()
+{
+    if (!m_options.offered) return;
+    if (m_method->cut_count() > 0) {
+        log::info("J: the earlier session can be resumed only before the first cut (U undoes it)");
+        return;
+    }
+    try {
+        sim::resume(*m_method, *m_options.offered);
+        let_go();
+        m_history.clear();
+        log::info("resumed the earlier session: {} stroke(s), {} cut(s)", m_options.offered->strokes.size(), m_method->cut_count());
+        if (m_journal) m_journal->end_stroke(*m_method, m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
+    } catch (const InputError& e) {
+        log::warn("not resumed: {}", e.what());
+    }
+    m_options.offered.reset();
 }
 
 void ViewSimulation::let_go()
@@ -37,6 +65,7 @@ void ViewSimulation::take_requests()
             let_go();
             m_level = at;
             m_history.clear(); // the deformation restarts from rest at the new level
+            start_journal();   // the journal holds one level's cuts
             log::info("level {}: {} elements ({}the deformation from rest)", at, m_method->element_count(),
                       m_method->name() == std::string("dbg") ? "the cuts kept, " : "uncut: Is-XFEM cannot carry cuts across levels yet; ");
         }
@@ -45,10 +74,15 @@ void ViewSimulation::take_requests()
         if (m_history.undo(*m_method)) {
             let_go();
             log::info("undo: back to before the last stroke");
+            if (m_journal) {
+                m_journal->rewound(*m_method);
+                m_journal->end_stroke(*m_method, m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
+            }
         } else {
             log::info("{}", m_method->checkpoint() ? "undo: nothing to undo" : "undo: not available with this method yet (docs/viewer.md)");
         }
     }
+    if (r.resume.exchange(false)) resume_offered();
     io::ToolSpec& active = m_scene.tools[static_cast<std::size_t>(r.active.load())];
     if (const int a = r.set_action.exchange(-1); a >= 0)
         active.action = a == 0 ? io::ToolAction::push : a == 1 ? io::ToolAction::cut : io::ToolAction::wet;
@@ -75,10 +109,15 @@ bool ViewSimulation::step(double now_s)
     if (r.stroke_started.exchange(false)) m_history.before_stroke(*m_method);
     if (m_driven >= 0) m_tools.drive(static_cast<std::size_t>(m_driven), m_pose.position, m_pose.orientation);
     try {
-        m_loop.next();
+        const sim::FrameStats frame = m_loop.next();
+        // A stroke ends when the button goes up, or (a 6-DoF controller) when a cut ends or the tool rests.
+        const bool released = r.stroke_ended.exchange(false);
+        if (m_stroke_ends.after_frame(frame) || released)
+            if (m_journal) m_journal->end_stroke(*m_method, frame.frame, frame.t_s);
     } catch (const InputError& e) { // a step that cannot be trusted: said, and the session paused to keep it
         log::warn("{}; paused (SPACE runs on, U undoes the last stroke)", e.what());
         r.paused = true;
+        if (m_journal) m_journal->end_stroke(*m_method, m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
     }
     // The surface near the tool and where the device is heading, for the haptic thread.
     contact::SurfacePoints& out = m_channels.snapshots.write_slot();
@@ -133,6 +172,10 @@ void ViewSimulation::make_picture()
     r.t_s = m_loop.frames() * m_scene.solver.dt_s;
     r.elements = m_method->element_count();
     r.level = m_level;
+    r.notice = m_options.offered && m_method->cut_count() == 0
+                   ? "An earlier session with this scene left " + std::to_string(m_options.offered->strokes.size()) +
+                         " stroke(s) in its journal: press J to resume them"
+                   : std::string();
     const io::ToolSpec& tool = m_scene.tools[static_cast<std::size_t>(q.active.load())];
     r.tool = tool.name + " (" +
              (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")

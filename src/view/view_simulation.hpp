@@ -6,6 +6,7 @@
 // step() is one iteration, so a test can drive it without threads or a window.
 
 #include "sim/frame_loop.hpp"
+#include "sim/journal.hpp"
 #include "sim/undo_history.hpp"
 #include "view/view_channels.hpp"
 
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <thread>
 #include <memory>
+#include <optional>
 
 namespace vox::view {
 
@@ -21,6 +23,12 @@ struct ViewSimulationOptions {
     int smooth = 4;                     ///< display smoothing the window gives the surface
     std::filesystem::path out_dir = "."; ///< where S saves
     Eigen::Vector3d start_mm = Eigen::Vector3d::Zero(); ///< where the tool is until the haptic thread reports
+    /// The session journal (sim/journal.hpp): written here, for the scene file `scene_file`; empty:
+    /// none (tests).
+    std::filesystem::path journal;
+    std::filesystem::path scene_file;
+    /// An earlier session's journal of this scene, offered until the first cut: J resumes it.
+    std::optional<sim::Journal> offered;
 };
 
 class ViewSimulation {
@@ -47,6 +55,10 @@ private:
     void let_go();
     void save() const;
     void make_picture();
+    /// A new journal for the method as it now is (the session's start, another level).
+    void start_journal();
+    /// The earlier session's cuts made on the object, when it has none yet.
+    void resume_offered();
 
     io::Scene& m_scene;
     std::unique_ptr<sim::Method> m_method;
@@ -55,6 +67,8 @@ private:
     ViewSimulationOptions m_options;
     sim::FrameLoop m_loop;
     sim::UndoHistory m_history; ///< the state before each stroke
+    std::unique_ptr<sim::JournalWriter> m_journal;
+    sim::StrokeEnds m_stroke_ends; ///< a 6-DoF controller's strokes (no button says when they end)
     int m_level = 1;
     int m_driven = -1; ///< the tool the device drives (-1: none yet)
     contact::PlacedShape m_pose;

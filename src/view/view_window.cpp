@@ -36,6 +36,7 @@ const char* const key_map = "mouse left: move the tool (a stroke)   wheel: neare
                             "mouse right: orbit   middle: pan   shift + wheel: zoom\n"
                             "R: reset the view   TAB: next tool   1 push  2 cut  3 wet\n"
                             "M: cut mode (remove / separate)   U: undo the last stroke\n"
+                            "J: resume the earlier session its journal offers\n"
                             "SPACE: pause / run   N: one step while paused\n"
                             "+ / -: coarser / finer level (deformation restarts)\n"
                             "C: element cage   V: the fine voxels   L: level of detail\n"
@@ -85,6 +86,7 @@ void run_window(const WindowSetup& setup, ViewChannels& ch, haptics::PointerDevi
         case GLFW_KEY_L: use_lod = !use_lod; break;
         case GLFW_KEY_S: rq.save_object = true; break;
         case GLFW_KEY_U: rq.undo = true; break;
+        case GLFW_KEY_J: rq.resume = true; break;
         case GLFW_KEY_M: rq.toggle_cut_mode = true; break;
         case GLFW_KEY_1: rq.set_action = 0; break;
         case GLFW_KEY_2: rq.set_action = 1; break;
@@ -114,7 +116,11 @@ void run_window(const WindowSetup& setup, ViewChannels& ch, haptics::PointerDevi
         }
     };
     input.button = [&](int button, bool down, int) {
-        if (button != GLFW_MOUSE_BUTTON_LEFT || !down) return;
+        if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+        if (!down) {
+            rq.stroke_ended = true; // the stroke's cuts go to the session journal
+            return;
+        }
         rq.stroke_started = true; // a stroke begins: what U undoes
         pointer.point_at(pointer_at(mouse_x, mouse_y));
     };
@@ -189,7 +195,8 @@ void run_window(const WindowSetup& setup, ViewChannels& ch, haptics::PointerDevi
                       drawn.empty() ? 0 : drawn.front().indices.size() / 3, use_lod && lod && drawn.front().indices.size() / 3 < lod_source_triangles ? " (display level of detail)" : "",
                       shown ? shown->tool.c_str() : "", rq.show_cage.load() ? "   cage shown" : "");
         text.draw(status, 14, 14, width, height);
-        if (show_help) text.draw(key_map, 14, height - 8 * 22 - 14, width, height);
+        if (shown && !shown->notice.empty()) text.draw(shown->notice, 14, 14 + 4 * 22, width, height);
+        if (show_help) text.draw(key_map, 14, height - 9 * 22 - 14, width, height);
         if (have_picture && first_shown < 0.0) first_shown = t;
         const bool last = setup.options.exit_after_s > 0.0 && first_shown >= 0.0 && t >= first_shown + setup.options.exit_after_s;
         if (screenshot || (last && !setup.options.screenshot.empty())) {

@@ -251,6 +251,7 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
         {"nii_huge_dims.nii", "memory limit"},
         {"nii_nan_pixdim.nii", "pixdim[2] = nan is not a positive voxel size"},
         {"nii_gz_vox_offset_past_end.nii.gz", "truncated: holds 0 bytes of voxel data after vox_offset 3000000000"},
+        {"nii_tiny_spacing.nii", "voxel spacing along axis 2 is 7.458340731200207e-155 mm, below the 0.0001 mm"},
         {"nii_truncated.nii.gz", "truncated"},
         {"nii_wrong_magic.nii", "wrong magic 'n+2'"},
         {"nii_zero_spacing.nii", "pixdim[2] = 0"},

@@ -97,6 +97,19 @@ TEST(NiftiReader, SlopeAndInterceptScaleValues)
     EXPECT_EQ(v.scaled(1), -1104.0);
 }
 
+TEST(NiftiReader, TheGzipFileAskedForIsReadEvenWithAPlainOneBesideIt)
+{
+    // Fuzzing found libnifti reading the voxels of "twin.nii" when asked for "twin.nii.gz".
+    const std::string gz = write_nifti_file("twin.nii.gz", [](nifti_image& nim) { nim.scl_slope = 1; });
+    const std::string plain = write_nifti_file("twin.nii", [](nifti_image& nim) {
+        auto* data = static_cast<std::int16_t*>(nim.data);
+        for (int n = 0; n < 12; ++n) data[n] = 7;
+    });
+    const Volume v = read_volume(gz);
+    for (int n = 0; n < 12; ++n) EXPECT_EQ(v.stored(n), n * 10 - 50) << n;
+    EXPECT_EQ(read_volume(plain).stored(3), 7.0);
+}
+
 TEST(NiftiReader, MissingFileAndGarbageAreInputErrors)
 {
     EXPECT_THROW((void)read_volume("/nonexistent/scan.nii"), vox::InputError);
