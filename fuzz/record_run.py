@@ -2,7 +2,7 @@
 """Records one timed fuzzing run (fuzz/run.sh) in docs/fuzzing/results.json, or renders the
 results into the table of docs/fuzzing.md (between its <!-- results --> markers).
 
-  record_run.py RESULTS TARGET MINUTES EXIT CORPUS_BEFORE CORPUS_AFTER ARTIFACTS LOG
+  record_run.py RESULTS TARGET SECONDS EXIT CORPUS_BEFORE CORPUS_AFTER ARTIFACTS LOG
   record_run.py --render RESULTS FUZZING_MD
 """
 import datetime
@@ -44,7 +44,7 @@ def parse_log(path):
     return stats
 
 
-def record(results_path, target, minutes, status, before, after, artifacts, log):
+def record(results_path, target, seconds, status, before, after, artifacts, log):
     results = {"runs": []}
     if os.path.exists(results_path):
         with open(results_path) as f:
@@ -53,7 +53,7 @@ def record(results_path, target, minutes, status, before, after, artifacts, log)
     results["runs"].append({
         "target": target,
         "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "minutes": int(minutes),
+        "seconds": int(seconds),
         "exit_status": int(status),
         "executions": s["number_of_executed_units"],
         "executions_per_s": s["average_exec_per_sec"],
@@ -75,12 +75,13 @@ def record(results_path, target, minutes, status, before, after, artifacts, log)
 def render(results_path, md_path):
     with open(results_path) as f:
         runs = json.load(f)["runs"]
-    rows = ["| target | minutes in all | last run | executions (last) | exec/s | edges | corpus files | failures |",
+    rows = ["| target | minutes in all (clean runs) | last run | executions (last) | exec/s | edges | corpus files | failures |",
             "|---|---|---|---|---|---|---|---|"]
     for target in sorted({r["target"] for r in runs}):
         mine = [r for r in runs if r["target"] == target]
         last = mine[-1]
-        rows.append(f"| {target} | {sum(r['minutes'] for r in mine)} | {last['date']} | {last['executions']} | "
+        clean = sum(r["seconds"] for r in mine if r["exit_status"] == 0) / 60
+        rows.append(f"| {target} | {clean:.0f} | {last['date']} | {last['executions']} | "
                     f"{last['executions_per_s']} | {last['edges_covered']} | {last['corpus_before']} -> "
                     f"{last['corpus_after']} | {sum(r['failures'] for r in mine)} |")
     machines = sorted({r["machine"] for r in runs})

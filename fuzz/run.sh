@@ -41,15 +41,16 @@ run_one() {
   mkdir -p "$fresh" "$art" "$(dirname "$log")"
   local before; before=$(find "$root/fuzz/corpus/$t" -type f | wc -l)
   local max_len=4096; [ "$t" = vdb ] && max_len=16384
-  local status=0
+  local status=0 start; start=$(date +%s)
   # New inputs go to $fresh; the committed corpus seeds the run and is only read.
   "$exe" -max_total_time=$((minutes * 60)) -timeout=10 -rss_limit_mb=2048 -max_len=$max_len \
     -print_final_stats=1 -artifact_prefix="$art/" "$fresh" "$root/fuzz/corpus/$t" >"$log" 2>&1 || status=$?
+  local seconds=$(( $(date +%s) - start ))
   # Keep only what reaches code the corpus does not.
   "$exe" -merge=1 "$root/fuzz/corpus/$t" "$fresh" >>"$log" 2>&1 || true
   local after; after=$(find "$root/fuzz/corpus/$t" -type f | wc -l)
   local crashes; crashes=$(find "$art" -type f | wc -l)
-  python3 "$root/fuzz/record_run.py" "$root/docs/fuzzing/results.json" "$t" "$minutes" "$status" "$before" "$after" \
+  python3 "$root/fuzz/record_run.py" "$root/docs/fuzzing/results.json" "$t" "$seconds" "$status" "$before" "$after" \
     "$crashes" "$log"
   echo "fuzz: $t: exit $status, corpus $before -> $after files, $crashes artifact(s); log $log"
 }

@@ -7,8 +7,10 @@
 #include "io/text_parsing.hpp"
 #include "io/volume_reader.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -31,9 +33,11 @@ long long parse_int(const std::string& path, const std::map<std::string, std::st
         return fallback;
     }
     char* end = nullptr;
+    errno = 0;
     const long long v = std::strtoll(it->second.c_str(), &end, 10);
     if (end == it->second.c_str() || *end != '\0')
         throw file_error(path, key + "=" + printable(it->second) + " is not an integer");
+    if (errno == ERANGE) throw file_error(path, key + "=" + printable(it->second) + " is beyond a 64-bit integer");
     return v;
 }
 
@@ -121,7 +125,13 @@ Volume read_inr(const std::string& path)
                                  parse_real(path, kv, "ZO", parse_real(path, kv, "TZ", 0.0)));
     v.index_to_world = make_index_to_world(spacing, Eigen::Matrix3d::Identity(), origin);
 
-    const auto count = static_cast<std::uint64_t>(v.voxel_count());
+    // The product checked before it is formed: three 64-bit sizes overflow it (found by fuzzing).
+    std::uint64_t count = 1;
+    for (const std::int64_t d : v.dims) {
+        if (count > std::numeric_limits<std::uint64_t>::max() / static_cast<std::uint64_t>(d))
+            throw file_error(path, "dimensions overflow 64-bit sizes");
+        count *= static_cast<std::uint64_t>(d);
+    }
     check_allocation(path, count, scalar_size(v.type));
     const std::size_t need = count * scalar_size(v.type);
     if (bytes.size() - header_size < need)
