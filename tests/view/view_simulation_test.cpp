@@ -6,6 +6,7 @@
 #include "io/scene_object.hpp"
 #include "sim/dbg_method.hpp"
 #include "sim/isxfem_method.hpp"
+#include "sim/journal.hpp"
 #include "test_support.hpp"
 #include "view/view_simulation.hpp"
 
@@ -72,6 +73,69 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeCutsUndoPutsItBackAndTheKeysAreTaken)
     keys.level_change = 1; // beyond the grid's levels: stays
     ASSERT_TRUE(simulation.step(0.9));
     EXPECT_EQ(simulation.level(), 3);
+}
+
+TEST_P(ViewSimulationOnEachMethod, AStrokeIsJournaledWhenTheButtonGoesUpAndANewSessionResumesIt)
+{
+    const bool dbg = GetParam() == io::SolverType::dbg;
+    const std::filesystem::path scene_file = VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json";
+    io::Scene scene = io::load_scene(scene_file);
+    io::use_method(scene, GetParam());
+    scene.script.clear();
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    const auto make = [&]() -> std::unique_ptr<sim::Method> {
+        if (dbg) return std::make_unique<sim::DbgMethod>(scene, labels, 2, 3);
+        return std::make_unique<sim::IsxfemMethod>(scene, labels, 2);
+    };
+    const std::filesystem::path dir = vox::test::fresh_dir(std::string("view_journal_") + (dbg ? "dbg" : "isxfem"));
+    const std::filesystem::path journal = dir / "bar_cut_isxfem.journal";
+    std::size_t cuts = 0;
+    std::vector<double> motion;
+    {
+        sim::ToolPolicy tools(scene);
+        ViewChannels channels(20000);
+        ViewSimulationOptions options;
+        options.out_dir = dir;
+        options.journal = journal;
+        options.scene_file = scene_file;
+        ViewSimulation simulation(scene, make(), tools, channels, options);
+        channels.requests.stroke_started = true;
+        const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
+        for (int f = 0; f < 30; ++f) {
+            channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
+            channels.proxies.publish();
+            if (f == 29) channels.requests.stroke_ended = true; // the button goes up
+            ASSERT_TRUE(simulation.step(0.01 * f));
+        }
+        cuts = simulation.method().cut_count();
+        motion = simulation.method().motion();
+        ASSERT_GT(cuts, 0u);
+    } // the session ends (or the process dies): the journal is on disk
+
+    // The next session with this scene: offered, not applied, until J.
+    const sim::Journal earlier = sim::read_journal(journal, sim::journal_header(scene_file, *make()));
+    ASSERT_FALSE(earlier.strokes.empty());
+    sim::ToolPolicy tools(scene);
+    ViewChannels channels(20000);
+    ViewSimulationOptions options;
+    options.out_dir = dir;
+    options.journal = journal;
+    options.scene_file = scene_file;
+    options.offered = earlier;
+    ViewSimulation simulation(scene, make(), tools, channels, options);
+    ASSERT_TRUE(simulation.step(0.0));
+    EXPECT_EQ(simulation.method().cut_count(), 0u);
+    ASSERT_TRUE(channels.pictures.update());
+    EXPECT_NE(channels.pictures.read_slot().notice.find("press J to resume"), std::string::npos);
+    channels.requests.paused = true; // resumed exactly as it was: no frame stepped after it here
+    channels.requests.resume = true;
+    EXPECT_FALSE(simulation.step(0.01));
+    EXPECT_EQ(simulation.method().cut_count(), cuts);
+    EXPECT_EQ(simulation.method().motion(), motion);
+    EXPECT_TRUE(std::filesystem::exists(dir / "bar_cut_isxfem.journal.previous")) << "the earlier journal kept aside";
+    // The new session's journal holds the resumed cuts, so it can be resumed in turn.
+    const sim::Journal now = sim::read_journal(journal, sim::journal_header(scene_file, simulation.method()));
+    EXPECT_EQ(now.cuts(), earlier.cuts());
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, ViewSimulationOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
