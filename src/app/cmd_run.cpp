@@ -99,6 +99,8 @@ void add_run_command(CLI::App& app)
         std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
         if (!args->record.empty() && args->device.empty() && args->replay.empty())
             throw InputError("--record: there is no device to record; add --device script or --replay FILE");
+        if (!args->resume.empty() && !std::filesystem::is_regular_file(args->resume)) // before the object is loaded
+            throw file_error(args->resume, "no such file (--resume takes a session journal)");
 
         auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
         const sim::OpenedMethod opened = sim::open_method(scene, labels);
@@ -149,6 +151,8 @@ void add_run_command(CLI::App& app)
         const std::string linear_solver = method.linear_solver();
         sim::RunRecord record(args->scene, method, dt);
         if (opened.choice) record.document()["level_choice"] = level_choice_json(*opened.choice);
+        if (!args->resume.empty())
+            record.document()["resumed_from"] = {{"journal", args->resume}, {"frame", first_frame - 1}, {"cuts", method.cut_count()}};
         std::vector<sim::ForceSample> tool_forces; // without a device: the first placed tool's, per frame
         sim::FrameLoop loop(scene, method, tools, device.get());
         loop.go_on_from(first_frame - 1);
@@ -182,7 +186,8 @@ void add_run_command(CLI::App& app)
         write_atomically(dir / "stats.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << record.document().dump(1) << '\n'; });
         staging.commit();
         log::info("wrote {}: stats.json, final.obj and {} frame meshes; mean step {:.2f} ms, max displacement {:.3f} mm", out.string(),
-                  frames / scene.output.mesh_every_n_frames, record.total_step_ms() / std::max(frames, 1),
+                  frames / scene.output.mesh_every_n_frames - (first_frame - 1) / scene.output.mesh_every_n_frames,
+                  record.total_step_ms() / std::max(frames - first_frame + 1, 1),
                   record.last_step().max_displacement_mm);
     });
 }

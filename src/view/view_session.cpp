@@ -31,6 +31,8 @@ namespace vox::view {
 void run_view(const std::string& scene_path, const ViewOptions& options)
 {
     const io::Scene loaded = io::load_scene(scene_path);
+    if (!options.resume.empty() && !std::filesystem::is_regular_file(options.resume)) // before the object is loaded
+        throw file_error(options.resume, "no such file (--resume takes a session journal)");
     if (loaded.tools.empty()) throw loaded.error("tools", "the viewer needs at least one tool to sculpt with");
     // Not silently the other method: a researcher comparing the two must see the one asked for.
     // The user moves the tools: the script does not.
