@@ -14,6 +14,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+// In a build with sanitizers (fuzzing), the hook their reports end with; null otherwise.
+extern "C" void __sanitizer_set_death_callback(void (*callback)()) __attribute__((weak));
+
 namespace vox {
 namespace {
 
@@ -21,6 +24,7 @@ namespace {
 constexpr int k_exit_ok = 0;
 constexpr int k_exit_threw = 3;
 constexpr int k_exit_no_memory = 4;
+constexpr int k_exit_sanitizer = 5; ///< a sanitizer stopped it (instrumented builds)
 constexpr std::size_t k_max_message = 1000;
 
 /// The process's current address-space size in bytes (first field of /proc/self/statm, in pages).
@@ -36,6 +40,10 @@ std::uint64_t address_space_bytes()
 
 [[noreturn]] void child_main(const std::function<void()>& work, const ChildLimits& limits, int report_fd)
 {
+    // A crash here is the parent's to report: handlers inherited from it (a sanitizer's, a
+    // fuzzer's that would save the input as a failure of its own) give way to the default.
+    for (const int s : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(s, SIG_DFL);
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback([] { _exit(k_exit_sanitizer); });
     if (limits.silence_stderr) {
         const int null_fd = open("/dev/null", O_WRONLY);
         if (null_fd >= 0) dup2(null_fd, STDERR_FILENO);
@@ -116,6 +124,8 @@ ChildOutcome run_in_child(const std::function<void()>& work, const ChildLimits& 
         out.signal = WTERMSIG(status);
     } else if (WEXITSTATUS(status) == k_exit_no_memory) {
         out.kind = ChildOutcome::Kind::out_of_memory;
+    } else if (WEXITSTATUS(status) == k_exit_sanitizer) {
+        out.kind = ChildOutcome::Kind::crashed; // what a sanitizer found is what would crash, or worse, without it
     } else if (WEXITSTATUS(status) != k_exit_ok) {
         out.kind = ChildOutcome::Kind::failed;
         out.message = message.substr(0, k_max_message);
