@@ -227,6 +227,19 @@ LabelGrid LabelGrid::load(const std::filesystem::path& path)
     if (!found) throw file_error(name, "holds no int32 label grid (found " + std::to_string(grids->size()) + " grid(s) of other types)");
     if (!found->transform().isLinear()) throw file_error(name, "the grid's transform is not affine");
     found->setName("labels");
+    // A transform OpenVDB stored but cannot turn into a matrix (a zero scale), or one no scan has:
+    // refused as a scan's would be (io/volume.cpp). Found by fuzzing.
+    Eigen::Matrix4d t;
+    try {
+        t = from_vdb_transform(found->transform());
+    } catch (const openvdb::Exception& e) {
+        throw file_error(name, std::string("its grid transform is unusable (") + e.what() + ")");
+    }
+    constexpr double k_min_spacing_mm = 1e-4, k_max_world_mm = 1e6;
+    const Eigen::Vector3d spacing = t.topLeftCorner<3, 3>().colwise().norm();
+    if (!t.allFinite() || !(spacing.minCoeff() >= k_min_spacing_mm) || !(t.topRightCorner<3, 1>().cwiseAbs().maxCoeff() <= k_max_world_mm))
+        throw file_error(name, "its grid transform is not a scan's: voxel sizes below 0.0001 mm, an origin beyond 1e6 mm or a "
+                               "number that is not finite");
     return from_vdb(found);
 }
 

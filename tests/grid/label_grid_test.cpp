@@ -93,6 +93,7 @@ TEST(LabelGrid, CorruptFilesAreReadInAChildAndRefusedNamingTheFile)
         {"vdb_hang_memory_a.vdb", "reading it needs more than the memory limit of 512 MiB"},
         {"vdb_hang_memory_b.vdb", "reading it needs more than the memory limit of 512 MiB"},
         {"vdb_hang_spin.vdb", "OpenVDB's reader did not finish within 3 s"},
+        {"vdb_singular_transform.vdb", "its grid transform is unusable"}, // the vdb fuzz target's
     };
     for (const auto& [name, reason] : expected) {
         SCOPED_TRACE(name);
@@ -102,7 +103,7 @@ TEST(LabelGrid, CorruptFilesAreReadInAChildAndRefusedNamingTheFile)
             ADD_FAILURE() << "loaded";
         } catch (const vox::InputError& e) {
             const std::string message = e.what();
-            EXPECT_EQ(message.rfind(file + ": not a readable OpenVDB file", 0), 0u) << message;
+            EXPECT_EQ(message.rfind(file + ": ", 0), 0u) << message;
             EXPECT_NE(message.find(reason), std::string::npos) << message;
         }
     }
