@@ -3,12 +3,15 @@
 #include "core/atomic_file.hpp"
 #include "core/child_process.hpp"
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/memory_limit.hpp"
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
 
+#include <algorithm>
 #include <fstream>
+#include <iostream>
 #include <mutex>
 #include <sstream>
 
@@ -217,12 +220,21 @@ LabelGrid LabelGrid::load(const std::filesystem::path& path)
     in.clear();
     in.seekg(0);
     openvdb::GridPtrVecPtr grids;
+    // OpenVDB's reader writes its warnings ("multi-buffer trees are no longer supported") to
+    // std::cerr itself; they go to the debug log instead, so a refusal stays one line.
+    std::ostringstream warnings;
+    std::streambuf* const cerr_buffer = std::cerr.rdbuf(warnings.rdbuf());
     try {
         openvdb::io::Stream stream(in);
         grids = stream.getGrids();
     } catch (const std::exception& e) {
+        std::cerr.rdbuf(cerr_buffer);
         throw file_error(name, std::string("not a readable OpenVDB file (") + e.what() + ")");
     }
+    std::cerr.rdbuf(cerr_buffer);
+    std::string said = warnings.str();
+    std::replace(said.begin(), said.end(), '\n', ' ');
+    if (!said.empty()) log::debug("{}: OpenVDB: {}", name, said);
     openvdb::Int32Grid::Ptr found = label_grid_of(*grids);
     if (!found) throw file_error(name, "holds no int32 label grid (found " + std::to_string(grids->size()) + " grid(s) of other types)");
     if (!found->transform().isLinear()) throw file_error(name, "the grid's transform is not affine");
