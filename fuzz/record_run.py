@@ -75,7 +75,7 @@ def record(results_path, target, seconds, status, before, after, artifacts, log)
 def render(results_path, md_path):
     with open(results_path) as f:
         runs = json.load(f)["runs"]
-    rows = ["| target | minutes in all (clean runs) | last run | executions (last) | exec/s | edges | corpus files | failures |",
+    rows = ["| target | minutes in all (clean runs) | last run | executions (last) | exec/s | edges | corpus files | failures found (all runs) |",
             "|---|---|---|---|---|---|---|---|"]
     for target in sorted({r["target"] for r in runs}):
         mine = [r for r in runs if r["target"] == target]
