@@ -50,7 +50,7 @@ run_one() {
     -print_final_stats=1 -artifact_prefix="$art/" "$fresh" "$root/fuzz/corpus/$t" >"$log" 2>&1 || status=$?
   local seconds=$(( $(date +%s) - start ))
   # Keep only what reaches code the corpus does not.
-  "$exe" -merge=1 "$root/fuzz/corpus/$t" "$fresh" >>"$log" 2>&1 || true
+  "$exe" -merge=1 -artifact_prefix="$art/" "${extra[@]}" "$root/fuzz/corpus/$t" "$fresh" >>"$log" 2>&1 || true
   local after; after=$(find "$root/fuzz/corpus/$t" -type f | wc -l)
   local crashes; crashes=$(find "$art" -type f | wc -l)
   # One writer at a time: targets run in parallel.
