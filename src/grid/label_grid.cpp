@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory_limit.hpp"
+#include "grid/voxel_limits.hpp"
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
@@ -247,9 +248,8 @@ LabelGrid LabelGrid::load(const std::filesystem::path& path)
     } catch (const openvdb::Exception& e) {
         throw file_error(name, std::string("its grid transform is unusable (") + e.what() + ")");
     }
-    constexpr double k_min_spacing_mm = 1e-4, k_max_world_mm = 1e6;
     const Eigen::Vector3d spacing = t.topLeftCorner<3, 3>().colwise().norm();
-    if (!t.allFinite() || !(spacing.minCoeff() >= k_min_spacing_mm) || !(t.topRightCorner<3, 1>().cwiseAbs().maxCoeff() <= k_max_world_mm))
+    if (!t.allFinite() || !(spacing.minCoeff() >= k_min_voxel_mm) || !(t.topRightCorner<3, 1>().cwiseAbs().maxCoeff() <= k_max_world_mm))
         throw file_error(name, "its grid transform is not a scan's: voxel sizes below 0.0001 mm, an origin beyond 1e6 mm or a "
                                "number that is not finite");
     return from_vdb(found);

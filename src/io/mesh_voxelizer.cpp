@@ -6,6 +6,7 @@
 #include "core/log.hpp"
 #include "core/memory_limit.hpp"
 #include "core/progress.hpp"
+#include "grid/voxel_limits.hpp"
 #include "io/winding_number.hpp"
 
 #include <openvdb/openvdb.h>
@@ -156,8 +157,7 @@ grid::LabelGrid voxelize_mesh(const TriangleMesh& mesh_mm, double voxel_mm, cons
 {
     if (!std::isfinite(voxel_mm) || voxel_mm <= 0.0)
         throw file_error(options.name, fmt::format("voxel size {} mm must be positive and finite", voxel_mm));
-    constexpr double k_min_voxel_mm = 1e-4; // as for scans (io/volume.cpp): below, the grid's transform is singular
-    if (voxel_mm < k_min_voxel_mm)
+    if (voxel_mm < grid::k_min_voxel_mm)
         throw file_error(options.name, fmt::format("voxel size {:g} mm is below the 0.0001 mm (0.1 micrometre) limit (a mesh "
                                                    "this small needs --scale, millimetres per file unit)",
                                                    voxel_mm));

@@ -23,7 +23,6 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -199,39 +198,12 @@ RawHeader check_header(const std::string& path)
     return raw;
 }
 
-/// Bytes of decompressed data in a gzip file, counted up to `enough` (no further: a legitimate
-/// file need not be inflated to its end twice).
-std::uint64_t gzip_size_up_to(const std::string& path, std::uint64_t enough)
-{
-    gzFile gz = gzopen(path.c_str(), "rb");
-    if (!gz) throw file_error(path, "cannot open");
-    std::vector<char> chunk(1 << 16);
-    std::uint64_t total = 0;
-    while (total < enough) {
-        const int got = gzread(gz, chunk.data(), static_cast<unsigned>(chunk.size()));
-        if (got <= 0) break;
-        total += static_cast<std::uint64_t>(got);
-    }
-    gzclose(gz);
-    return total;
-}
-
-/// Refuses a file too short for the voxels its header declares. libnifti would only say that it
-/// cannot load them, and a gzip file whose vox_offset points past its data it reads from the wrong
-/// place without complaint: so a gzip file's decompressed size is counted here.
-void check_data_size(const std::string& path, const RawHeader& raw)
-{
-    const auto offset = static_cast<std::uint64_t>(raw.vox_offset);
-    std::error_code ec;
-    const std::uint64_t size = is_gzip_file(path) ? gzip_size_up_to(path, offset + raw.voxel_bytes)
-                                                  : std::filesystem::file_size(path, ec);
-    if (ec || size >= offset + raw.voxel_bytes) return;
-    throw file_error(path, "truncated: holds " + std::to_string(size > offset ? size - offset : 0) +
-                               " bytes of voxel data after vox_offset " + std::to_string(offset) +
-                               ", the header's dimensions need " + std::to_string(raw.voxel_bytes));
-}
-
-/// `bytes` bytes of the file (decompressed when it is gzip) from `offset` on.
+/// `bytes` bytes of the file (decompressed when it is gzip) from `offset` on, inflated once. A
+/// file too short for them is refused with what it holds: libnifti would only say that it cannot
+/// load them, and for a gzip file whose vox_offset points past its data it read from the wrong place
+/// without complaint. libnifti's loader is not used for the voxels at all: it looks for the image
+/// file by name and, when "scan.nii" lies beside the "scan.nii.gz" asked for, reads the other one's
+/// (found by fuzzing).
 std::vector<std::byte> read_voxels(const std::string& path, std::uint64_t offset, std::uint64_t bytes)
 {
     gzFile gz = gzopen(path.c_str(), "rb"); // reads plain files as they are
@@ -244,13 +216,17 @@ std::vector<std::byte> read_voxels(const std::string& path, std::uint64_t offset
         ok = gzread(gz, skip.data(), n) == static_cast<int>(n);
         skipped += n;
     }
-    for (std::uint64_t done = 0; ok && done < bytes;) {
+    std::uint64_t done = 0;
+    while (ok && done < bytes) {
         const auto n = static_cast<unsigned>(std::min<std::uint64_t>(std::uint64_t{1} << 30, bytes - done));
-        ok = gzread(gz, data.data() + done, n) == static_cast<int>(n);
-        done += n;
+        const int got = gzread(gz, data.data() + done, n);
+        ok = got == static_cast<int>(n);
+        done += got > 0 ? static_cast<std::uint64_t>(got) : 0;
     }
     gzclose(gz);
-    if (!ok) throw file_error(path, "truncated or unreadable voxel data");
+    if (!ok)
+        throw file_error(path, "truncated: holds " + std::to_string(done) + " bytes of voxel data after vox_offset " +
+                                   std::to_string(offset) + ", the header's dimensions need " + std::to_string(bytes));
     return data;
 }
 
@@ -286,7 +262,6 @@ Volume read_nifti(const std::string& path)
     std::call_once(quiet, [] { nifti_set_debug_level(0); });
     check_input_file(path);
     const RawHeader raw = check_header(path);
-    check_data_size(path, raw);
 
     NiftiPtr nim(nifti_image_read(path.c_str(), 0)); // the header only
     if (!nim) throw file_error(path, "not a readable NIfTI file (libnifti refuses its header)");
@@ -299,9 +274,6 @@ Volume read_nifti(const std::string& path)
             throw file_error(path, "dimension " + std::to_string(a) + " is " + std::to_string(v.dims[a]));
     check_allocation(path, static_cast<std::uint64_t>(v.voxel_count()), scalar_size(v.type));
 
-    // The voxels are read here, from this very file: libnifti's loader looks for the image file by
-    // name and, when "scan.nii" lies beside the "scan.nii.gz" asked for, reads the other one's
-    // (found by fuzzing).
     v.data = read_voxels(path, static_cast<std::uint64_t>(raw.vox_offset), static_cast<std::uint64_t>(v.voxel_count()) * scalar_size(v.type));
     if (nim->byteorder != nifti_short_order()) swap_bytes(v);
 

@@ -1,6 +1,7 @@
 #include "io/volume.hpp"
 
 #include "core/error.hpp"
+#include "grid/voxel_limits.hpp"
 #include "io/text_parsing.hpp"
 
 #include <algorithm>
@@ -76,25 +77,20 @@ void validate(const Volume& v)
                                            " (must be positive)");
     if (!v.index_to_world.allFinite()) throw file_error(v.source, "the index-to-world transform is not finite");
     const Eigen::Vector3d s = v.spacing();
-    // Below a tenth of a micrometre no scanner images (micro-CT reaches a micrometre), and the
-    // grid's affine transform would be singular in double precision.
-    constexpr double k_min_spacing_mm = 1e-4;
+    // The limits every grid takes (grid/voxel_limits.hpp).
     for (int a = 0; a < 3; ++a) {
         if (!(s[a] > 0.0)) throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is zero");
-        if (s[a] < k_min_spacing_mm)
+        if (s[a] < grid::k_min_voxel_mm)
             throw file_error(v.source, "voxel spacing along axis " + std::to_string(a) + " is " + detail::number_text(s[a]) +
                                            " mm, below the 0.0001 mm (0.1 micrometre) limit");
     }
     if (std::abs(v.index_to_world.topLeftCorner<3, 3>().determinant()) <= 1e-12 * s.prod())
         throw file_error(v.source, "the voxel axes are degenerate (direction matrix is singular)");
-    // Far beyond any scanner or studio; past it the grid's transforms lose their precision, and
-    // near 1e308 they overflow.
-    constexpr double k_max_world_mm = 1e6;
     for (int corner = 0; corner < 8; ++corner) {
         const Eigen::Vector4d index((corner & 1) ? v.dims[0] : 0, (corner & 2) ? v.dims[1] : 0,
                                     (corner & 4) ? v.dims[2] : 0, 1.0);
         const double far = (v.index_to_world * index).head<3>().cwiseAbs().maxCoeff();
-        if (!(far <= k_max_world_mm))
+        if (!(far <= grid::k_max_world_mm))
             throw file_error(v.source, "its voxels lie up to " + detail::number_text(far) +
                                            " mm from the origin, beyond the 1e6 mm (1 km) limit: check its origin and spacing");
     }

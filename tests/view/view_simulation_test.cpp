@@ -89,15 +89,15 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeIsJournaledWhenTheButtonGoesUpAndANewS
     };
     const std::filesystem::path dir = vox::test::fresh_dir(std::string("view_journal_") + (dbg ? "dbg" : "isxfem"));
     const std::filesystem::path journal = dir / "bar_cut_isxfem.journal";
+    ViewSimulationOptions options; // both sessions journal to the same place
+    options.out_dir = dir;
+    options.journal = journal;
+    options.scene_file = scene_file;
     std::size_t cuts = 0;
     std::vector<double> motion;
     {
         sim::ToolPolicy tools(scene);
         ViewChannels channels(20000);
-        ViewSimulationOptions options;
-        options.out_dir = dir;
-        options.journal = journal;
-        options.scene_file = scene_file;
         ViewSimulation simulation(scene, make(), tools, channels, options);
         channels.requests.stroke_started = true;
         const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
@@ -117,10 +117,6 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeIsJournaledWhenTheButtonGoesUpAndANewS
     ASSERT_FALSE(earlier.strokes.empty());
     sim::ToolPolicy tools(scene);
     ViewChannels channels(20000);
-    ViewSimulationOptions options;
-    options.out_dir = dir;
-    options.journal = journal;
-    options.scene_file = scene_file;
     options.offered = earlier;
     ViewSimulation simulation(scene, make(), tools, channels, options);
     ASSERT_TRUE(simulation.step(0.0));
