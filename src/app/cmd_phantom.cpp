@@ -2,6 +2,8 @@
 #include "app/selection_options.hpp"
 #include "core/log.hpp"
 #include "grid/phantom.hpp"
+#include "io/nifti_writer.hpp"
+#include "io/skull_phantom.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -58,6 +60,22 @@ void add_phantom_command(CLI::App& app)
                       labels.active_voxel_count(), spec->voxel_mm);
         });
     }
+
+    auto skull = std::make_shared<io::SkullPhantomSpec>();
+    auto skull_out = std::make_shared<std::string>();
+    auto spacing = std::make_shared<std::vector<double>>();
+    CLI::App* cmd = phantom->add_subcommand(
+        "skull", "A head CT in Hounsfield units (.nii or .nii.gz): skull vault with orbits, brain, scalp, a separate "
+                 "head holder and loose fragments; select bone with a threshold (226:3071)");
+    cmd->add_option("-o,--output", *skull_out, "Output .nii.gz or .nii file")->required();
+    cmd->add_option("--voxel-mm", *spacing, "Voxel spacing x y z, mm (default 0.9 0.9 1.5)")->expected(3);
+    cmd->callback([skull, skull_out, spacing] {
+        if (spacing->size() == 3) skull->voxel_mm = {(*spacing)[0], (*spacing)[1], (*spacing)[2]};
+        const io::Volume v = io::make_skull_phantom(*skull);
+        io::write_nifti(v, *skull_out);
+        log::info("wrote {}: skull phantom, {} x {} x {} voxels of {} x {} x {} mm", *skull_out, v.dims[0], v.dims[1],
+                  v.dims[2], skull->voxel_mm.x(), skull->voxel_mm.y(), skull->voxel_mm.z());
+    });
 }
 
 } // namespace vox::app

@@ -117,10 +117,46 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> read_box(const JsonNode& box)
 /// A scalpel's size when the scene gives none: about a No. 10 surgical blade, mm.
 const Eigen::Vector3d default_scalpel_size_mm(30.0, 0.5, 8.0);
 
+PieceSelection read_piece_selection(JsonReader& r)
+{
+    PieceSelection p;
+    if (const std::optional<JsonNode> node = r.optional_node("components")) {
+        if (node->value().is_string()) {
+            const std::string text = as<std::string>(*node);
+            if (text == "largest") {
+                p.components = PieceSelection::Components::largest;
+            } else if (text == "held") {
+                p.components = PieceSelection::Components::held;
+            } else {
+                node->fail("expected \"largest\", \"held\" or a number of pieces (the N largest)");
+            }
+        } else {
+            p.components = PieceSelection::Components::count;
+            p.count = static_cast<std::uint32_t>(as<int>(*node, at_least(1.0)));
+        }
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("min_voxels")) {
+        p.min_voxels = static_cast<std::uint64_t>(as<int>(*node, at_least(1.0)));
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("seed_mm")) {
+        const std::vector<JsonNode> points = node->elements();
+        if (points.empty()) node->fail("must list at least one point [x, y, z]");
+        for (const JsonNode& point : points) p.seeds_mm.push_back(finite_vector(point));
+    }
+    return p;
+}
+
 Selection read_selection(JsonReader r)
 {
     Selection s;
-    if (r.exactly_one_of({"label", "threshold"}) == "label") {
+    s.pieces = read_piece_selection(r);
+    if (r.has("label") && r.has("threshold")) {
+        r.node().fail("takes only one of \"label\", \"threshold\"");
+    }
+    if (!r.has("label") && !r.has("threshold")) {
+        // Pieces of every non-zero voxel.
+        if (s.pieces.empty()) r.node().fail("needs label, threshold, components, min_voxels or seed_mm");
+    } else if (r.has("label")) {
         const JsonNode node = r.required_node("label");
         // A single label may be written without brackets.
         const std::vector<JsonNode> items = node.value().is_number() ? std::vector<JsonNode>{node} : node.elements();
@@ -269,6 +305,12 @@ SceneObject read_object(JsonReader r)
     }
     if (!o.auto_levels && (budget || error)) {
         (budget ? *budget : *error).fail("only meaningful with \"levels\": \"auto\"");
+    }
+    if (const std::optional<JsonNode> node = r.optional_node("unheld_pieces")) {
+        static constexpr NameTable<UnheldPieces, 3> names{{{"hold", UnheldPieces::hold},
+                                                           {"fall", UnheldPieces::fall},
+                                                           {"leave_out", UnheldPieces::leave_out}}};
+        o.unheld = choose_enum(*node, names);
     }
     r.finish("for a " + std::string(kind) + " object");
     return o;
@@ -564,6 +606,10 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
         for (const JsonNode& node : constraints->elements()) {
             scene.constraints.push_back(read_constraint(JsonReader(node)));
         }
+    }
+    // "components": "held" keeps the pieces the constraint boxes reach.
+    for (const Constraint& c : scene.constraints) {
+        scene.object.select.pieces.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
     }
     if (loads) {
         for (const JsonNode& node : loads->elements()) {

@@ -32,6 +32,14 @@ enum class ObjectKind {
     mesh,    ///< a closed triangle mesh, voxelised
 };
 
+/// What becomes of the object's pieces that no constraint box reaches (a CT's loose fragments, a
+/// scanner's head holder), from the start of a run. Pieces a cut frees later fall.
+enum class UnheldPieces {
+    hold,      ///< "hold" (default): they stay where the scan has them (every node fixed)
+    fall,      ///< "fall": they move freely, under gravity and tools
+    leave_out, ///< "leave_out": they are not simulated at all
+};
+
 /// The object to simulate: its source, and the coarsening level it is simulated at.
 struct SceneObject {
     ObjectKind kind = ObjectKind::phantom;
@@ -55,6 +63,8 @@ struct SceneObject {
     /// whose measured step fits) or max_error (the coarsest level whose deflection differs from
     /// the next finer level's by at most this fraction); exactly one of the two is given.
     bool auto_levels = false;
+    /// Key "unheld_pieces".
+    UnheldPieces unheld = UnheldPieces::hold;
     std::optional<double> step_budget_ms;
     std::optional<double> max_error;
 };

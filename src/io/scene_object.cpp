@@ -20,7 +20,33 @@ grid::LabelGrid load_scene_object(const Scene& scene)
     }
 }
 
+namespace {
+
+/// "unheld_pieces": "leave_out": only the pieces a constraint box reaches.
+grid::LabelGrid leave_out_unheld(const Scene& scene, grid::LabelGrid labels)
+{
+    if (scene.object.unheld != UnheldPieces::leave_out) return labels;
+    if (scene.constraints.empty())
+        throw scene.error("object.unheld_pieces", "\"leave_out\" would leave out the whole object: no constraint "
+                                                  "holds any of it");
+    PieceSelection held;
+    held.components = PieceSelection::Components::held;
+    for (const Constraint& c : scene.constraints) held.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
+    return select_pieces(labels, held, labels.metadata("source"));
+}
+
+grid::LabelGrid build_object_voxels(const Scene& scene);
+
+} // namespace
+
 grid::LabelGrid build_scene_object(const Scene& scene)
+{
+    return leave_out_unheld(scene, build_object_voxels(scene));
+}
+
+namespace {
+
+grid::LabelGrid build_object_voxels(const Scene& scene)
 {
     const SceneObject& o = scene.object;
     switch (o.kind) {
@@ -43,6 +69,8 @@ grid::LabelGrid build_scene_object(const Scene& scene)
     }
     throw scene.error("object", "unknown object kind");
 }
+
+} // namespace
 
 void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
 {

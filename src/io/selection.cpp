@@ -78,15 +78,20 @@ void check_integer_label(const std::string& source, double stored)
 
 std::string Selection::describe() const
 {
-    if (threshold_min)
-        return "threshold [" + format_number(*threshold_min) + ", " +
-               (threshold_max ? format_number(*threshold_max) : std::string("inf")) + "]";
-    if (labels.empty()) return "every non-zero voxel";
-    std::string out = labels.size() == 1 ? "label " : "labels ";
-    for (std::size_t i = 0; i < labels.size(); ++i) {
-        if (i > 0) out += ',';
-        out += std::to_string(labels[i]);
+    std::string out;
+    if (threshold_min) {
+        out = "threshold [" + format_number(*threshold_min) + ", " +
+              (threshold_max ? format_number(*threshold_max) : std::string("inf")) + "]";
+    } else if (labels.empty()) {
+        out = "every non-zero voxel";
+    } else {
+        out = labels.size() == 1 ? "label " : "labels ";
+        for (std::size_t i = 0; i < labels.size(); ++i) {
+            if (i > 0) out += ',';
+            out += std::to_string(labels[i]);
+        }
     }
+    if (!pieces.empty()) out += "; " + pieces.describe();
     return out;
 }
 
@@ -135,14 +140,14 @@ grid::LabelGrid select_voxels(const Volume& v, const Selection& s)
         throw file_error(v.source, "the selection (" + s.describe() + ") holds no voxel; " +
                                        (scaled ? "values" : "stored values") + " present: " + describe_values(counts));
     }
-    return out;
+    return s.pieces.empty() ? std::move(out) : select_pieces(out, s.pieces, v.source);
 }
 
 grid::LabelGrid select_labels(const grid::LabelGrid& labels, const Selection& s, const std::string& source)
 {
     if (s.empty()) {
         if (labels.active_voxel_count() == 0) throw file_error(source, "holds no active voxel");
-        return labels.clone();
+        return select_pieces(labels, s.pieces, source);
     }
     grid::LabelGrid out(labels.index_to_world());
     out.set_metadata("source", labels.metadata("source").empty() ? source : labels.metadata("source"));
@@ -157,7 +162,7 @@ grid::LabelGrid select_labels(const grid::LabelGrid& labels, const Selection& s,
         throw file_error(source, "the selection (" + s.describe() + ") holds no voxel; labels present: " +
                                      describe_values(counts));
     }
-    return out;
+    return s.pieces.empty() ? std::move(out) : select_pieces(out, s.pieces, source);
 }
 
 } // namespace vox::io

@@ -2,6 +2,7 @@
 // Which voxels of a scan become the object: by label, by a value window, or every non-zero voxel.
 
 #include "grid/label_grid.hpp"
+#include "io/piece_selection.hpp"
 #include "io/volume.hpp"
 
 #include <cstdint>
@@ -15,11 +16,14 @@ namespace vox::io {
 /// one of them keep that label. With a threshold, voxels whose scaled value (slope * stored +
 /// intercept, e.g. Hounsfield units) lies in [threshold_min, threshold_max] (inclusive; no upper
 /// bound when max is unset) get label 1. With neither, every non-zero voxel keeps its value as label.
+/// Then `pieces` chooses among the pieces (6-connected components) of the voxels selected.
 struct Selection {
     std::vector<std::int32_t> labels;
     std::optional<double> threshold_min;
     std::optional<double> threshold_max;
+    PieceSelection pieces;
 
+    /// No label and no threshold: every non-zero voxel, keeping its value (pieces aside).
     [[nodiscard]] bool empty() const { return labels.empty() && !threshold_min; }
     /// "label 255", "threshold [226, 3071]", "every non-zero voxel": for messages.
     [[nodiscard]] std::string describe() const;

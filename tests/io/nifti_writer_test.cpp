@@ -1,0 +1,86 @@
+#include "io/nifti_writer.hpp"
+
+#include "core/error.hpp"
+#include "io/volume_reader.hpp"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <nifti2_io.h>
+
+#include <cstring>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+using namespace vox::io;
+
+namespace {
+
+/// A 4 x 3 x 2 int16 volume with a turned, shifted, anisotropic transform.
+Volume sample_volume()
+{
+    Volume v;
+    v.dims = {4, 3, 2};
+    v.type = ScalarType::i16;
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    v.index_to_world = make_index_to_world({0.8, 0.9, 2.5}, turn, {-12.0, 40.5, 7.25});
+    v.scale_slope = 2.0;
+    v.scale_intercept = -1024.0;
+    v.data.resize(24 * 2);
+    for (std::int16_t n = 0; n < 24; ++n) {
+        const auto value = static_cast<std::int16_t>(n * 37 - 300);
+        std::memcpy(v.data.data() + 2 * n, &value, 2);
+    }
+    return v;
+}
+
+} // namespace
+
+TEST(NiftiWriter, RoundTripsThroughOurReader)
+{
+    const Volume v = sample_volume();
+    for (const char* name : {"written.nii", "written.nii.gz"}) {
+        const fs::path path = fs::path(::testing::TempDir()) / name;
+        write_nifti(v, path);
+        const Volume back = read_volume(path.string());
+        EXPECT_EQ(back.dims, v.dims) << name;
+        EXPECT_EQ(back.type, v.type) << name;
+        EXPECT_EQ(back.data, v.data) << name;
+        EXPECT_DOUBLE_EQ(back.scale_slope, 2.0);
+        EXPECT_DOUBLE_EQ(back.scale_intercept, -1024.0);
+        EXPECT_LT((back.index_to_world - v.index_to_world).cwiseAbs().maxCoeff(), 1e-5) << name;
+    }
+}
+
+TEST(NiftiWriter, LibniftiReadsTheSameVoxelsInRasWithAMatchingQform)
+{
+    // libnifti2 itself, not our reader: its sform and qform must both put voxel (i, j, k) at the
+    // volume's LPS point with x and y negated.
+    const Volume v = sample_volume();
+    const fs::path path = fs::path(::testing::TempDir()) / "libnifti.nii.gz";
+    write_nifti(v, path);
+    nifti_image* nim = nifti_image_read(path.c_str(), 1);
+    ASSERT_NE(nim, nullptr);
+    EXPECT_EQ(nim->nx, 4);
+    EXPECT_EQ(nim->ny, 3);
+    EXPECT_EQ(nim->nz, 2);
+    EXPECT_EQ(nim->datatype, DT_INT16);
+    EXPECT_EQ(std::memcmp(nim->data, v.data.data(), v.data.size()), 0);
+    for (const Eigen::Vector3d& ijk : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(3, 2, 1), Eigen::Vector3d(1, 0, 1)}) {
+        const Eigen::Vector3d lps = (v.index_to_world * ijk.homogeneous()).head<3>();
+        for (const nifti_dmat44& m : {nim->sto_xyz, nim->qto_xyz}) {
+            Eigen::Vector3d ras;
+            for (int r = 0; r < 3; ++r) ras[r] = m.m[r][0] * ijk.x() + m.m[r][1] * ijk.y() + m.m[r][2] * ijk.z() + m.m[r][3];
+            EXPECT_NEAR(ras.x(), -lps.x(), 1e-4);
+            EXPECT_NEAR(ras.y(), -lps.y(), 1e-4);
+            EXPECT_NEAR(ras.z(), lps.z(), 1e-4);
+        }
+    }
+    nifti_image_free(nim);
+}
+
+TEST(NiftiWriter, RefusesOtherNamesAndLeavesNothing)
+{
+    const fs::path path = fs::path(::testing::TempDir()) / "written.mha";
+    EXPECT_THROW(write_nifti(sample_volume(), path), vox::InputError);
+    EXPECT_FALSE(fs::exists(path));
+}
