@@ -1,5 +1,6 @@
 #pragma once
-// The --label / --threshold options shared by the subcommands that read volumes.
+// The --label / --threshold options shared by the subcommands that read volumes, and the piece
+// options (--components, --min-voxels, --seed-mm) that apply to volumes and meshes alike.
 
 #include "io/object_import.hpp"
 #include "io/selection.hpp"
@@ -18,7 +19,11 @@ namespace vox::app {
 struct SelectionOptions {
     std::vector<std::int32_t> labels;
     std::string threshold;
-    /// Throws InputError when both are given or the threshold text is malformed.
+    std::string components; ///< "largest" or N
+    std::uint64_t min_voxels = 0;
+    std::vector<std::string> seeds_mm; ///< "X,Y,Z" each
+    /// Throws InputError when both are given, the threshold text is malformed, or a piece option
+    /// is.
     [[nodiscard]] io::Selection to_selection() const;
 };
 

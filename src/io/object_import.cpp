@@ -33,7 +33,7 @@ grid::LabelGrid import_object(const std::string& path, const ImportOptions& opti
         grid::LabelGrid grid = voxelize_mesh(mesh, h, voxelize);
         if (!options.voxel_mm) log::info("{}: voxel size {:.6g} mm (longest side / 128; set --voxel-size)", path, h);
         grid.set_metadata("source", path);
-        return grid;
+        return options.selection.pieces.empty() ? std::move(grid) : select_pieces(grid, options.selection.pieces, path);
     }
     if (options.voxel_mm || options.mm_per_unit != 1.0)
         throw file_error(path, "--voxel-size and --scale apply to meshes; a volume keeps its own voxels");

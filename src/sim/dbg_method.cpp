@@ -1,6 +1,7 @@
 #include "sim/dbg_method.hpp"
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/stopwatch.hpp"
 #include "cut/pieces.hpp"
 #include "cut/voxel_cut.hpp"
@@ -31,6 +32,9 @@ DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGr
     : m_scene(scene), m_labels(std::move(labels)), m_level(level), m_grid_levels(grid->max_level()), m_grid(std::move(grid))
 {
     m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
+    if (m_sim->held_piece_count() > 0)
+        log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
+                  "\"fall\" frees them, \"leave_out\" drops them)", m_scene.source, m_sim->held_piece_count());
     for (const surface::SurfaceVertex& v : m_sim->surface().embedded().vertices())
         if (v.users) m_uncut.insert(v.key);
 }
@@ -221,7 +225,8 @@ void DbgMethod::add_summary_figures(nlohmann::json& summary) const
     summary.update({{"voxels", m_grid->voxels().alive_count()},
                     {"wet_elements", wet},
                     {"mass_kg", m_grid->total_mass_kg()},
-                    {"separated_voxels", m_separated.size()}}); // each voxel once, however many of its faces opened
+                    {"separated_voxels", m_separated.size()}, // each voxel once, however many of its faces opened
+                    {"held_pieces", m_sim->held_piece_count()}});
 }
 
 std::unique_ptr<Method> DbgMethod::at_level(int level) const

@@ -1,11 +1,13 @@
 #include "sim/dbg_simulation.hpp"
 
+#include "cut/pieces.hpp"
 #include "cut/state_transfer.hpp"
 #include "fem/multigrid.hpp"
 #include "fem/rest_cholesky.hpp"
 
 #include "core/stopwatch.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace vox::sim {
@@ -189,17 +191,20 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
 
     solver.set_gravity(scene.gravity_m_s2);
     auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return nodes_in_box(grid, model, level, lo, hi); };
+    std::vector<unsigned char> constrained(model.node_count(), 0);
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
         bool caught = false;
         for (std::uint32_t n : box_nodes(c.box_min_mm, c.box_max_mm)) {
             solver.fix(n, axes);
+            constrained[n] = 1;
             caught = true;
         }
         if (!caught && first)
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
+    if (scene.object.unheld == io::UnheldPieces::hold) hold_unheld_pieces(first, constrained);
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
         const io::Load& load = scene.loads[k];
         const std::vector<std::uint32_t> caught = box_nodes(load.box_min_mm, load.box_max_mm);
@@ -208,6 +213,43 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
     }
+}
+
+void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained)
+{
+    const fem::HexModel& model = *m_model;
+    const grid::BranchedGrid& grid = *m_grid;
+    // The fine voxels of model element e (level 0: the element is one voxel).
+    const auto first_voxel = [&](std::uint32_t e) {
+        const std::uint32_t ge = model.elements()[e].grid_element;
+        return m_level == 0 ? ge : grid.level(m_level).elements[ge].voxels.front();
+    };
+    if (first) {
+        // The pieces as the run starts; their voxels stay held through later cuts and rebuilds,
+        // while pieces a cut frees from held material fall.
+        const std::vector<std::uint32_t> piece = cut::element_pieces(model);
+        const std::size_t pieces = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
+        std::vector<unsigned char> reached(pieces, 0);
+        for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+            for (std::uint32_t n : model.elements()[e].dof_node)
+                if (constrained[n]) reached[piece[e]] = 1;
+        m_held_voxels.assign(grid.voxels().slots(), 0);
+        m_held_pieces = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), 0));
+        for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+            if (reached[piece[e]]) continue;
+            const std::uint32_t ge = model.elements()[e].grid_element;
+            if (m_level == 0) {
+                m_held_voxels[ge] = 1;
+            } else {
+                for (std::uint32_t v : grid.level(m_level).elements[ge].voxels) m_held_voxels[v] = 1;
+            }
+        }
+    }
+    if (m_held_pieces == 0) return;
+    // An element's material is connected, so its first voxel says for all of them.
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+        if (m_held_voxels[first_voxel(e)])
+            for (std::uint32_t n : model.elements()[e].dof_node) m_solver->fix(n, 7u);
 }
 
 } // namespace vox::sim

@@ -50,6 +50,8 @@ public:
     [[nodiscard]] fem::ImplicitSolver& solver() { return *m_solver; }
     [[nodiscard]] const fem::ImplicitSolver& solver() const { return *m_solver; }
     [[nodiscard]] const cut::ModelSurface& surface() const { return *m_model_surface; }
+    /// The pieces no constraint reached as the run started, held in place ("unheld_pieces": "hold").
+    [[nodiscard]] std::size_t held_piece_count() const { return m_held_pieces; }
     /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
     [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
 
@@ -65,8 +67,15 @@ private:
     /// After a cut, `previous` and `report` let unchanged elements keep their matrices.
     void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr);
 
+    /// "unheld_pieces": "hold": fixes every node of the pieces no constraint reaches (found when
+    /// `first`; after cuts, the elements holding their voxels). `constrained` flags the nodes the
+    /// scene's constraint boxes hold.
+    void hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained);
+
     io::Scene m_scene;
     const grid::BranchedGrid* m_grid;
+    std::vector<unsigned char> m_held_voxels; ///< per fine voxel slot: held by "unheld_pieces": "hold"
+    std::size_t m_held_pieces = 0;
     int m_level;
     std::unique_ptr<fem::HexModel> m_model;
     std::unique_ptr<fem::ImplicitSolver> m_solver;

@@ -42,6 +42,9 @@ IsxfemMethod::IsxfemMethod(const io::Scene& scene, std::shared_ptr<const grid::L
     check_isxfem_scene(scene);
     m_grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *m_labels, std::max(level, 1)));
     m_sim = std::make_unique<IsxfemSimulation>(m_scene, *m_grid, level);
+    if (m_sim->held_piece_count() > 0)
+        log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
+                  "\"fall\" frees them, \"leave_out\" drops them)", m_scene.source, m_sim->held_piece_count());
     m_strokes.resize(scene.tools.size());
 }
 
@@ -243,6 +246,7 @@ void IsxfemMethod::add_summary_figures(nlohmann::json& summary) const
         log::warn("{} run(s) of the cut surface could not be closed along their crack: the exported surface has holes there", closure.open_chains);
     summary["voxels"] = m_grid->voxels().alive_count();
     summary["mass_kg"] = m_grid->total_mass_kg();
+    summary["held_pieces"] = m_sim->held_piece_count();
     summary["isxfem"] = {{"k", m_scene.solver.isxfem_k},
                          {"regularisation", {{"lambda", m_scene.solver.isxfem_regularisation_lambda},
                                              {"threshold", m_scene.solver.isxfem_regularisation_threshold}}},

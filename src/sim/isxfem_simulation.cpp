@@ -3,6 +3,7 @@
 #include "sim/dbg_simulation.hpp"
 #include "core/error.hpp"
 #include "cut/model_surface.hpp"
+#include "cut/pieces.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
 
@@ -46,6 +47,23 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         if (nodes.empty())
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
+    }
+    if (scene.object.unheld == io::UnheldPieces::hold) {
+        // Pieces no constraint reaches stay where they are: every node of theirs fixed.
+        const std::vector<std::uint32_t> piece = cut::element_pieces(hex);
+        std::vector<unsigned char> reached(piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1, 0);
+        std::vector<unsigned char> constrained(hex.node_count(), 0);
+        for (const auto& [n, axes] : m_fixed) constrained[n] = 1;
+        for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
+            for (std::uint32_t n : hex.elements()[e].dof_node)
+                if (constrained[n]) reached[piece[e]] = 1;
+        m_held_pieces = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), 0));
+        std::vector<unsigned char> held(hex.node_count(), 0);
+        for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
+            if (!reached[piece[e]])
+                for (std::uint32_t n : hex.elements()[e].dof_node) held[n] = 1;
+        for (std::uint32_t n = 0; n < hex.node_count(); ++n)
+            if (held[n]) m_fixed.emplace_back(n, 7u);
     }
     make_solver();
 

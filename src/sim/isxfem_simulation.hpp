@@ -24,6 +24,8 @@ public:
     /// Throws the scene's InputError when a constraint or load box catches no node.
     IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
     ~IsxfemSimulation();
+    /// The pieces no constraint reached, held in place ("unheld_pieces": "hold").
+    [[nodiscard]] std::size_t held_piece_count() const { return m_held_pieces; }
 
     [[nodiscard]] const isxfem::XfemModel& model() const { return *m_model; }
     [[nodiscard]] isxfem::XfemSolver& solver() { return *m_solver; }
@@ -119,6 +121,7 @@ private:
     bool m_factor = true; ///< the warped factor, else Jacobi
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     std::vector<std::pair<std::uint32_t, unsigned>> m_fixed; ///< supported node, held axes (1 x, 2 y, 4 z)
+    std::size_t m_held_pieces = 0; ///< pieces no constraint reached, held ("unheld_pieces": "hold")
     std::unique_ptr<isxfem::XfemModel> m_model;
     std::unique_ptr<isxfem::XfemSolver> m_solver;
     std::unique_ptr<isxfem::CutClosure> m_closure;

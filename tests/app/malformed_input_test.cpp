@@ -150,7 +150,7 @@ TEST(MalformedInput, ARunThatFailsMidwayLeavesNothingBehind)
     // folder must not appear (it is written in a staging folder moved into place at the end), and
     // no staging folder may be left either.
     const fs::path d = fresh_dir("bad_run_midway");
-    std::ofstream(d / "scene.json") << R"({"object": {"phantom": {"shape": "beam"}, "levels": 2},
+    std::ofstream(d / "scene.json") << R"({"object": {"phantom": {"shape": "beam"}, "levels": 2, "unheld_pieces": "fall"},
         "loads": [{"box_mm": [[190, -1, -1], [201, 11, 11]], "force_n": [0, 0, -1e9]}],
         "output": {"mesh_every_n_frames": 1}})";
     const auto r = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 5 --out " + quote((d / "out").string()));
