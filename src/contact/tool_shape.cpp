@@ -174,6 +174,16 @@ ToolShape ToolShape::sphere(double radius)
     return s;
 }
 
+ToolShape ToolShape::cylinder(double radius, double length)
+{
+    ToolShape s;
+    s.m_kind = Kind::cylinder;
+    s.m_radius = radius;
+    s.m_length = length;
+    s.m_bounds = Eigen::AlignedBox3d(Eigen::Vector3d(-radius, -radius, -length / 2), Eigen::Vector3d(radius, radius, length / 2));
+    return s;
+}
+
 ToolShape ToolShape::from_mesh(TriangleMesh mesh)
 {
     if (mesh.triangles.empty()) throw InputError("tool mesh: it has no triangle");
@@ -238,6 +248,20 @@ double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gra
         if (gradient) *gradient = r > 0.0 ? Eigen::Vector3d(p / r) : Eigen::Vector3d(0, 0, 1);
         return r - m_radius;
     }
+    case Kind::cylinder: {
+        // Distances to the side (radial) and to the end planes (axial), combined as for a box.
+        const double rho = std::hypot(p.x(), p.y());
+        const Eigen::Vector2d radial = rho > 0.0 ? Eigen::Vector2d(p.x() / rho, p.y() / rho) : Eigen::Vector2d(1, 0);
+        const double dr = rho - m_radius, dz = std::abs(p.z()) - m_length / 2;
+        const double sz = p.z() >= 0.0 ? 1.0 : -1.0;
+        if (dr <= 0.0 && dz <= 0.0) {
+            if (gradient) *gradient = dr >= dz ? Eigen::Vector3d(radial.x(), radial.y(), 0) : Eigen::Vector3d(0, 0, sz);
+            return std::max(dr, dz);
+        }
+        const double a = std::max(dr, 0.0), b = std::max(dz, 0.0), d = std::hypot(a, b);
+        if (gradient) *gradient = Eigen::Vector3d(a * radial.x(), a * radial.y(), b * sz) / d;
+        return d;
+    }
     case Kind::mesh:
         return mesh_distance(p, gradient);
     }
@@ -277,6 +301,27 @@ TriangleMesh ToolShape::mesh(double margin, int detail) const
     }
     case Kind::sphere:
         return icosphere(m_radius + margin, detail);
+    case Kind::cylinder: {
+        const int sides = 8 << std::clamp(detail, 0, 4);
+        const double r = m_radius + margin, h = m_length / 2 + margin;
+        for (double z : {-h, h}) {
+            m.positions.emplace_back(0.0, 0.0, z); // the end's centre
+            for (int k = 0; k < sides; ++k) {
+                const double a = 2.0 * M_PI * k / sides;
+                m.positions.emplace_back(r * std::cos(a), r * std::sin(a), z);
+            }
+        }
+        const int top = sides + 1;
+        for (int k = 0; k < sides; ++k) {
+            const int a = 1 + k, b = 1 + (k + 1) % sides;
+            m.triangles.emplace_back(0, b, a);                   // bottom, seen from -z
+            m.triangles.emplace_back(top, top + a, top + b);     // top
+            m.triangles.emplace_back(a, b, top + b);             // side
+            m.triangles.emplace_back(a, top + b, top + a);
+        }
+        orient_outward(m, Eigen::Vector3d::Zero());
+        return m;
+    }
     case Kind::mesh: {
         m = m_mesh;
         std::vector<Eigen::Vector3d> normal(m.positions.size(), Eigen::Vector3d::Zero());

@@ -11,6 +11,8 @@
 //    the bottom front corner (the point) upward and back, extruded over the thickness (y); the
 //    cutting edge is the bottom (-z) edge;
 //  - sphere: a ball of a radius;
+//  - cylinder: a solid cylinder along the tool's z (a drill's shaft or a flat-ended burr), flat
+//    ends;
 //  - mesh: any closed, consistently oriented triangle mesh (distance to the nearest triangle,
 //    sign by the generalised winding number).
 
@@ -29,13 +31,15 @@ struct TriangleMesh {
 
 class ToolShape {
 public:
-    enum class Kind { box, scalpel, sphere, mesh };
+    enum class Kind { box, scalpel, sphere, cylinder, mesh };
 
     /// `size`: full extents along x, y, z, mm (each > 0).
     static ToolShape box(const Eigen::Vector3d& size);
     /// `size`: length (x), thickness (y), height (z), mm (each > 0).
     static ToolShape scalpel(const Eigen::Vector3d& size);
     static ToolShape sphere(double radius);
+    /// Radius across, length along the tool's z, mm (each > 0); centred on the origin.
+    static ToolShape cylinder(double radius, double length);
     /// A closed triangle mesh in the tool's frame, mm. Throws InputError when it has no triangle.
     static ToolShape from_mesh(TriangleMesh mesh);
 
@@ -67,6 +71,7 @@ private:
     Kind m_kind = Kind::box;
     Eigen::Vector3d m_size = Eigen::Vector3d::Zero();
     double m_radius = 0.0;
+    double m_length = 0.0; ///< cylinder
     /// box, scalpel: the convex profile in the x-z plane, counter-clockwise (x right, z up).
     std::vector<Eigen::Vector2d> m_profile;
     TriangleMesh m_mesh; ///< mesh tools

@@ -26,6 +26,7 @@ std::vector<Eigen::Vector3d> section(const contact::ToolShape& shape, double mar
     case contact::ToolShape::Kind::scalpel:
         for (const Eigen::Vector2d& q : shape.profile(margin)) out.emplace_back(q.x(), 0.0, q.y());
         return out;
+    case contact::ToolShape::Kind::cylinder: // its section through the axis is a rectangle
     case contact::ToolShape::Kind::mesh: {
         const Eigen::AlignedBox3d b = shape.bounds(margin);
         return {{b.min().x(), 0, b.min().z()}, {b.max().x(), 0, b.min().z()}, {b.max().x(), 0, b.max().z()}, {b.min().x(), 0, b.max().z()}};
@@ -37,7 +38,8 @@ std::vector<Eigen::Vector3d> section(const contact::ToolShape& shape, double mar
 } // namespace
 
 std::vector<std::uint32_t> voxels_inside(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                         const contact::PlacedShape& inner, const std::vector<std::uint32_t>& seed_vertices)
+                                         const contact::PlacedShape& inner, const std::vector<std::uint32_t>& seed_vertices,
+                                         double reach_mm)
 {
     const grid::FineVoxels& voxels = surface.grid().voxels();
     std::unordered_set<std::uint32_t> seen;
@@ -53,7 +55,7 @@ std::vector<std::uint32_t> voxels_inside(const ModelSurface& surface, const std:
     while (!queue.empty()) {
         const std::uint32_t v = queue.front();
         queue.pop_front();
-        const bool inside = inner.signed_distance(surface.voxel_centre_mm(v, node_positions)) < 0.0;
+        const bool inside = inner.signed_distance(surface.voxel_centre_mm(v, node_positions)) < reach_mm;
         if (inside) out.push_back(v);
         if (!inside && !seeds.count(v)) continue;
         voxels.for_each_link(v, [&](std::uint32_t u, int) {

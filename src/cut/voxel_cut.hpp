@@ -23,9 +23,11 @@
 namespace vox::cut {
 
 /// Voxel slots to remove: flood from the voxels of `seed_vertices` (surface vertex slots in
-/// contact with the tool) through face-connected voxels whose deformed centres are inside `inner`.
+/// contact with the tool) through face-connected voxels whose deformed centres are inside `inner`
+/// (closer than `reach_mm` to it, when given: a drill's teeth reach past its body).
 [[nodiscard]] std::vector<std::uint32_t> voxels_inside(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                                       const contact::PlacedShape& inner, const std::vector<std::uint32_t>& seed_vertices);
+                                                       const contact::PlacedShape& inner, const std::vector<std::uint32_t>& seed_vertices,
+                                                       double reach_mm = 0.0);
 
 /// The surface a tool cuts along, swept over one stroke, as triangles: its section at both ends
 /// of the stroke and the band each edge of the section sweeps between them.

@@ -36,12 +36,13 @@ constexpr NameTable<PreconditionerChoice, 4> preconditioners{{{"auto", Precondit
 constexpr NameTable<bool, 2> mass_kinds{{{"lumped", true}, {"consistent", false}}};
 constexpr NameTable<ConstraintType, 2> constraint_types{
     {{"fixed", ConstraintType::fixed}, {"slide", ConstraintType::slide}}};
-constexpr NameTable<ToolShape, 4> tool_shapes{{{"blade", ToolShape::blade},
+constexpr NameTable<ToolShape, 5> tool_shapes{{{"blade", ToolShape::blade},
                                                {"scalpel", ToolShape::scalpel},
                                                {"sphere", ToolShape::sphere},
+                                               {"cylinder", ToolShape::cylinder},
                                                {"mesh", ToolShape::mesh}}};
-constexpr NameTable<ToolAction, 3> tool_actions{
-    {{"push", ToolAction::push}, {"cut", ToolAction::cut}, {"wet", ToolAction::wet}}};
+constexpr NameTable<ToolAction, 4> tool_actions{
+    {{"push", ToolAction::push}, {"cut", ToolAction::cut}, {"wet", ToolAction::wet}, {"drill", ToolAction::drill}}};
 constexpr NameTable<CutMode, 2> cut_modes{{{"remove", CutMode::remove}, {"separate", CutMode::separate}}};
 
 // ---------------------------------------------------------------------------------------------
@@ -306,6 +307,7 @@ SceneObject read_object(JsonReader r)
     if (!o.auto_levels && (budget || error)) {
         (budget ? *budget : *error).fail("only meaningful with \"levels\": \"auto\"");
     }
+    if (const std::optional<JsonNode> node = r.optional_node("smooth_surface")) o.smooth_surface = as<bool>(*node);
     if (const std::optional<JsonNode> node = r.optional_node("unheld_pieces")) {
         static constexpr NameTable<UnheldPieces, 3> names{{{"hold", UnheldPieces::hold},
                                                            {"fall", UnheldPieces::fall},
@@ -485,6 +487,10 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
     case ToolShape::sphere:
         t.radius_mm = r.required<double>("radius_mm", positive);
         break;
+    case ToolShape::cylinder:
+        t.radius_mm = r.required<double>("radius_mm", positive);
+        t.length_mm = r.required<double>("length_mm", positive);
+        break;
     case ToolShape::mesh:
         t.mesh = existing_file(r.required_node("mesh"));
         break;
@@ -505,6 +511,8 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
         r.optional("contact_stiffness_n_per_mm", t.contact_stiffness_n_per_mm, half_open_range(0.0, 1e4));
     t.cut_pressure_pa = r.optional("cut_pressure_pa", t.cut_pressure_pa, half_open_range(0.0, 1e9));
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
+    t.burr_speed_rpm = r.optional("burr_speed_rpm", t.burr_speed_rpm, half_open_range(0.0, 1e6));
+    t.drill_rate_mm3_per_n_rev = r.optional("drill_rate_mm3_per_n_rev", t.drill_rate_mm3_per_n_rev, half_open_range(0.0, 1.0));
     if (const std::optional<JsonNode> node = r.optional_node("two_phase")) {
         t.two_phase = as<bool>(*node);
         if (t.two_phase && (t.action != ToolAction::cut || t.cut_mode != CutMode::separate))
@@ -654,6 +662,11 @@ Scene load_scene(const std::filesystem::path& path)
 {
     const nlohmann::json document = read_json_file(path);
     return parse_scene(document, std::filesystem::absolute(path).parent_path(), path.string());
+}
+
+bool smooths_surface(const SceneObject& object, SolverType solver)
+{
+    return object.smooth_surface.value_or(object.kind != ObjectKind::phantom && solver == SolverType::dbg);
 }
 
 } // namespace vox::io

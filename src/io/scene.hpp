@@ -65,6 +65,10 @@ struct SceneObject {
     bool auto_levels = false;
     /// Key "unheld_pieces".
     UnheldPieces unheld = UnheldPieces::hold;
+    /// Key "smooth_surface": the surface is smoothed at rest (windowed sinc, volume kept) so that
+    /// slice terraces and voxel steps do not show; false keeps the voxel steps. Unset: see
+    /// smooths_surface().
+    std::optional<bool> smooth_surface;
     std::optional<double> step_budget_ms;
     std::optional<double> max_error;
 };
@@ -180,8 +184,9 @@ struct Load {
 enum class ToolShape {
     blade,   ///< a thin box
     scalpel, ///< a pointed surgical blade
-    sphere,  ///< a ball
-    mesh,    ///< any closed triangle mesh
+    sphere,   ///< a ball
+    cylinder, ///< a solid cylinder along the tool's z, flat ends (a drill's shaft, a flat burr)
+    mesh,     ///< any closed triangle mesh
 };
 
 /// What a tool does where it meets the object. Every tool pushes with its outer shape (the inner
@@ -191,6 +196,8 @@ enum class ToolAction {
     cut,  ///< the inner shape cuts where it reaches material and the mean contact pressure on the
           ///< outer shape is at or above ToolSpec::cut_pressure_pa ("cut")
     wet,  ///< raises the water content of the elements it touches at ToolSpec::wet_rate_per_s ("wet")
+    drill, ///< a spinning burr: removes the material it touches at a rate that grows with the
+           ///< pressing force and the burr's speed (ToolSpec::burr_speed_rpm, drill_rate_mm3_per_n_rev) ("drill")
 };
 
 /// What a cut does to the fine voxels the inner shape reaches.
@@ -221,8 +228,10 @@ struct ToolSpec {
     /// blade, scalpel: extent along the tool's x (length), y (thickness), z (height), mm; a
     /// scalpel without size_mm is 30 x 0.5 x 8.
     Eigen::Vector3d size_mm = Eigen::Vector3d::Zero();
-    /// sphere: radius, mm.
+    /// sphere, cylinder: radius, mm.
     double radius_mm = 0.0;
+    /// cylinder: length along the tool's z, mm.
+    double length_mm = 0.0;
     /// mesh: the tool's surface mesh (vertices in mm), absolute; it existed when read.
     std::filesystem::path mesh;
     /// What the tool does; absent from the file: default_tool_action(shape).
@@ -244,6 +253,14 @@ struct ToolSpec {
     /// wet tools: how fast the water content (0..1) of the elements touched rises, per second of
     /// contact, in (0, 1e3]; the content stops at 1.
     double wet_rate_per_s = 1.0;
+    /// drill tools: the burr's speed, revolutions per minute, in (0, 1e6] (surgical drills turn
+    /// at 10,000 to 80,000 rpm).
+    double burr_speed_rpm = 40000.0;
+    /// drill tools: material removed per newton of pressing force per revolution, mm^3, in
+    /// (0, 1]: the removal rate is this x force (N) x revolutions per second. The default
+    /// removes 10 mm^3/s at 1 N and 50,000 rpm, the order of bone-drilling rates reported for
+    /// otologic burrs.
+    double drill_rate_mm3_per_n_rev = 0.012;
     /// Two-phase cutting (the sculpting paper's): while a cut tool touches the object, the object
     /// is held still and the tool marks its cut; when the cut condition is met the whole marked
     /// path is cut at once and the simulation resumes. Default false: cuts happen frame by frame.
@@ -317,6 +334,12 @@ struct Scene {
 /// Simulates `scene` with `type` (a command line's override of solver.type): the tools whose
 /// cut_mode the file left open take that method's default.
 void use_method(Scene& scene, SolverType type);
+
+/// Whether the object's surface is smoothed: the scene's "smooth_surface", else on for scans and
+/// meshes simulated by the branched grid, and off for phantoms (their exact, documented shapes
+/// are what tests and benchmarks compare against) and for Is-XFEM (its crack closure works on
+/// the voxel surface).
+[[nodiscard]] bool smooths_surface(const SceneObject& object, SolverType solver);
 
 /// Reads and validates a scene file. Comments (// and /* */) are allowed in it. Throws
 /// InputError "FILE: key.path: problem", or "FILE: line L column C: problem" for bad JSON.

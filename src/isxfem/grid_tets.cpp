@@ -105,7 +105,11 @@ std::pair<std::size_t, std::array<double, 4>> locate(const TetMesh& mesh, std::s
             best_l = bary;
         }
     }
-    return {best, clamped(best_l)}; // a point on the cell's boundary may sit a rounding error outside
+    // A point on the cell's boundary may sit a rounding error outside: clamp that. A point
+    // farther out (a smoothed surface vertex, which may leave its element a little, as the
+    // branched grid's trilinear coordinates may leave [0, 1]) keeps its coordinates: they still
+    // reproduce any affine motion of the tetrahedron exactly.
+    return {best, best_min > -1e-9 ? clamped(best_l) : best_l};
 }
 
 } // namespace vox::isxfem

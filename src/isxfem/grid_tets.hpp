@@ -25,7 +25,8 @@ struct GridTets {
 GridTets tets_from_model(const grid::BranchedGrid& grid, const fem::HexModel& model);
 
 /// The tetrahedron of model element `element` that holds the rest point `x` (world m), and the
-/// point's barycentric coordinates there (clamped to the tetrahedron).
+/// point's barycentric coordinates there (clamped to the tetrahedron when it lies on it to a
+/// rounding error; a point outside the element gets those of the tetrahedron it is least outside).
 std::pair<std::size_t, std::array<double, 4>> locate(const TetMesh& mesh, std::size_t element, const Eigen::Vector3d& x);
 
 } // namespace vox::isxfem

@@ -133,6 +133,35 @@ CutFigures DbgMethod::apply(std::vector<grid::Coord> removed, std::vector<std::p
     return out;
 }
 
+CutFigures DbgMethod::drill(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at, double volume_mm3)
+{
+    if (m_drill_budget.size() <= tool) m_drill_budget.resize(tool + 1, 0.0);
+    const std::vector<Eigen::Vector3d>& positions = m_sim->solver().positions();
+    // The burr's teeth reach past its body through its contact zone (the push margin), and the
+    // voxels it touches have their centres half a voxel deeper still.
+    const Eigen::Vector3d h = 1e3 * m_grid->voxels().voxel_size_m();
+    const double reach = spec.push_margin_mm + 0.5 * h.maxCoeff();
+    const std::vector<std::uint32_t> within = cut::voxels_inside(m_sim->surface(), positions, at, m_touch[tool].vertices, reach);
+    if (within.empty()) {
+        m_drill_budget[tool] = 0.0; // no banking of removal while the burr touches nothing
+        return {};
+    }
+    const double voxel_mm3 = h.prod();
+    m_drill_budget[tool] += volume_mm3;
+    const auto wanted = static_cast<std::size_t>(std::floor(m_drill_budget[tool] / voxel_mm3));
+    if (wanted == 0) return {};
+    // The voxels nearest the burr's body go first (slot order breaks ties, so runs repeat).
+    std::vector<std::pair<double, std::uint32_t>> nearest;
+    nearest.reserve(within.size());
+    for (std::uint32_t v : within) nearest.emplace_back(at.signed_distance(m_sim->surface().voxel_centre_mm(v, positions)), v);
+    const std::size_t taken = std::min(wanted, nearest.size());
+    std::partial_sort(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(taken), nearest.end());
+    m_drill_budget[tool] = taken < wanted ? 0.0 : m_drill_budget[tool] - static_cast<double>(taken) * voxel_mm3;
+    std::vector<grid::Coord> removed;
+    for (std::size_t k = 0; k < taken; ++k) removed.push_back(m_grid->voxels().coord(nearest[k].second));
+    return apply(std::move(removed), {});
+}
+
 void DbgMethod::wet(std::size_t tool, double water)
 {
     fem::ImplicitSolver& solver = m_sim->solver();

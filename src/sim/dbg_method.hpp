@@ -46,6 +46,7 @@ public:
                       const CutOrder& order) override;
     void lift(std::size_t) override {}
     void wet(std::size_t tool, double water) override;
+    CutFigures drill(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at, double volume_mm3) override;
     void end_tools() override;
     StepFigures step() override;
 
@@ -93,6 +94,7 @@ private:
     std::vector<cut::SurfaceContact> m_touch;
     std::vector<bool> m_touched;  ///< placed (and touched) this frame
     std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
+    std::vector<double> m_drill_budget; ///< per tool: volume a drill may still remove, below one voxel's, mm^3
     /// A separating tool's cutting section at the previous frame, in rest space: a frame's cut
     /// opens what the section swept since.
     std::vector<std::vector<Eigen::Vector3d>> m_previous_section;

@@ -64,6 +64,12 @@ grid::BranchedGrid build_scene_grid(const io::Scene& scene, const grid::LabelGri
                               max_level);
 }
 
+void smooth_scene_surface(const io::Scene& scene, const grid::BranchedGrid& grid, surface::EmbeddedSurface& surface)
+{
+    if (!io::smooths_surface(scene.object, scene.solver.type)) return;
+    surface.smooth_windowed_sinc(grid, k_smoothing_iterations, k_smoothing_passband);
+}
+
 std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
                                         const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
 {
@@ -97,6 +103,7 @@ DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& g
 {
     build(true);
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
+    smooth_scene_surface(scene, grid, *m_surface);
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
 }
 

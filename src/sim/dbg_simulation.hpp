@@ -33,6 +33,16 @@ namespace vox::sim {
 [[nodiscard]] std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
                                                       const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
+/// The smoothing of "smooth_surface" (on by default): a windowed-sinc filter of this degree and
+/// pass band (surface/embedded_surface.hpp), strong enough to take out the terraces of 1.5 mm
+/// CT slices while keeping the shape and, exactly, the enclosed volume.
+inline constexpr int k_smoothing_iterations = 20;
+inline constexpr double k_smoothing_passband = 0.05;
+
+/// Smooths a scene's surface at rest, once, as it is extracted (both methods), unless the
+/// scene's object says "smooth_surface": false.
+void smooth_scene_surface(const io::Scene& scene, const grid::BranchedGrid& grid, surface::EmbeddedSurface& surface);
+
 /// Milliseconds spent applying one cut.
 struct CutTimings {
     double grid_update_ms = 0.0; ///< BranchedGrid::update

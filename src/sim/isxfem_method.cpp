@@ -22,11 +22,16 @@ double closed_walls_mm(const io::ToolSpec& spec) { return spec.action == io::Too
 void check_isxfem_scene(const io::Scene& scene)
 {
     if (scene.object.auto_levels) throw scene.error("object.levels", "\"isxfem\" needs a fixed level (0 to 6), not \"auto\"");
+    if (scene.object.smooth_surface.value_or(false))
+        throw scene.error("object.smooth_surface", "\"isxfem\" closes its cracks on the voxel surface and does not smooth "
+                                                   "it yet; smoothing needs \"type\": \"dbg\"");
     for (std::size_t k = 0; k < scene.tools.size(); ++k) {
         const io::ToolSpec& t = scene.tools[k];
         const std::string where = "tools[" + std::to_string(k) + "]";
         if (t.action == io::ToolAction::wet)
             throw scene.error(where, "\"" + t.name + "\": \"isxfem\" does not wet yet; wetting tools need \"type\": \"dbg\"");
+        if (t.action == io::ToolAction::drill)
+            throw scene.error(where, "\"" + t.name + "\": \"isxfem\" does not remove material, so it cannot drill; drills need \"type\": \"dbg\"");
         if (t.action != io::ToolAction::cut) continue;
         if (t.shape != io::ToolShape::blade && t.shape != io::ToolShape::scalpel)
             throw scene.error(where, "\"" + t.name + "\": \"isxfem\" cuts with blades and scalpels only so far; other cutting shapes need \"type\": \"dbg\"");

@@ -43,6 +43,8 @@ public:
                       const CutOrder& order) override;
     void lift(std::size_t tool) override;
     void wet(std::size_t tool, double water) override;
+    /// Never called: check_isxfem_scene refuses drilling tools (Is-XFEM does not remove material).
+    CutFigures drill(std::size_t, const io::ToolSpec&, const contact::PlacedShape&, double) override { return {}; }
     void end_tools() override;
     StepFigures step() override;
 

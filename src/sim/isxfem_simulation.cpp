@@ -69,6 +69,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
 
     // The surface, each used vertex located in a tetrahedron of its element.
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
+    smooth_scene_surface(scene, grid, *m_surface);
     const cut::ModelSurface embedding(grid, hex, *m_surface);
     for (std::uint32_t v = 0; v < m_surface->vertices().size(); ++v) {
         if (m_surface->vertices()[v].users == 0) continue;

@@ -111,6 +111,9 @@ public:
     virtual void lift(std::size_t tool) = 0;
     /// A wetting tool adds `water` (0..1) to what it touched this frame.
     virtual void wet(std::size_t tool, double water) = 0;
+    /// A drilling tool removes up to `volume_mm3` (with what earlier frames left over) of the
+    /// material it touches at `at`, the voxels nearest its body first.
+    virtual CutFigures drill(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at, double volume_mm3) = 0;
     /// The frame's contact forces go to the solver for the next step.
     virtual void end_tools() = 0;
 

@@ -16,6 +16,8 @@ contact::ToolShape make_tool_shape(const io::ToolSpec& t)
         return contact::ToolShape::scalpel(t.size_mm); // the scene reader gives scalpels their default size
     case io::ToolShape::sphere:
         return contact::ToolShape::sphere(t.radius_mm);
+    case io::ToolShape::cylinder:
+        return contact::ToolShape::cylinder(t.radius_mm, t.length_mm);
     case io::ToolShape::mesh: {
         const io::TriangleMesh m = io::read_mesh(t.mesh.string());
         return contact::ToolShape::from_mesh({m.vertices, m.triangles});
@@ -109,6 +111,15 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
             out.propagation_ms += clock.lap() - cut.grid_update_ms - cut.remesh_ms - cut.fem_update_ms;
         }
         if (spec.action == io::ToolAction::wet) method.wet(k, spec.wet_rate_per_s * dt_s);
+        if (spec.action == io::ToolAction::drill && order.touching) {
+            // Removal rate = rate constant x pressing force x revolutions per second (Agus et
+            // al. 2003; Morris et al. 2006 remove bone voxels at a force- and speed-driven rate).
+            const double volume_mm3 = spec.drill_rate_mm3_per_n_rev * c.force_on_tool_n.norm() * spec.burr_speed_rpm / 60.0 * dt_s;
+            const CutFigures cut = method.drill(k, spec, placed, volume_mm3);
+            if (cut.changed()) t.cut = true;
+            out.cut += cut;
+            out.propagation_ms += clock.lap() - cut.grid_update_ms - cut.remesh_ms - cut.fem_update_ms;
+        }
     }
     method.end_tools();
     out.collision_ms += clock.lap();

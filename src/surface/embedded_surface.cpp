@@ -4,10 +4,12 @@
 #include "core/morton.hpp"
 #include "core/progress.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace vox::surface {
 namespace {
@@ -308,10 +310,8 @@ SurfaceMesh EmbeddedSurface::mesh(const grid::BranchedGrid& grid, std::span<cons
     return out;
 }
 
-void EmbeddedSurface::smooth(const grid::BranchedGrid& grid, int iterations)
+std::vector<std::vector<std::uint32_t>> EmbeddedSurface::vertex_neighbours() const
 {
-    const Eigen::Matrix4d& t = grid.voxels().index_to_world();
-    const Eigen::Matrix3d linear = t.topLeftCorner<3, 3>(), inverse = linear.inverse();
     std::vector<std::vector<std::uint32_t>> neighbours(m_vertices.size());
     for (const auto& tri : m_triangles) {
         if (tri[0] == grid::no_index) continue;
@@ -324,6 +324,27 @@ void EmbeddedSurface::smooth(const grid::BranchedGrid& grid, int iterations)
         std::sort(n.begin(), n.end());
         n.erase(std::unique(n.begin(), n.end()), n.end());
     }
+    return neighbours;
+}
+
+void EmbeddedSurface::set_rest_world(const grid::BranchedGrid& grid, const std::vector<Eigen::Vector3d>& x)
+{
+    const Eigen::Matrix3d inverse = grid.voxels().index_to_world().topLeftCorner<3, 3>().inverse();
+    const Eigen::Vector3d size = Eigen::Vector3d::Constant(static_cast<double>(1 << m_level));
+    for (std::size_t i = 0; i < m_vertices.size(); ++i) {
+        SurfaceVertex& v = m_vertices[i];
+        if (v.users == 0) continue;
+        v.rest = inverse * x[i];
+        // Same element; coordinates may leave [0, 1] slightly, which trilinear interpolation allows.
+        const grid::Coord& cell = grid.level(m_level).elements[v.element].cell;
+        v.local = (v.rest - grid::BranchedGrid::cell_corner_index(cell, m_level, 0)).cwiseQuotient(size);
+    }
+}
+
+void EmbeddedSurface::smooth(const grid::BranchedGrid& grid, int iterations)
+{
+    const Eigen::Matrix3d linear = grid.voxels().index_to_world().topLeftCorner<3, 3>();
+    const std::vector<std::vector<std::uint32_t>> neighbours = vertex_neighbours();
     // Taubin's lambda|mu filter in world space (anisotropic voxels must not bias it).
     std::vector<Eigen::Vector3d> x(m_vertices.size()), next(m_vertices.size());
     for (std::size_t i = 0; i < m_vertices.size(); ++i) x[i] = linear * m_vertices[i].rest;
@@ -340,15 +361,101 @@ void EmbeddedSurface::smooth(const grid::BranchedGrid& grid, int iterations)
         }
         std::swap(x, next);
     }
-    const Eigen::Vector3d size = Eigen::Vector3d::Constant(static_cast<double>(1 << m_level));
-    for (std::size_t i = 0; i < m_vertices.size(); ++i) {
-        SurfaceVertex& v = m_vertices[i];
-        if (v.users == 0) continue;
-        v.rest = inverse * x[i];
-        // Same element; coordinates may leave [0, 1] slightly, which trilinear interpolation allows.
-        const grid::Coord& cell = grid.level(m_level).elements[v.element].cell;
-        v.local = (v.rest - grid::BranchedGrid::cell_corner_index(cell, m_level, 0)).cwiseQuotient(size);
+    set_rest_world(grid, x);
+}
+
+namespace {
+
+/// Enclosed volume (world units cubed) of the used triangles over points `x`; `sign` -1 when the
+/// corner order gives inward normals.
+double enclosed_volume(const std::vector<std::array<std::uint32_t, 3>>& triangles, const std::vector<Eigen::Vector3d>& x,
+                       double sign)
+{
+    double six_v = 0.0;
+    for (const auto& t : triangles)
+        if (t[0] != grid::no_index) six_v += x[t[0]].dot(x[t[1]].cross(x[t[2]]));
+    return sign * six_v / 6.0;
+}
+
+} // namespace
+
+double EmbeddedSurface::rest_volume_mm3(const grid::BranchedGrid& grid) const
+{
+    const Eigen::Matrix3d linear = grid.voxels().index_to_world().topLeftCorner<3, 3>();
+    std::vector<Eigen::Vector3d> x(m_vertices.size());
+    for (std::size_t i = 0; i < m_vertices.size(); ++i) x[i] = linear * m_vertices[i].rest;
+    return enclosed_volume(m_triangles, x, m_flip ? -1.0 : 1.0);
+}
+
+double EmbeddedSurface::smooth_windowed_sinc(const grid::BranchedGrid& grid, int iterations, double passband)
+{
+    if (iterations < 1 || !(passband > 0.0 && passband < 2.0))
+        throw std::invalid_argument("smooth_windowed_sinc: iterations >= 1 and passband in (0, 2)");
+    const Eigen::Matrix3d linear = grid.voxels().index_to_world().topLeftCorner<3, 3>();
+    const std::vector<std::vector<std::uint32_t>> neighbours = vertex_neighbours();
+    const std::size_t n = m_vertices.size();
+    const double sign = m_flip ? -1.0 : 1.0;
+    // The neighbour average W has eigenvalues cos(theta) in [-1, 1] (theta the mesh frequency);
+    // the ideal low pass 1 for theta < theta_pb has cosine coefficients c_0 = theta_pb / pi,
+    // c_i = 2 sin(i theta_pb) / (i pi); cos(i theta) = T_i(cos theta) is the Chebyshev polynomial
+    // of W, so the filter is sum_i w_i c_i T_i(W) x (w: a Hamming window), normalised to pass
+    // theta = 0 (the shape's mean) exactly. passband is 1 - cos(theta_pb), as the eigenvalues of
+    // I - W (VTK's vtkWindowedSincPolyDataFilter maps it the same way up to a factor of 2).
+    const double theta = std::acos(1.0 - passband);
+    const double pi = 3.14159265358979323846;
+    std::vector<double> weight(static_cast<std::size_t>(iterations) + 1);
+    double sum = 0.0;
+    for (int i = 0; i <= iterations; ++i) {
+        const double c = i == 0 ? theta / pi : 2.0 * std::sin(i * theta) / (i * pi);
+        const double window = 0.54 + 0.46 * std::cos(i * pi / (iterations + 1));
+        weight[static_cast<std::size_t>(i)] = c * window;
+        sum += c * window;
     }
+    for (double& w : weight) w /= sum;
+
+    std::vector<Eigen::Vector3d> t0(n), t1(n), t2(n), out(n);
+    for (std::size_t i = 0; i < n; ++i) t0[i] = linear * m_vertices[i].rest;
+    const double volume_before = enclosed_volume(m_triangles, t0, sign);
+    auto average = [&](const std::vector<Eigen::Vector3d>& x, std::size_t i) {
+        if (m_vertices[i].users == 0 || neighbours[i].empty()) return x[i];
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (std::uint32_t j : neighbours[i]) mean += x[j];
+        return Eigen::Vector3d(mean / static_cast<double>(neighbours[i].size()));
+    };
+    Progress progress("smoothing the surface", static_cast<std::uint64_t>(iterations));
+    for (std::size_t i = 0; i < n; ++i) {
+        t1[i] = average(t0, i);
+        out[i] = weight[0] * t0[i] + weight[1] * t1[i];
+    }
+    for (int k = 2; k <= iterations; ++k) {
+        progress.update(static_cast<std::uint64_t>(k));
+        for (std::size_t i = 0; i < n; ++i) {
+            t2[i] = 2.0 * average(t1, i) - t0[i];
+            out[i] += weight[static_cast<std::size_t>(k)] * t2[i];
+        }
+        std::swap(t0, t1);
+        std::swap(t1, t2);
+    }
+    const double volume_smoothed = enclosed_volume(m_triangles, out, sign);
+    // Restore the volume: move every vertex by the same distance along its normal (two passes,
+    // as the area changes a little with the move).
+    for (int pass = 0; pass < 2; ++pass) {
+        std::vector<Eigen::Vector3d> normal(n, Eigen::Vector3d::Zero());
+        double area = 0.0;
+        for (const auto& t : m_triangles) {
+            if (t[0] == grid::no_index) continue;
+            const Eigen::Vector3d twice = sign * (out[t[1]] - out[t[0]]).cross(out[t[2]] - out[t[0]]);
+            area += 0.5 * twice.norm();
+            for (int c = 0; c < 3; ++c) normal[t[static_cast<std::size_t>(c)]] += twice;
+        }
+        const double volume = enclosed_volume(m_triangles, out, sign);
+        if (area <= 0.0) break;
+        const double shift = (volume_before - volume) / area;
+        for (std::size_t i = 0; i < n; ++i)
+            if (m_vertices[i].users > 0 && normal[i].squaredNorm() > 0.0) out[i] += shift * normal[i].normalized();
+    }
+    set_rest_world(grid, out);
+    return volume_before != 0.0 ? volume_smoothed / volume_before - 1.0 : 0.0;
 }
 
 } // namespace vox::surface

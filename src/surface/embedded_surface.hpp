@@ -67,6 +67,17 @@ public:
     /// vertex staying embedded in its element: its trilinear coordinates are recomputed there.
     void smooth(const grid::BranchedGrid& grid, int iterations);
 
+    /// Windowed-sinc low-pass smoothing of the rest positions (Taubin, Zhang and Golub 1996, the
+    /// filter behind 3D Slicer's surface smoothing): a Chebyshev polynomial of the neighbour
+    /// average, of degree `iterations`, that passes the shape's low frequencies unchanged and
+    /// removes those above `passband` (slice terraces, voxel steps). A uniform move along the
+    /// vertex normals then restores the volume the surface enclosed before. Each vertex stays
+    /// embedded in its element. Returns the relative volume change before that restoration.
+    double smooth_windowed_sinc(const grid::BranchedGrid& grid, int iterations, double passband);
+
+    /// The volume the surface encloses at rest, mm^3 (divergence theorem over its triangles).
+    [[nodiscard]] double rest_volume_mm3(const grid::BranchedGrid& grid) const;
+
 private:
     void extract_cube(const grid::BranchedGrid& grid, const grid::Coord& cube);
     void clear_cube(std::uint64_t cube_key);
@@ -74,6 +85,10 @@ private:
                              const std::array<std::uint32_t, 8>& corners);
     void embed(const grid::BranchedGrid& grid, SurfaceVertex& v) const;
     void release_vertex(std::uint32_t v);
+    /// Each used vertex slot's neighbours along triangle edges (sorted, unique).
+    [[nodiscard]] std::vector<std::vector<std::uint32_t>> vertex_neighbours() const;
+    /// Sets the rest positions from world-space points (per vertex slot) and re-embeds them.
+    void set_rest_world(const grid::BranchedGrid& grid, const std::vector<Eigen::Vector3d>& x);
     [[nodiscard]] std::uint64_t cube_key(const grid::Coord& cube) const;
 
     int m_level = 1;

@@ -297,3 +297,48 @@ TEST(EmbeddedSurface, APartialCutLeavesOneClosedPieceWithAVisibleSlit)
     expect_closed_oriented(s.mesh(grid));
     EXPECT_EQ(mesh_pieces(s.mesh(grid)), 2u);
 }
+
+TEST(EmbeddedSurface, WindowedSincSmoothingTakesOutSliceTerracesAndKeepsTheVolume)
+{
+    // A ball of radius 20 mm on CT-like voxels (1 x 1 x 2.5 mm): its surface shows slice terraces.
+    constexpr double r = 20.0;
+    const Eigen::Vector3d centre(30.0, 30.0, 30.0), spacing(1.0, 1.0, 2.5);
+    LabelGrid labels(Eigen::Vector4d(spacing.x(), spacing.y(), spacing.z(), 1.0).asDiagonal().toDenseMatrix());
+    int count = 0;
+    for (int k = 0; k < 25; ++k)
+        for (int j = 0; j < 61; ++j)
+            for (int i = 0; i < 61; ++i)
+                if ((Eigen::Vector3d(i, j, k).cwiseProduct(spacing) - centre).norm() <= r) {
+                    labels.set({i, j, k}, 1);
+                    ++count;
+                }
+    const BranchedGrid grid = make_grid(labels, 2);
+    EmbeddedSurface s(grid, 2);
+    // How far the surface strays from the best ball through it: the RMS of the radius about its mean.
+    auto radius_spread = [&] {
+        const SurfaceMesh m = s.mesh(grid);
+        double sum = 0.0, sum2 = 0.0;
+        for (const Eigen::Vector3d& p : m.positions) {
+            const double d = (p - centre).norm();
+            sum += d;
+            sum2 += d * d;
+        }
+        const double n = static_cast<double>(m.positions.size());
+        return std::sqrt(std::max(0.0, sum2 / n - (sum / n) * (sum / n)));
+    };
+    const double spread_before = radius_spread();
+    const double volume_before = s.rest_volume_mm3(grid);
+    const double change = s.smooth_windowed_sinc(grid, 20, 0.05); // the scenes' default
+    const double spread_after = radius_spread();
+    EXPECT_LT(spread_after, 0.55 * spread_before) << "terraces left: " << spread_before << " -> " << spread_after << " mm";
+    EXPECT_LT(std::abs(change), 0.02) << "the filter itself keeps the shape's volume closely";
+    EXPECT_NEAR(s.rest_volume_mm3(grid), volume_before, 1e-6 * volume_before) << "and the normal move restores it";
+    const double voxels_mm3 = count * spacing.prod();
+    EXPECT_NEAR(s.rest_volume_mm3(grid), voxels_mm3, 0.01 * voxels_mm3) << "within 1 % of the voxels' volume";
+    expect_closed_oriented(s.mesh(grid));
+    // Still embedded: node positions at rest reproduce the smoothed rest surface.
+    const auto rest = grid.rest_node_positions(2);
+    const SurfaceMesh at_rest = s.mesh(grid), deformed_rest = s.mesh(grid, rest);
+    for (std::size_t i = 0; i < at_rest.positions.size(); ++i)
+        ASSERT_LT((at_rest.positions[i] - deformed_rest.positions[i]).norm(), 1e-9);
+}
