@@ -587,9 +587,9 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     EXPECT_EQ(with_key("wet_rate_per_s", 1001), "s.json: tools[1].wet_rate_per_s: must be in (0, 1000], got 1001");
     EXPECT_EQ(with_key("wet_rate_per_s", nullptr), "s.json: tools[1].wet_rate_per_s: expected a number, got null");
     EXPECT_EQ(with_key("action", "slice"),
-              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", got \"slice\"");
+              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", \"drill\", got \"slice\"");
     EXPECT_EQ(with_key("action", "Cut"),
-              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", got \"Cut\"");
+              "s.json: tools[1].action: expected one of \"push\", \"cut\", \"wet\", \"drill\", got \"Cut\"");
     EXPECT_EQ(with_key("action", 1), "s.json: tools[1].action: expected a string, got 1");
     EXPECT_EQ(with_key("cut_mode", "split"),
               "s.json: tools[1].cut_mode: expected one of \"remove\", \"separate\", got \"split\"");
@@ -601,7 +601,8 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     // A misspelt key is still unknown, and the message lists the new keys among the known ones.
     EXPECT_EQ(with_key("cut_pressure", 1e4),
               "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
-              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, two_phase)");
+              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, burr_speed_rpm, "
+              "drill_rate_mm3_per_n_rev, two_phase)");
     // NaN cannot be in a file but can be in a document built in code.
     EXPECT_EQ(with_key("push_margin_mm", std::nan("")).rfind("s.json: tools[1].push_margin_mm: must be in [0, 100]", 0),
               0u);
