@@ -48,7 +48,8 @@ public:
     /// Orthonormal part of the index-to-world map: world = frame * index-aligned (a reflection
     /// when the scan's transform mirrors).
     [[nodiscard]] const Eigen::Matrix3d& frame() const { return m_frame; }
-    /// Consistent mass row sums per node plus the floor below, kg (gravity acts on the row sums only).
+    /// Consistent mass row sums per node plus the floor below, kg (gravity acts on all of it, so
+    /// that a free piece falls without bending).
     [[nodiscard]] const std::vector<double>& nodal_mass() const { return m_nodal_mass; }
     /// Lumped mass added to nodes whose share of material is tiny (a corner far from the one voxel
     /// of a partly filled element): each node weighs at least 1e-3 of a full cell's corner mass. (The

@@ -57,7 +57,7 @@ struct StepStats {
     double assembly_ms = 0.0;         ///< rotations, matrix and forces (every Newton iteration summed)
     double solve_ms = 0.0;            ///< preconditioner set-up and CG
     int cg_iterations = 0;            ///< summed over Newton iterations in the quasi-static mode
-    int newton_iterations = 0;
+    int newton_iterations = 0;        ///< static mode, and dynamic steps solved fully (newton_step)
     double residual = 0.0;            ///< relative: CG residual (dynamic) or force residual (static)
     double kinetic_energy_j = 0.0;
     double elastic_energy_j = 0.0;
@@ -156,7 +156,16 @@ private:
     /// One linearised implicit Euler step of `dt`; returns the external forces' work over it and
     /// sets `energy_before` to the kinetic plus elastic energy at its start.
     double linear_step(double dt, StepStats& s, double& energy_before);
-    /// A step of `dt` that must not create energy; halves itself (recursively) when it does.
+    /// The same step solved fully: Newton on implicit Euler's incremental potential
+    /// Phi(v) = 1/2 (1 + alpha dt) v'Mv - v'M v0 + Psi(x0 + dt v) + U(x0 + dt v) (Psi the
+    /// corotational elastic energy, U gravity, loads and contact), each iteration re-rotating the
+    /// elements, with a backtracking line search on Phi, as optimisation-based integrators do.
+    /// The Rayleigh stiffness term is left out of it. Same returns as linear_step.
+    double newton_step(double dt, StepStats& s, double& energy_before);
+    /// Phi at the current velocities (positions x0 + dt v set): see newton_step.
+    double incremental_potential(double dt, const std::vector<Eigen::Vector3d>& x0, const Eigen::VectorXd& m_v0);
+    /// A step of `dt` that must not create energy: linearised, else fully nonlinear, else halved
+    /// (recursively).
     void advance(double dt, int depth, StepStats& s);
 
     const HexModel& m_model;
