@@ -151,6 +151,28 @@ Selection read_selection(JsonReader r)
 {
     Selection s;
     s.pieces = read_piece_selection(r);
+    if (const std::optional<JsonNode> node = r.optional_node("threshold_bands")) {
+        if (r.has("label") || r.has("threshold")) r.node().fail("takes only one of \"label\", \"threshold\", \"threshold_bands\"");
+        const std::vector<JsonNode> items = node->elements();
+        if (items.empty()) node->fail("must list at least one band {\"range\": [lo, hi], \"label\": L}");
+        for (const JsonNode& item : items) {
+            JsonReader band(item);
+            ThresholdBand b;
+            const JsonNode range = band.required_node("range");
+            if (!range.value().is_array() || range.value().size() != 2) range.fail_type("an array [lo, hi] of 2 numbers");
+            const std::vector<JsonNode> ends = range.elements();
+            b.min = as<double>(ends[0]);
+            b.max = as<double>(ends[1]);
+            if (b.min > b.max) range.fail("lower bound " + number_text(b.min) + " is above upper bound " + number_text(b.max));
+            const JsonNode label = band.required_node("label");
+            b.label = as<std::int32_t>(label);
+            if (b.label == 0) label.fail("label 0 is the background; give each band a label other than 0");
+            band.finish();
+            s.bands.push_back(b);
+        }
+        r.finish();
+        return s;
+    }
     if (r.has("label") && r.has("threshold")) {
         r.node().fail("takes only one of \"label\", \"threshold\"");
     }
@@ -364,19 +386,22 @@ void read_materials(JsonReader r, const SceneObject& object, Scene& scene)
     }
     if (const std::optional<JsonNode> labels = r.optional_node("labels")) {
         const bool whole_scan = object.kind == ObjectKind::volume && object.select.empty();
-        const bool by_label = object.kind == ObjectKind::volume && !object.select.labels.empty();
+        const bool by_band = object.kind == ObjectKind::volume && !object.select.bands.empty();
+        const bool by_label = by_band || (object.kind == ObjectKind::volume && !object.select.labels.empty());
+        std::vector<std::int32_t> selected = object.select.labels;
+        for (const ThresholdBand& b : object.select.bands) selected.push_back(b.label);
         for (const auto& [key, node] : labels->members()) {
             const std::int32_t label = label_key(node, key);
             if (!whole_scan && !by_label) {
                 node.fail("only a scan selected by label (or taken whole) has labels; use materials.default");
             }
-            const auto& selected = object.select.labels;
             if (by_label && std::find(selected.begin(), selected.end(), label) == selected.end()) {
                 std::string list;
                 for (const std::int32_t l : selected) {
                     list += (list.empty() ? "" : ", ") + std::to_string(l);
                 }
-                node.fail("label " + std::to_string(label) + " is not in object.select.label (" + list + ")");
+                node.fail("label " + std::to_string(label) + " is not in object.select." +
+                          (by_band ? "threshold_bands" : "label") + " (" + list + ")");
             }
             if (!scene.label_materials.emplace(label, read_material(JsonReader(node), scene.default_material)).second) {
                 node.fail("label " + std::to_string(label) + " has two entries");

@@ -40,6 +40,9 @@ struct Selector {
     const Selection& s;
     std::int32_t operator()(double stored, double scaled) const
     {
+        for (const ThresholdBand& b : s.bands)
+            if (scaled >= b.min && scaled <= b.max) return b.label;
+        if (!s.bands.empty()) return 0;
         if (s.threshold_min) {
             const bool in = scaled >= *s.threshold_min && (!s.threshold_max || scaled <= *s.threshold_max);
             return in ? 1 : 0;
@@ -79,7 +82,11 @@ void check_integer_label(const std::string& source, double stored)
 std::string Selection::describe() const
 {
     std::string out;
-    if (threshold_min) {
+    if (!bands.empty()) {
+        out = "threshold bands";
+        for (const ThresholdBand& b : bands)
+            out += " [" + format_number(b.min) + ", " + format_number(b.max) + "] -> " + std::to_string(b.label);
+    } else if (threshold_min) {
         out = "threshold [" + format_number(*threshold_min) + ", " +
               (threshold_max ? format_number(*threshold_max) : std::string("inf")) + "]";
     } else if (labels.empty()) {
@@ -127,14 +134,14 @@ grid::LabelGrid select_voxels(const Volume& v, const Selection& s)
             for (std::int32_t i = 0; i < v.dims[0]; ++i, ++n) {
                 const double stored = v.stored(n);
                 if (keep_values && stored != 0.0) check_integer_label(v.source, stored);
-                const std::int32_t label = select(stored, s.threshold_min ? v.scaled(n) : stored);
+                const std::int32_t label = select(stored, s.threshold_min || !s.bands.empty() ? v.scaled(n) : stored);
                 if (label != 0) out.set({i, j, k}, label);
             }
         progress.update(static_cast<std::uint64_t>(k + 1));
     }
     if (out.active_voxel_count() == 0) {
         std::map<double, std::uint64_t> counts;
-        const bool scaled = s.threshold_min.has_value();
+        const bool scaled = s.threshold_min.has_value() || !s.bands.empty();
         for (std::int64_t m = 0; m < v.voxel_count() && counts.size() <= 13; ++m)
             ++counts[scaled ? v.scaled(m) : v.stored(m)];
         throw file_error(v.source, "the selection (" + s.describe() + ") holds no voxel; " +

@@ -17,14 +17,24 @@ namespace vox::io {
 /// intercept, e.g. Hounsfield units) lies in [threshold_min, threshold_max] (inclusive; no upper
 /// bound when max is unset) get label 1. With neither, every non-zero voxel keeps its value as label.
 /// Then `pieces` chooses among the pieces (6-connected components) of the voxels selected.
+/// One band of `threshold_bands`: voxels whose scaled value lies in [min, max] get `label`.
+struct ThresholdBand {
+    double min = 0.0;
+    double max = 0.0;
+    std::int32_t label = 1;
+};
+
 struct Selection {
     std::vector<std::int32_t> labels;
     std::optional<double> threshold_min;
     std::optional<double> threshold_max;
+    /// Several tissues from one scan (a CT's bone and soft tissue): each band its own label; where
+    /// bands overlap the first listed wins. Exclusive with labels and the threshold.
+    std::vector<ThresholdBand> bands;
     PieceSelection pieces;
 
-    /// No label and no threshold: every non-zero voxel, keeping its value (pieces aside).
-    [[nodiscard]] bool empty() const { return labels.empty() && !threshold_min; }
+    /// No label, threshold or band: every non-zero voxel, keeping its value (pieces aside).
+    [[nodiscard]] bool empty() const { return labels.empty() && !threshold_min && bands.empty(); }
     /// "label 255", "threshold [226, 3071]", "every non-zero voxel": for messages.
     [[nodiscard]] std::string describe() const;
 };

@@ -1,5 +1,7 @@
 #include "io/skull_phantom.hpp"
 
+#include "core/error.hpp"
+#include "io/scene.hpp"
 #include "io/selection.hpp"
 #include "io/volume_reader.hpp"
 
@@ -7,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <nlohmann/json.hpp>
 
 using namespace vox::io;
 
@@ -65,4 +68,42 @@ TEST(SkullPhantom, BoneThresholdCatchesSkullHolderAndLooseFragmentsAsSeparatePie
     EXPECT_LT(holder.max_mm.z(), 40.0);
     EXPECT_GT(holder.voxels, 5000u);
     for (std::size_t p = 2; p < pieces.size(); ++p) EXPECT_LT(pieces.pieces()[p].voxels, 200u) << "piece " << p + 1;
+}
+
+TEST(SkullPhantom, ThresholdBandsGiveBoneAndSoftTissueTheirOwnLabels)
+{
+    // Bone [226, 3071] -> 1, soft tissue [0, 100] -> 2 (scalp, brain, neck); air and the
+    // holder's foam are in no band. A scene gives each label its own material.
+    nlohmann::json doc = nlohmann::json::parse(R"({
+        "object": {"select": {"threshold_bands": [{"range": [226, 3071], "label": 1}, {"range": [0, 100], "label": 2}]}},
+        "materials": {"labels": {"1": {"youngs_modulus_pa": 1.5e10}, "2": {"youngs_modulus_pa": 3e4}}}
+    })");
+    doc["object"]["volume"] = VOX_SOURCE_DIR "/data/skull_phantom.nii.gz";
+    const Scene scene = parse_scene(doc, VOX_SOURCE_DIR "/data", "bands.json");
+    ASSERT_EQ(scene.object.select.bands.size(), 2u);
+    const vox::grid::LabelGrid labels = select_voxels(make_skull_phantom({}), scene.object.select);
+    const auto histogram = labels.label_histogram();
+    ASSERT_EQ(histogram.size(), 2u);
+    Selection bone;
+    bone.threshold_min = 226.0;
+    bone.threshold_max = 3071.0;
+    EXPECT_EQ(histogram.at(1), select_voxels(make_skull_phantom({}), bone).active_voxel_count());
+    EXPECT_GT(histogram.at(2), histogram.at(1)) << "more soft tissue than bone in a head";
+    EXPECT_EQ(labels.get(vox::grid::Coord(100, 122, 27)), 2) << "brain at the head's centre";
+
+    // A label of 0, a band the wrong way round and a material for a label no band gives are refused.
+    nlohmann::json bad = doc;
+    bad["object"]["select"]["threshold_bands"][1]["label"] = 0;
+    EXPECT_THROW((void)parse_scene(bad, VOX_SOURCE_DIR "/data", "bands.json"), vox::InputError);
+    bad = doc;
+    bad["object"]["select"]["threshold_bands"][1]["range"] = {100, 0};
+    EXPECT_THROW((void)parse_scene(bad, VOX_SOURCE_DIR "/data", "bands.json"), vox::InputError);
+    bad = doc;
+    bad["materials"]["labels"]["3"] = {{"youngs_modulus_pa", 1e5}};
+    try {
+        (void)parse_scene(bad, VOX_SOURCE_DIR "/data", "bands.json");
+        FAIL() << "no error";
+    } catch (const vox::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("label 3 is not in object.select.threshold_bands (1, 2)"), std::string::npos) << e.what();
+    }
 }
