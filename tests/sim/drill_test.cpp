@@ -8,6 +8,7 @@
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/tool_policy.hpp"
+#include "sim/undo_history.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -84,6 +85,25 @@ TEST(Drill, AFasterBurrRemovesMoreAndACylinderDrillsToo)
     EXPECT_GE(flat.removed_voxels, 3u) << flat.allowed_mm3;
     EXPECT_GE(static_cast<double>(flat.removed_voxels), flat.allowed_mm3 - 1.0 - 1e-9);
     EXPECT_LE(static_cast<double>(flat.removed_voxels), flat.allowed_mm3 + 1e-9);
+}
+
+TEST(Drill, DrillingIsUndoneAsTheViewerUndoesAStroke)
+{
+    const io::Scene scene = drilling({{"shape", "sphere"}, {"radius_mm", 3.0}, {"burr_speed_rpm", 60000}});
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    auto method = open_method(scene, labels).method;
+    ToolPolicy tools(scene);
+    FrameLoop loop(scene, *method, tools);
+    UndoHistory history(4);
+    ASSERT_TRUE(history.before_stroke(*method));
+    const std::size_t triangles = method->surface_mesh().triangles.size();
+    std::size_t removed = 0;
+    for (int f = 0; f < 35; ++f) removed += loop.next().tools.cut.removed_voxels;
+    ASSERT_GT(removed, 0u);
+    ASSERT_NE(method->surface_mesh().triangles.size(), triangles);
+    ASSERT_TRUE(history.undo(*method));
+    EXPECT_EQ(method->surface_mesh().triangles.size(), triangles) << "the drilled hole is filled again";
+    EXPECT_EQ(method->cut_count(), 0u);
 }
 
 TEST(Drill, IsxfemRefusesItByName)
