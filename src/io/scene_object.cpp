@@ -27,8 +27,7 @@ grid::LabelGrid leave_out_unheld(const Scene& scene, grid::LabelGrid labels)
 {
     if (scene.object.unheld != UnheldPieces::leave_out) return labels;
     if (scene.constraints.empty())
-        throw scene.error("object.unheld_pieces", "\"leave_out\" would leave out the whole object: no constraint "
-                                                  "holds any of it");
+        throw InputError("unheld_pieces: \"leave_out\" would leave out the whole object: no constraint holds any of it");
     PieceSelection held;
     held.components = PieceSelection::Components::held;
     for (const Constraint& c : scene.constraints) held.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
