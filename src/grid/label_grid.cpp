@@ -167,6 +167,25 @@ openvdb::Int32Grid::Ptr label_grid_of(const openvdb::GridPtrVec& grids)
 /// milliseconds for the bundled ones; OpenVDB reads hundreds of MB a second).
 double read_seconds_allowed(std::uint64_t bytes) { return 3.0 + 0.1 * static_cast<double>(bytes >> 20); }
 
+/// A reader's own message made fit for one line: a corrupt file can put its garbage into it
+/// (OpenVDB names the unknown map type it read), so control and non-ASCII bytes become '?',
+/// runs of white space one space, and it stops after 160 characters.
+std::string one_line(const std::string& text)
+{
+    std::string out;
+    for (const char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (u == ' ' || u == '\t' || u == '\n' || u == '\r') {
+            if (!out.empty() && out.back() != ' ') out += ' ';
+        } else {
+            out += (u < 32 || u > 126) ? '?' : c;
+        }
+        if (out.size() >= 160) return out + "...";
+    }
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    return out;
+}
+
 /// Reads the file in a child process first: OpenVDB's reader trusts the counts in a file, so a
 /// corrupt one can crash it, spin for ever or allocate gigabytes. Only when the child read it
 /// cleanly, within the memory limit and in time, does this process read the same bytes.
@@ -184,7 +203,7 @@ void check_in_child(std::istringstream& in, const std::string& name, std::uint64
     switch (outcome.kind) {
     case ChildOutcome::Kind::ok: return;
     case ChildOutcome::Kind::failed:
-        throw file_error(name, "not a readable OpenVDB file (" + outcome.message + ")");
+        throw file_error(name, "not a readable OpenVDB file (" + one_line(outcome.message) + ")");
     case ChildOutcome::Kind::out_of_memory:
         throw file_error(name, corrupt + "reading it needs more than the memory limit of " +
                                    std::to_string(memory_limit_bytes() >> 20) +
@@ -230,7 +249,7 @@ LabelGrid LabelGrid::load(const std::filesystem::path& path)
         grids = stream.getGrids();
     } catch (const std::exception& e) {
         std::cerr.rdbuf(cerr_buffer);
-        throw file_error(name, std::string("not a readable OpenVDB file (") + e.what() + ")");
+        throw file_error(name, "not a readable OpenVDB file (" + one_line(e.what()) + ")");
     }
     std::cerr.rdbuf(cerr_buffer);
     std::string said = warnings.str();
