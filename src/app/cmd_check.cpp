@@ -28,33 +28,24 @@ const char* unheld_text(io::UnheldPieces u)
     return "";
 }
 
-std::string thousands(std::uint64_t n)
-{
-    std::string s = std::to_string(n);
-    for (int at = static_cast<int>(s.size()) - 3; at > 0; at -= 3) s.insert(static_cast<std::size_t>(at), ",");
-    return s;
-}
-
 /// The object's pieces, largest first, each with whether a constraint box reaches it; a warning
 /// naming the pieces nothing holds.
 void list_pieces(const io::Scene& scene, const grid::LabelGrid& labels, const std::string& path)
 {
     const grid::VoxelPieces pieces(labels);
-    std::vector<Eigen::AlignedBox3d> boxes;
-    for (const io::Constraint& c : scene.constraints) boxes.emplace_back(c.box_min_mm, c.box_max_mm);
-    const std::vector<bool> held = io::pieces_in_boxes(labels, pieces, boxes);
+    const std::vector<bool> held = io::pieces_in_boxes(labels, pieces, scene.object.select.pieces.held_boxes);
     constexpr std::size_t listed = 10;
     std::printf("pieces: %zu (voxels joined through faces), largest first\n", pieces.size());
     for (std::size_t p = 0; p < std::min(listed, pieces.size()); ++p) {
         const grid::VoxelPiece& piece = pieces.pieces()[p];
         std::printf("  %zu: %s voxels, %.6g mm^3, from (%.1f, %.1f, %.1f) to (%.1f, %.1f, %.1f) mm, %s\n", p + 1,
-                    thousands(piece.voxels).c_str(), piece.volume_mm3, piece.min_mm.x(), piece.min_mm.y(),
+                    io::count_text(piece.voxels).c_str(), piece.volume_mm3, piece.min_mm.x(), piece.min_mm.y(),
                     piece.min_mm.z(), piece.max_mm.x(), piece.max_mm.y(), piece.max_mm.z(),
                     held[p] ? "held by a constraint" : "held by no constraint");
     }
     if (pieces.size() > listed)
         std::printf("  ... %zu more, of %s voxels or fewer each\n", pieces.size() - listed,
-                    thousands(pieces.pieces()[listed].voxels).c_str());
+                    io::count_text(pieces.pieces()[listed].voxels).c_str());
     std::vector<std::size_t> loose;
     std::uint64_t loose_voxels = 0;
     for (std::size_t p = 0; p < pieces.size(); ++p)
@@ -68,7 +59,7 @@ void list_pieces(const io::Scene& scene, const grid::LabelGrid& labels, const st
         names += (k ? ", " : "") + std::to_string(loose[k]);
     if (loose.size() > 20) names += ", ...";
     log::warn("{}: {} of {} pieces ({} voxels) are held by no constraint: {} {}; they are {}; select pieces with "
-              "object.select.components, min_voxels or seed_mm", path, loose.size(), pieces.size(), thousands(loose_voxels),
+              "object.select.components, min_voxels or seed_mm", path, loose.size(), pieces.size(), io::count_text(loose_voxels),
               loose.size() == 1 ? "piece" : "pieces", names, unheld_text(scene.object.unheld));
 }
 

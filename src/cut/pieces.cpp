@@ -27,4 +27,17 @@ std::size_t piece_count(const fem::HexModel& model)
     return pieces.empty() ? 0 : *std::max_element(pieces.begin(), pieces.end()) + 1;
 }
 
+std::vector<unsigned char> unheld_elements(const fem::HexModel& model, const std::vector<unsigned char>& held, std::size_t& count)
+{
+    const std::vector<std::uint32_t> piece = element_pieces(model);
+    std::vector<unsigned char> reached(piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1, 0);
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+        for (std::uint32_t n : model.elements()[e].dof_node)
+            if (held[n]) reached[piece[e]] = 1;
+    count = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), 0));
+    std::vector<unsigned char> out(piece.size());
+    for (std::size_t e = 0; e < piece.size(); ++e) out[e] = reached[piece[e]] ? 0 : 1;
+    return out;
+}
+
 } // namespace vox::cut

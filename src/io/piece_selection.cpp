@@ -17,14 +17,14 @@ std::string point_text(const Eigen::Vector3d& p)
     return os.str();
 }
 
+} // namespace
+
 std::string count_text(std::uint64_t n)
 {
     std::string s = std::to_string(n);
     for (int at = static_cast<int>(s.size()) - 3; at > 0; at -= 3) s.insert(static_cast<std::size_t>(at), ",");
     return s;
 }
-
-} // namespace
 
 std::string PieceSelection::describe() const
 {

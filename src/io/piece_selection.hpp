@@ -49,6 +49,9 @@ struct PieceSelection {
 [[nodiscard]] grid::LabelGrid select_pieces(const grid::LabelGrid& labels, const PieceSelection& selection,
                                             const std::string& source);
 
+/// 266098 as "266,098", for counts in messages.
+[[nodiscard]] std::string count_text(std::uint64_t n);
+
 /// "3 pieces: 1 (266,098 voxels, 323,309 mm3), 2 (...)...": a short summary for logs.
 [[nodiscard]] std::string describe_pieces(const grid::VoxelPieces& pieces, std::size_t at_most = 5);
 

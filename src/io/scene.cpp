@@ -640,7 +640,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
             scene.constraints.push_back(read_constraint(JsonReader(node)));
         }
     }
-    // "components": "held" keeps the pieces the constraint boxes reach.
+    // "components": "held" and "unheld_pieces" need the boxes the constraints reach (any object kind).
     for (const Constraint& c : scene.constraints) {
         scene.object.select.pieces.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
     }

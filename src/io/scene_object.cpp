@@ -30,7 +30,7 @@ grid::LabelGrid leave_out_unheld(const Scene& scene, grid::LabelGrid labels)
         throw InputError("unheld_pieces: \"leave_out\" would leave out the whole object: no constraint holds any of it");
     PieceSelection held;
     held.components = PieceSelection::Components::held;
-    for (const Constraint& c : scene.constraints) held.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
+    held.held_boxes = scene.object.select.pieces.held_boxes; // the constraint boxes
     return select_pieces(labels, held, labels.metadata("source"));
 }
 

@@ -234,16 +234,10 @@ void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned ch
     if (first) {
         // The pieces as the run starts; their voxels stay held through later cuts and rebuilds,
         // while pieces a cut frees from held material fall.
-        const std::vector<std::uint32_t> piece = cut::element_pieces(model);
-        const std::size_t pieces = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
-        std::vector<unsigned char> reached(pieces, 0);
-        for (std::uint32_t e = 0; e < model.elements().size(); ++e)
-            for (std::uint32_t n : model.elements()[e].dof_node)
-                if (constrained[n]) reached[piece[e]] = 1;
+        const std::vector<unsigned char> unheld = cut::unheld_elements(model, constrained, m_held_pieces);
         m_held_voxels.assign(grid.voxels().slots(), 0);
-        m_held_pieces = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), 0));
         for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
-            if (reached[piece[e]]) continue;
+            if (!unheld[e]) continue;
             const std::uint32_t ge = model.elements()[e].grid_element;
             if (m_level == 0) {
                 m_held_voxels[ge] = 1;

@@ -50,17 +50,12 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     }
     if (scene.object.unheld == io::UnheldPieces::hold) {
         // Pieces no constraint reaches stay where they are: every node of theirs fixed.
-        const std::vector<std::uint32_t> piece = cut::element_pieces(hex);
-        std::vector<unsigned char> reached(piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1, 0);
         std::vector<unsigned char> constrained(hex.node_count(), 0);
         for (const auto& [n, axes] : m_fixed) constrained[n] = 1;
-        for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
-            for (std::uint32_t n : hex.elements()[e].dof_node)
-                if (constrained[n]) reached[piece[e]] = 1;
-        m_held_pieces = static_cast<std::size_t>(std::count(reached.begin(), reached.end(), 0));
+        const std::vector<unsigned char> unheld = cut::unheld_elements(hex, constrained, m_held_pieces);
         std::vector<unsigned char> held(hex.node_count(), 0);
         for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
-            if (!reached[piece[e]])
+            if (unheld[e])
                 for (std::uint32_t n : hex.elements()[e].dof_node) held[n] = 1;
         for (std::uint32_t n = 0; n < hex.node_count(); ++n)
             if (held[n]) m_fixed.emplace_back(n, 7u);
