@@ -24,6 +24,7 @@ const char* unheld_text(io::UnheldPieces u)
     case io::UnheldPieces::hold: return "held in place (\"unheld_pieces\": \"hold\", the default)";
     case io::UnheldPieces::fall: return "free to fall (\"unheld_pieces\": \"fall\")";
     case io::UnheldPieces::leave_out: return "left out (\"unheld_pieces\": \"leave_out\")";
+    case io::UnheldPieces::rigid: return "moved as rigid bodies (\"unheld_pieces\": \"rigid\")";
     }
     return "";
 }

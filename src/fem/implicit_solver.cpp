@@ -133,6 +133,28 @@ void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
     for (int a = 0; a < 3; ++a)
         if (axes & (1u << a)) m_fixed[3 * node + static_cast<std::size_t>(a)] = 1;
     if (m_preconditioner) m_preconditioner->invalidate(); // built with other rows held
+    m_active_current = false;
+}
+
+void ImplicitSolver::update_active()
+{
+    // An element whose every degree of freedom is held (rigid material, a held piece) moves no
+    // node the solve moves, so its rotation, forces and matrix blocks are never needed: skipping
+    // it makes a rigid skull cost nothing.
+    const auto& elements = m_model.elements();
+    m_active.assign(elements.size(), 0);
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+        for (std::uint32_t n : elements[e].dof_node)
+            if (!m_fixed[3 * n] || !m_fixed[3 * n + 1] || !m_fixed[3 * n + 2]) {
+                m_active[e] = 1;
+                break;
+            }
+        if (m_active[e]) continue;
+        m_element_force[e].setZero();
+        m_element_product[e].setZero();
+        m_element_energy[e] = 0.0;
+    }
+    m_active_current = true;
 }
 
 void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
@@ -189,12 +211,14 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
 {
     const Eigen::Matrix3d& frame = m_model.frame();
     const auto& elements = m_model.elements();
+    if (!m_active_current) update_active();
     // Element pass: rotation, corotated displacements, elastic forces and energy. A dynamic step
     // ends with this pass at its new positions (the energy check); the next step starts from the
     // same positions and reuses it, unless plastic strain is due to creep first.
     if (!(m_element_pass_current && m_plastic.empty())) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
             for (std::size_t e = range.begin(); e != range.end(); ++e) {
+                if (!m_active[e]) continue;
                 const HexElement& el = elements[e];
                 // Displacements relative to corner 0: K ignores translations, and far from the origin
                 // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
@@ -238,6 +262,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                 Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * diagonal_mass);
                 for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
                     const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                    if (!m_active[e]) continue;
                     const Eigen::Matrix3d& r = m_element_rotation[e];
                     const Eigen::Matrix3d block = r * elements[e].stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * static_cast<int>(c)) * r.transpose();
                     d += k_scale * m_stiffness_scale[e] * block.diagonal();
@@ -253,6 +278,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
             const int row_length = outer[3 * n + 1] - outer[3 * n];
             for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
                 const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                if (!m_active[e]) continue;
                 const HexElement& el = elements[e];
                 const Eigen::Matrix3d& r = m_element_rotation[e];
                 const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
@@ -372,6 +398,7 @@ void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::Vect
     const auto& elements = m_model.elements();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t e = range.begin(); e != range.end(); ++e) {
+            if (!m_active[e]) continue;
             const HexElement& el = elements[e];
             const Eigen::Matrix3d& r = m_element_rotation[e];
             Vector24d local;
@@ -409,7 +436,8 @@ void ImplicitSolver::update_node_rotations()
     std::vector<Eigen::Vector4d> sum(m_x.size(), Eigen::Vector4d::Zero());
     const auto& elements = m_model.elements();
     for (std::size_t e = 0; e < elements.size(); ++e)
-        for (std::uint32_t n : elements[e].dof_node) accumulate_rotation(sum[n], m_rotation[e]);
+        if (m_active[e])
+            for (std::uint32_t n : elements[e].dof_node) accumulate_rotation(sum[n], m_rotation[e]);
     for (std::size_t n = 0; n < m_x.size(); ++n)
         if (sum[n].squaredNorm() > 0.0) m_node_rotation[n].coeffs() = sum[n].normalized();
 }

@@ -151,6 +151,9 @@ private:
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void update_node_rotations();
+    /// Flags the elements with a degree of freedom free to move (m_active); the others are
+    /// skipped by every element loop.
+    void update_active();
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
     [[nodiscard]] double kinetic_energy() const;
     /// One linearised implicit Euler step of `dt`; returns the external forces' work over it and
@@ -172,6 +175,8 @@ private:
     SolverOptions m_options;
     std::vector<Eigen::Vector3d> m_x, m_v, m_external;
     std::vector<unsigned char> m_fixed; ///< per dof
+    std::vector<unsigned char> m_active; ///< per element: some node of it free (update_active)
+    bool m_active_current = false;
     std::vector<NodeContact> m_contact;
     std::vector<Eigen::Vector3d> m_contact_x0;  ///< per contact: the node's position when it was set
     std::vector<std::int32_t> m_contact_of_node; ///< per node: index in m_contact, or -1

@@ -331,9 +331,10 @@ SceneObject read_object(JsonReader r)
     }
     if (const std::optional<JsonNode> node = r.optional_node("smooth_surface")) o.smooth_surface = as<bool>(*node);
     if (const std::optional<JsonNode> node = r.optional_node("unheld_pieces")) {
-        static constexpr NameTable<UnheldPieces, 3> names{{{"hold", UnheldPieces::hold},
+        static constexpr NameTable<UnheldPieces, 4> names{{{"hold", UnheldPieces::hold},
                                                            {"fall", UnheldPieces::fall},
-                                                           {"leave_out", UnheldPieces::leave_out}}};
+                                                           {"leave_out", UnheldPieces::leave_out},
+                                                           {"rigid", UnheldPieces::rigid}}};
         o.unheld = choose_enum(*node, names);
     }
     r.finish("for a " + std::string(kind) + " object");
@@ -355,11 +356,18 @@ Material read_material(JsonReader r, Material m)
         p.finish();
         m.plasticity = plastic;
     }
-    if (const std::optional<JsonNode> node = r.optional_node("wetting")) {
-        JsonReader w(*node);
+    const std::optional<JsonNode> wetting = r.optional_node("wetting");
+    if (wetting) {
+        JsonReader w(*wetting);
         m.wetting.stiffness_ratio = w.optional("stiffness_ratio", m.wetting.stiffness_ratio, half_open_range(0.0, 1.0));
         m.wetting.yield_ratio = w.optional("yield_ratio", m.wetting.yield_ratio, half_open_range(0.0, 1.0));
         w.finish();
+    }
+    const std::optional<JsonNode> rigid = r.optional_node("rigid");
+    if (rigid) m.rigid = as<bool>(*rigid);
+    if (m.rigid && (m.plasticity || wetting)) {
+        const std::string problem = "a rigid material does not deform, so it has no plasticity or wetting";
+        (rigid ? *rigid : r.node()).fail(problem);
     }
     r.finish();
     return m;

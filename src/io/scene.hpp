@@ -38,6 +38,7 @@ enum class UnheldPieces {
     hold,      ///< "hold" (default): they stay where the scan has them (every node fixed)
     fall,      ///< "fall": they move freely, under gravity and tools
     leave_out, ///< "leave_out": they are not simulated at all
+    rigid,     ///< "rigid": each moves as one rigid body, under gravity and tools (branched grid)
 };
 
 /// The object to simulate: its source, and the coarsening level it is simulated at.
@@ -99,6 +100,11 @@ struct Material {
     double density_kg_m3 = 1000.0;
     std::optional<Plasticity> plasticity;
     Wetting wetting;
+    /// Key "rigid": the material does not deform (bone, a table, a holder). It has no finite
+    /// elements of its own: the elements holding any of it are held in place, and the soft
+    /// material attached to them with them; a piece made of rigid material alone that no
+    /// constraint holds moves as one rigid body (branched grid). Still cut, drilled and touched.
+    bool rigid = false;
 };
 
 /// Water content given to the elements whose material centroid lies in a box.

@@ -35,6 +35,9 @@ DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGr
     if (m_sim->held_piece_count() > 0)
         log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
                   "\"fall\" frees them, \"leave_out\" drops them)", m_scene.source, m_sim->held_piece_count());
+    if (m_sim->rigid_element_count() > 0 || m_sim->rigid_body_count() > 0)
+        log::info("{}: {} element(s) hold rigid material; {} piece(s) move as rigid bodies", m_scene.source,
+                  m_sim->rigid_element_count(), m_sim->rigid_body_count());
     for (const surface::SurfaceVertex& v : m_sim->surface().embedded().vertices())
         if (v.users) m_uncut.insert(v.key);
 }
@@ -182,7 +185,7 @@ void DbgMethod::end_tools()
 
 StepFigures DbgMethod::step()
 {
-    const fem::StepStats s = m_sim->solver().step();
+    const fem::StepStats s = m_sim->step();
     StepFigures out;
     out.step_ms = s.step_ms;
     out.assembly_ms = s.assembly_ms;
@@ -255,7 +258,9 @@ void DbgMethod::add_summary_figures(nlohmann::json& summary) const
                     {"wet_elements", wet},
                     {"mass_kg", m_grid->total_mass_kg()},
                     {"separated_voxels", m_separated.size()}, // each voxel once, however many of its faces opened
-                    {"held_pieces", m_sim->held_piece_count()}});
+                    {"held_pieces", m_sim->held_piece_count()},
+                    {"rigid_elements", m_sim->rigid_element_count()},
+                    {"rigid_bodies", m_sim->rigid_body_count()}});
 }
 
 std::unique_ptr<Method> DbgMethod::at_level(int level) const

@@ -2,12 +2,14 @@
 
 #include "cut/pieces.hpp"
 #include "cut/state_transfer.hpp"
+#include "sim/rigid_parts.hpp"
 #include "fem/multigrid.hpp"
 #include "fem/rest_cholesky.hpp"
 
 #include "core/stopwatch.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 
 namespace vox::sim {
@@ -99,7 +101,7 @@ std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fe
 }
 
 DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
-    : m_scene(scene), m_grid(&grid), m_level(level)
+    : m_scene(scene), m_grid(&grid), m_rigid_material(rigid_materials(scene)), m_level(level)
 {
     build(true);
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
@@ -129,6 +131,31 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     return t;
 }
 
+fem::StepStats DbgSimulation::step()
+{
+    if (m_bodies.empty()) return m_solver->step();
+    // The bodies' state from their nodes, which then stand still in the finite-element solve
+    // (they are held there, and a held node's velocity would count as energy the step lost).
+    Stopwatch clock;
+    fem::ImplicitSolver& solver = *m_solver;
+    std::vector<fem::RigidBody::State> states;
+    for (const fem::RigidBody& b : m_bodies) {
+        states.push_back(b.state(solver.positions(), solver.velocities()));
+        for (std::uint32_t n : b.nodes()) solver.velocities()[n].setZero();
+    }
+    fem::StepStats s = solver.step();
+    const double damping = m_scene.solver.rayleigh_mass_per_s;
+    for (std::size_t k = 0; k < m_bodies.size(); ++k) {
+        m_bodies[k].advance(states[k], m_scene.solver.dt_s, damping, m_scene.gravity_m_s2, solver.external_forces(), solver.contact(),
+                            m_body_of_node, static_cast<std::int32_t>(k), solver.positions(), solver.velocities());
+        s.kinetic_energy_j += m_bodies[k].kinetic_energy(m_bodies[k].state(solver.positions(), solver.velocities()));
+        for (std::uint32_t n : m_bodies[k].nodes())
+            s.max_displacement_m = std::max(s.max_displacement_m, (solver.positions()[n] - m_model->rest_positions()[n]).norm());
+    }
+    s.step_ms = clock.lap();
+    return s;
+}
+
 void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid::UpdateReport* report)
 {
     const io::Scene& scene = m_scene;
@@ -147,14 +174,57 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
         m_model = std::make_unique<fem::HexModel>(grid, level);
     }
     const fem::HexModel& model = *m_model;
-    const std::size_t dofs = 3 * model.node_count();
-    const io::PreconditionerChoice choice = resolve(scene.solver.preconditioner, dofs, level < grid.max_level());
+
+    // Which axes of which nodes are held, before the solver exists: the preconditioner is chosen
+    // by the degrees of freedom left free (a rigid skull leaves none).
+    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return nodes_in_box(grid, model, level, lo, hi); };
+    std::vector<unsigned> held_axes(model.node_count(), 0u);
+    std::vector<unsigned char> constrained(model.node_count(), 0);
+    for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
+        const io::Constraint& c = scene.constraints[k];
+        const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
+        bool caught = false;
+        for (std::uint32_t n : box_nodes(c.box_min_mm, c.box_max_mm)) {
+            held_axes[n] |= axes;
+            constrained[n] = 1;
+            caught = true;
+        }
+        if (!caught && first)
+            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
+    }
+    // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
+    const std::vector<unsigned char> rigid_element = rigid_elements(grid, model, m_rigid_material);
+    if (scene.object.unheld == io::UnheldPieces::hold)
+        hold_unheld_pieces(first, anchoring_nodes(model, rigid_element, constrained), held_axes);
+    std::vector<unsigned char> held(model.node_count(), 0);
+    for (std::uint32_t n = 0; n < model.node_count(); ++n) held[n] = held_axes[n] != 0u;
+    const RigidParts rigid = rigid_parts(model, rigid_element, held, scene.object.unheld == io::UnheldPieces::rigid);
+    m_rigid_elements = rigid.rigid_elements;
+    m_bodies.clear();
+    m_body_of_node.assign(model.node_count(), -1);
+    for (const std::vector<std::uint32_t>& nodes : rigid.bodies) {
+        for (std::uint32_t n : nodes) {
+            held_axes[n] = 7u; // placed by the body's own step
+            m_body_of_node[n] = static_cast<std::int32_t>(m_bodies.size());
+        }
+        m_bodies.emplace_back(nodes, model.rest_positions(), model.nodal_mass());
+    }
+    std::size_t free_dofs = 0;
+    for (std::uint32_t n = 0; n < model.node_count(); ++n) {
+        if (rigid.anchored[n]) held_axes[n] = 7u;
+        free_dofs += 3 - static_cast<std::size_t>(std::popcount(held_axes[n]));
+    }
+
+    const io::PreconditionerChoice choice = free_dofs == 0 ? io::PreconditionerChoice::jacobi
+                                                           : resolve(scene.solver.preconditioner, free_dofs, level < grid.max_level());
     if (choice == io::PreconditionerChoice::multigrid && level >= grid.max_level())
         throw scene.error("solver.preconditioner", "multigrid needs a level coarser than the simulated one");
     fem::SolverOptions options = solver_options(scene.solver);
     options.matrix_free = choice == io::PreconditionerChoice::jacobi;
     m_solver = std::make_unique<fem::ImplicitSolver>(model, options);
     fem::ImplicitSolver& solver = *m_solver;
+    for (std::uint32_t n = 0; n < model.node_count(); ++n)
+        if (held_axes[n]) solver.fix(n, held_axes[n]);
     switch (choice) {
     case io::PreconditionerChoice::cholesky:
         solver.set_preconditioner(std::make_unique<fem::RestCholesky>(model.frame()));
@@ -167,7 +237,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
         break;
     }
     default:
-        m_linear_solver = "CG, Jacobi preconditioner, matrix-free";
+        m_linear_solver = free_dofs == 0 ? "none: every node is held or rigid" : "CG, Jacobi preconditioner, matrix-free";
     }
 
     std::vector<fem::MaterialBehaviour> behaviour;
@@ -197,21 +267,6 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
     }
 
     solver.set_gravity(scene.gravity_m_s2);
-    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return nodes_in_box(grid, model, level, lo, hi); };
-    std::vector<unsigned char> constrained(model.node_count(), 0);
-    for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
-        const io::Constraint& c = scene.constraints[k];
-        const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
-        bool caught = false;
-        for (std::uint32_t n : box_nodes(c.box_min_mm, c.box_max_mm)) {
-            solver.fix(n, axes);
-            constrained[n] = 1;
-            caught = true;
-        }
-        if (!caught && first)
-            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
-    }
-    if (scene.object.unheld == io::UnheldPieces::hold) hold_unheld_pieces(first, constrained);
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
         const io::Load& load = scene.loads[k];
         const std::vector<std::uint32_t> caught = box_nodes(load.box_min_mm, load.box_max_mm);
@@ -222,7 +277,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
     }
 }
 
-void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained)
+void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained, std::vector<unsigned>& held_axes)
 {
     const fem::HexModel& model = *m_model;
     const grid::BranchedGrid& grid = *m_grid;
@@ -250,7 +305,7 @@ void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned ch
     // An element's material is connected, so its first voxel says for all of them.
     for (std::uint32_t e = 0; e < model.elements().size(); ++e)
         if (m_held_voxels[first_voxel(e)])
-            for (std::uint32_t n : model.elements()[e].dof_node) m_solver->fix(n, 7u);
+            for (std::uint32_t n : model.elements()[e].dof_node) held_axes[n] = 7u;
 }
 
 } // namespace vox::sim

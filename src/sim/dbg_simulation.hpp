@@ -7,6 +7,7 @@
 
 #include "cut/model_surface.hpp"
 #include "fem/implicit_solver.hpp"
+#include "fem/rigid_body.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 
@@ -62,8 +63,14 @@ public:
     [[nodiscard]] const cut::ModelSurface& surface() const { return *m_model_surface; }
     /// The pieces no constraint reached as the run started, held in place ("unheld_pieces": "hold").
     [[nodiscard]] std::size_t held_piece_count() const { return m_held_pieces; }
+    /// Elements holding rigid material, and the pieces moving as rigid bodies (fem/rigid_body.hpp).
+    [[nodiscard]] std::size_t rigid_element_count() const { return m_rigid_elements; }
+    [[nodiscard]] std::size_t rigid_body_count() const { return m_bodies.size(); }
     /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
     [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
+
+    /// One frame's step: the finite elements, then the rigid bodies under the same contact.
+    fem::StepStats step();
 
     /// Removes fine voxels and disconnects faces of `grid` (the grid this simulation was built
     /// on), updates the surface locally and rebuilds the model, carrying positions, velocities,
@@ -79,11 +86,12 @@ private:
 
     /// "unheld_pieces": "hold": fixes every node of the pieces no constraint reaches (found when
     /// `first`; after cuts, the elements holding their voxels). `constrained` flags the nodes the
-    /// scene's constraint boxes hold.
-    void hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained);
+    /// scene's constraint boxes hold; the held nodes get all three axes in `held_axes`.
+    void hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained, std::vector<unsigned>& held_axes);
 
     io::Scene m_scene;
     const grid::BranchedGrid* m_grid;
+    std::vector<unsigned char> m_rigid_material; ///< per grid material (sim/rigid_parts.hpp)
     std::vector<unsigned char> m_held_voxels; ///< per fine voxel slot: held by "unheld_pieces": "hold"
     std::size_t m_held_pieces = 0;
     int m_level;
@@ -92,6 +100,9 @@ private:
     std::unique_ptr<surface::EmbeddedSurface> m_surface;
     std::unique_ptr<cut::ModelSurface> m_model_surface;
     std::string m_linear_solver;
+    std::size_t m_rigid_elements = 0;
+    std::vector<fem::RigidBody> m_bodies;
+    std::vector<std::int32_t> m_body_of_node; ///< per node: its body, or -1
 };
 
 } // namespace vox::sim

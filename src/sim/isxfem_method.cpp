@@ -25,6 +25,8 @@ void check_isxfem_scene(const io::Scene& scene)
     if (scene.object.smooth_surface.value_or(false))
         throw scene.error("object.smooth_surface", "\"isxfem\" closes its cracks on the voxel surface and does not smooth "
                                                    "it yet; smoothing needs \"type\": \"dbg\"");
+    if (scene.object.unheld == io::UnheldPieces::rigid)
+        throw scene.error("object.unheld_pieces", "\"isxfem\" does not move pieces as rigid bodies yet; \"rigid\" needs \"type\": \"dbg\"");
     for (std::size_t k = 0; k < scene.tools.size(); ++k) {
         const io::ToolSpec& t = scene.tools[k];
         const std::string where = "tools[" + std::to_string(k) + "]";
@@ -252,6 +254,8 @@ void IsxfemMethod::add_summary_figures(nlohmann::json& summary) const
     summary["voxels"] = m_grid->voxels().alive_count();
     summary["mass_kg"] = m_grid->total_mass_kg();
     summary["held_pieces"] = m_sim->held_piece_count();
+    summary["rigid_elements"] = m_sim->rigid_element_count();
+    summary["rigid_bodies"] = 0; // Is-XFEM moves no piece as a rigid body
     summary["isxfem"] = {{"k", m_scene.solver.isxfem_k},
                          {"regularisation", {{"lambda", m_scene.solver.isxfem_regularisation_lambda},
                                              {"threshold", m_scene.solver.isxfem_regularisation_threshold}}},

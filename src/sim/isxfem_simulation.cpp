@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "cut/model_surface.hpp"
 #include "cut/pieces.hpp"
+#include "sim/rigid_parts.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
 
@@ -48,11 +49,13 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
     }
+    // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
+    const std::vector<unsigned char> rigid_element = rigid_elements(grid, hex, rigid_materials(scene));
     if (scene.object.unheld == io::UnheldPieces::hold) {
         // Pieces no constraint reaches stay where they are: every node of theirs fixed.
         std::vector<unsigned char> constrained(hex.node_count(), 0);
         for (const auto& [n, axes] : m_fixed) constrained[n] = 1;
-        const std::vector<unsigned char> unheld = cut::unheld_elements(hex, constrained, m_held_pieces);
+        const std::vector<unsigned char> unheld = cut::unheld_elements(hex, anchoring_nodes(hex, rigid_element, constrained), m_held_pieces);
         std::vector<unsigned char> held(hex.node_count(), 0);
         for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
             if (unheld[e])
@@ -60,6 +63,16 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         for (std::uint32_t n = 0; n < hex.node_count(); ++n)
             if (held[n]) m_fixed.emplace_back(n, 7u);
     }
+    // Rigid material is held in place, with the soft material attached to it.
+    std::vector<unsigned char> held(hex.node_count(), 0);
+    for (const auto& [n, axes] : m_fixed) held[n] = 1;
+    const RigidParts rigid = rigid_parts(hex, rigid_element, held, false);
+    m_rigid_elements = rigid.rigid_elements;
+    if (!rigid.bodies.empty())
+        throw scene.error("materials", "a piece of rigid material that nothing holds would move as a rigid body, which \"isxfem\" "
+                                       "cannot do yet; hold it (a constraint, or \"unheld_pieces\": \"hold\") or use \"type\": \"dbg\"");
+    for (std::uint32_t n = 0; n < hex.node_count(); ++n)
+        if (rigid.anchored[n]) m_fixed.emplace_back(n, 7u);
     make_solver();
 
     // The surface, each used vertex located in a tetrahedron of its element.

@@ -26,6 +26,8 @@ public:
     ~IsxfemSimulation();
     /// The pieces no constraint reached, held in place ("unheld_pieces": "hold").
     [[nodiscard]] std::size_t held_piece_count() const { return m_held_pieces; }
+    /// Hexahedral cells (of the level the tetrahedra come from) holding rigid material, held in place.
+    [[nodiscard]] std::size_t rigid_element_count() const { return m_rigid_elements; }
 
     [[nodiscard]] const isxfem::XfemModel& model() const { return *m_model; }
     [[nodiscard]] isxfem::XfemSolver& solver() { return *m_solver; }
@@ -122,6 +124,7 @@ private:
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     std::vector<std::pair<std::uint32_t, unsigned>> m_fixed; ///< supported node, held axes (1 x, 2 y, 4 z)
     std::size_t m_held_pieces = 0; ///< pieces no constraint reached, held ("unheld_pieces": "hold")
+    std::size_t m_rigid_elements = 0;
     std::unique_ptr<isxfem::XfemModel> m_model;
     std::unique_ptr<isxfem::XfemSolver> m_solver;
     std::unique_ptr<isxfem::CutClosure> m_closure;

@@ -53,9 +53,9 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, do
             log::info("levels auto: level {} skipped: {}", level, e.what());
             continue;
         }
-        sim->solver().step(); // warm-up: first factorisations, caches
+        sim->step(); // warm-up: first factorisations, caches
         std::vector<double> ms;
-        for (int k = 0; k < 3; ++k) ms.push_back(sim->solver().step().step_ms);
+        for (int k = 0; k < 3; ++k) ms.push_back(sim->step().step_ms);
         std::sort(ms.begin(), ms.end());
         out.trials.push_back({level, sim->solver().dof_count(), ms[1], -1.0});
         log::info("levels auto: level {} steps in {:.2f} ms ({} DOFs)", level, ms[1], sim->solver().dof_count());
@@ -86,7 +86,7 @@ std::vector<Eigen::Vector3d> static_displacements(const io::Scene& scene, const 
     s.solver.mode = io::SolverMode::static_equilibrium;
     s.solver.cg_max_iterations = std::max(s.solver.cg_max_iterations, 5000);
     DbgSimulation sim(s, grid, level);
-    sim.solver().step();
+    sim.step();
     dofs = sim.solver().dof_count();
     return sim.surface().displacements(sim.solver().positions());
 }
