@@ -121,6 +121,14 @@ void ImplicitSolver::set_contact(std::vector<NodeContact> contact)
     }
 }
 
+void ImplicitSolver::adopt_preconditioner(ImplicitSolver& previous, const std::vector<std::uint32_t>& changed_nodes)
+{
+    if (!previous.m_preconditioner) return;
+    set_preconditioner(std::move(previous.m_preconditioner));
+    m_last_dt = previous.m_last_dt; // a new dt would invalidate it
+    m_preconditioner->blocks_changed(changed_nodes);
+}
+
 void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
 {
     if (p && m_options.matrix_free)

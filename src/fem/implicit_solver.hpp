@@ -94,6 +94,10 @@ public:
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
     void set_preconditioner(std::unique_ptr<Preconditioner> p);
+    /// After a cut that kept every node of the model (same numbering, same holds, same dt): goes on
+    /// with `previous`'s preconditioner, told which node blocks changed (it may patch them instead
+    /// of being built anew: a drill taking a voxel a frame would otherwise refactor every frame).
+    void adopt_preconditioner(ImplicitSolver& previous, const std::vector<std::uint32_t>& changed_nodes);
     /// Set when the given preconditioner could not be built and Jacobi took over; empty otherwise.
     [[nodiscard]] const std::string& fallback_note() const { return m_fallback_note; }
 

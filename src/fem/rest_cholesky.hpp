@@ -72,10 +72,11 @@ public:
     RestCholesky(const RestCholesky&) = delete;
     RestCholesky& operator=(const RestCholesky&) = delete;
 
-    /// Also when a background factor is due to be swapped in: it may be discarded and taken again.
+    /// Also when a background factor is due to be swapped in (it may be discarded and taken again)
+    /// and when changed blocks wait for their patch.
     [[nodiscard]] bool needs_matrix() const override
     {
-        return m_stale || m_invalid || (m_running.valid() && static_cast<double>(m_running_iterations) >= m_running_cost);
+        return m_stale || m_invalid || m_patch_dirty || (m_running.valid() && static_cast<double>(m_running_iterations) >= m_running_cost);
     }
     void update(const SystemMatrix* a, const std::vector<unsigned char>& fixed,
                 const std::vector<Eigen::Quaterniond>& node_rotation) override;

@@ -122,8 +122,25 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
+    const io::PreconditionerChoice old_choice = m_choice;
     build(false, old_model.get(), &report);
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
+    if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 &&
+        old_model->grid_node() == m_model->grid_node()) {
+        // Every node kept its number: the factor goes on, patched where elements changed.
+        const grid::Level& lv = grid.level(m_level);
+        std::vector<unsigned char> changed(lv.elements.size(), 0);
+        if (static_cast<std::size_t>(m_level) < report.levels.size()) {
+            for (const auto& [e, from] : report.levels[static_cast<std::size_t>(m_level)].created) changed[e] = 1;
+            for (std::uint32_t e : report.levels[static_cast<std::size_t>(m_level)].updated) changed[e] = 1;
+        }
+        std::vector<std::uint32_t> nodes;
+        for (const fem::HexElement& el : m_model->elements())
+            if (changed[el.grid_element]) nodes.insert(nodes.end(), el.dof_node.begin(), el.dof_node.end());
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        m_solver->adopt_preconditioner(*old_solver, nodes);
+    }
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
     old_solver.reset(); // freeing the old factor is part of the update (it took milliseconds unseen)
     old_model.reset();
@@ -215,7 +232,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
         free_dofs += 3 - static_cast<std::size_t>(std::popcount(held_axes[n]));
     }
 
-    const io::PreconditionerChoice choice = free_dofs == 0 ? io::PreconditionerChoice::jacobi
+    const io::PreconditionerChoice choice = m_choice = free_dofs == 0 ? io::PreconditionerChoice::jacobi
                                                            : resolve(scene.solver.preconditioner, free_dofs, level < grid.max_level());
     if (choice == io::PreconditionerChoice::multigrid && level >= grid.max_level())
         throw scene.error("solver.preconditioner", "multigrid needs a level coarser than the simulated one");

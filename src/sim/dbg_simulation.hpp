@@ -100,6 +100,7 @@ private:
     std::unique_ptr<surface::EmbeddedSurface> m_surface;
     std::unique_ptr<cut::ModelSurface> m_model_surface;
     std::string m_linear_solver;
+    io::PreconditionerChoice m_choice = io::PreconditionerChoice::automatic; ///< resolved, at the last build
     std::size_t m_rigid_elements = 0;
     std::vector<fem::RigidBody> m_bodies;
     std::vector<std::int32_t> m_body_of_node; ///< per node: its body, or -1
