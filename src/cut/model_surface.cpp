@@ -2,6 +2,9 @@
 
 #include "grid/hex8.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace vox::cut {
 namespace {
 
@@ -32,18 +35,22 @@ ModelSurface::ModelSurface(const grid::BranchedGrid& grid, const fem::HexModel& 
     m_element.assign(vertices.size(), grid::no_index);
     m_local.assign(vertices.size(), Eigen::Vector3d::Zero());
     m_rest_mm.assign(vertices.size(), Eigen::Vector3d::Zero());
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        const surface::SurfaceVertex& v = vertices[i];
-        if (v.users == 0) continue;
-        m_rest_mm[i] = grid.voxels().world_mm(v.rest);
-        if (level == 0) {
-            m_element[i] = m_model_element[v.voxel];
-            m_local[i] = v.rest - grid::BranchedGrid::cell_corner_index(grid.voxels().coord(v.voxel), 0, 0);
-        } else {
-            m_element[i] = m_model_element[v.element];
-            m_local[i] = v.local;
+    // In parallel: a skull's surface has a few hundred thousand vertices, and a drill rebuilds
+    // this every frame it takes a voxel.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const surface::SurfaceVertex& v = vertices[i];
+            if (v.users == 0) continue;
+            m_rest_mm[i] = grid.voxels().world_mm(v.rest);
+            if (level == 0) {
+                m_element[i] = m_model_element[v.voxel];
+                m_local[i] = v.rest - grid::BranchedGrid::cell_corner_index(grid.voxels().coord(v.voxel), 0, 0);
+            } else {
+                m_element[i] = m_model_element[v.element];
+                m_local[i] = v.local;
+            }
         }
-    }
+    });
     group(m_element, model.elements().size(), m_element_start, m_element_vertices);
     // Triangles by vertex: each triangle listed under its three vertices.
     const auto& triangles = surface.triangles();

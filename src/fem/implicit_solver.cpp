@@ -26,7 +26,7 @@ void SolverOptions::validate() const
     if (newton_max_iterations < 1) bad("newton_max_iterations must be at least 1");
 }
 
-ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& options)
+ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& options, const ImplicitSolver* same_mesh)
     : m_model(model), m_options(options)
 {
     m_options.validate();
@@ -41,6 +41,36 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_element_energy.assign(model.elements().size(), 0.0);
     m_stiffness_scale.assign(model.elements().size(), 1.0);
     m_behaviour.resize(model.materials().size());
+    m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
+    m_element_force.assign(model.elements().size(), Vector24d::Zero());
+    m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
+    m_element_product.assign(model.elements().size(), Vector24d::Zero());
+    if (same_mesh && same_mesh->m_options.matrix_free == m_options.matrix_free && same_connectivity(same_mesh->m_model, model)) {
+        // A cut that changed element matrices only (a drill taking a voxel a frame): the
+        // incidence and the matrix pattern are those of the previous solver.
+        m_incidence_start = same_mesh->m_incidence_start;
+        m_incidence = same_mesh->m_incidence;
+        m_rank = same_mesh->m_rank;
+        m_diagonal_rank = same_mesh->m_diagonal_rank;
+        m_matrix = same_mesh->m_matrix;
+        std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + m_matrix.nonZeros(), 0.0);
+        return;
+    }
+    build_pattern();
+}
+
+bool ImplicitSolver::same_connectivity(const HexModel& a, const HexModel& b)
+{
+    if (a.node_count() != b.node_count() || a.elements().size() != b.elements().size()) return false;
+    for (std::size_t e = 0; e < a.elements().size(); ++e)
+        if (a.elements()[e].dof_node != b.elements()[e].dof_node) return false;
+    return true;
+}
+
+void ImplicitSolver::build_pattern()
+{
+    const HexModel& model = m_model;
+    const std::size_t n = model.node_count();
     // Which (element, corner) pairs touch each node: the row-wise assembly gathers from them.
     m_incidence_start.assign(n + 1, 0);
     for (const HexElement& e : model.elements())
@@ -50,10 +80,6 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     std::vector<std::uint32_t> fill(m_incidence_start.begin(), m_incidence_start.end() - 1);
     for (std::uint32_t e = 0; e < model.elements().size(); ++e)
         for (std::uint32_t c = 0; c < 8; ++c) m_incidence[fill[model.elements()[e].dof_node[c]]++] = 8 * e + c;
-    m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
-    m_element_force.assign(model.elements().size(), Vector24d::Zero());
-    m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
-    m_element_product.assign(model.elements().size(), Vector24d::Zero());
     if (m_options.matrix_free) return; // no matrix
 
     // The matrix pattern: a 3 x 3 block for every pair of nodes sharing an element. Built from

@@ -76,7 +76,9 @@ struct NodeContact {
 
 class ImplicitSolver {
 public:
-    ImplicitSolver(const HexModel& model, const SolverOptions& options);
+    /// `same_mesh`: a solver of a model that may have the same elements on the same nodes (the
+    /// model before a cut); when it has, its incidence and matrix pattern are reused.
+    ImplicitSolver(const HexModel& model, const SolverOptions& options, const ImplicitSolver* same_mesh = nullptr);
 
     /// Holds node `node` (dense index) along the axes whose bits are set in `axes` (1 x, 2 y, 4 z).
     void fix(std::uint32_t node, unsigned axes);
@@ -137,6 +139,10 @@ public:
     double elastic_energy();
 
 private:
+    /// Node incidence of the elements and, unless matrix-free, the matrix pattern.
+    void build_pattern();
+    /// Whether the two models have the same elements on the same nodes.
+    [[nodiscard]] static bool same_connectivity(const HexModel& a, const HexModel& b);
     /// What an assembly produces beyond the element rotations, elastic forces and energy.
     enum class Output { forces, diagonal, matrix };
     /// Element rotations, elastic forces (m_internal) and energy at the current positions; then

@@ -123,7 +123,7 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
     const io::PreconditionerChoice old_choice = m_choice;
-    build(false, old_model.get(), &report);
+    build(false, old_model.get(), &report, old_solver.get());
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
     if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 &&
         old_model->grid_node() == m_model->grid_node()) {
@@ -173,7 +173,8 @@ fem::StepStats DbgSimulation::step()
     return s;
 }
 
-void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid::UpdateReport* report)
+void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid::UpdateReport* report,
+                          const fem::ImplicitSolver* previous_solver)
 {
     const io::Scene& scene = m_scene;
     const grid::BranchedGrid& grid = *m_grid;
@@ -238,7 +239,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
         throw scene.error("solver.preconditioner", "multigrid needs a level coarser than the simulated one");
     fem::SolverOptions options = solver_options(scene.solver);
     options.matrix_free = choice == io::PreconditionerChoice::jacobi;
-    m_solver = std::make_unique<fem::ImplicitSolver>(model, options);
+    m_solver = std::make_unique<fem::ImplicitSolver>(model, options, previous_solver);
     fem::ImplicitSolver& solver = *m_solver;
     for (std::uint32_t n = 0; n < model.node_count(); ++n)
         if (held_axes[n]) solver.fix(n, held_axes[n]);

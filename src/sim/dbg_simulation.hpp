@@ -81,8 +81,10 @@ public:
 private:
     /// Model, solver, preconditioner, materials, constraints and loads at m_level; `first`: also
     /// the wet regions, and boxes that catch no node are errors (after a cut they may catch none).
-    /// After a cut, `previous` and `report` let unchanged elements keep their matrices.
-    void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr);
+    /// After a cut, `previous` and `report` let unchanged elements keep their matrices, and
+    /// `previous_solver` lends its matrix pattern when the elements sit on the same nodes.
+    void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr,
+               const fem::ImplicitSolver* previous_solver = nullptr);
 
     /// "unheld_pieces": "hold": fixes every node of the pieces no constraint reaches (found when
     /// `first`; after cuts, the elements holding their voxels). `constrained` flags the nodes the
