@@ -48,8 +48,13 @@ nlohmann::json level_choice_json(const sim::LevelChoice& choice)
     nlohmann::json trials = nlohmann::json::array();
     for (const sim::LevelTrial& t : choice.trials) {
         nlohmann::json j{{"level", t.level}, {"dofs", t.dofs}};
-        if (t.error >= 0.0) j["error"] = t.error;
-        else j["step_ms"] = t.step_ms;
+        if (t.error >= 0.0) {
+            j["error"] = t.error;
+        } else {
+            j["frame_ms"] = t.frame_ms;
+            j["step_ms"] = t.step_ms;
+            j["preconditioner"] = sim::preconditioner_name(t.preconditioner);
+        }
         trials.push_back(j);
     }
     return {{"reason", choice.reason}, {"trials", trials}};

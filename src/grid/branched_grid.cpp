@@ -518,4 +518,11 @@ double BranchedGrid::total_mass_kg() const
     return total;
 }
 
+BranchedGrid::BranchedGrid(const BranchedGrid& other)
+    : m_voxels(other.m_voxels), m_materials(other.m_materials), m_levels(other.m_levels), m_full_stiffness(other.m_full_stiffness),
+      m_full_mass(other.m_full_mass)
+{
+    for (const auto& map : other.m_maps) m_maps.push_back(map ? std::make_unique<MomentMatrices>(*map) : nullptr);
+}
+
 } // namespace vox::grid

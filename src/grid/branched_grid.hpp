@@ -99,6 +99,12 @@ public:
     {
     }
 
+    BranchedGrid(BranchedGrid&&) noexcept = default;
+    BranchedGrid& operator=(BranchedGrid&&) noexcept = default;
+    /// An independent copy (a trial that cuts one while the original stays as it was). Not a copy
+    /// constructor, so that no grid is copied by accident.
+    [[nodiscard]] BranchedGrid copy() const { return BranchedGrid(*this); }
+
     [[nodiscard]] const FineVoxels& voxels() const { return m_voxels; }
     [[nodiscard]] const std::vector<ElasticMaterial>& materials() const { return m_materials; }
     [[nodiscard]] int max_level() const { return static_cast<int>(m_levels.size()) - 1; }
@@ -132,6 +138,8 @@ public:
     UpdateReport update(std::span<const Coord> removed, std::span<const std::pair<Coord, int>> faces);
 
 private:
+    BranchedGrid(const BranchedGrid& other);
+    BranchedGrid& operator=(const BranchedGrid&) = delete;
     void build_level0(bool number_nodes);
     /// (Re)builds the elements of the given cells of level l from the level below; returns what changed.
     LevelChange rebuild_cells(int l, std::vector<std::uint64_t> cell_codes, bool initial);

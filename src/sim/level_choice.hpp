@@ -1,15 +1,21 @@
 #pragma once
 // "levels": "auto": the run picks the coarsening level itself and says why.
-//  - step_budget_ms: the finest level whose measured dynamic step (median of three after a
-//    warm-up) fits the budget; levels are tried from the coarsest down and the search stops at
-//    the first that does not fit (finer levels only cost more).
+//  - step_budget_ms: a budget for the whole frame (tools, cuts and the step). The finest level
+//    whose frames fit it, judged on the frames the scene will have: from the first frame in which
+//    a tool touches the object (found by running the script at the coarsest level), with their
+//    contact and cuts; frames at rest when no tool ever touches it. Each level is timed on its own
+//    copy of the grid (a 90th percentile of 10 frames after 2 of warm-up), with each
+//    preconditioner when the scene says "auto" (the fastest is kept, and the run uses it). Levels
+//    are tried from the coarsest down and the search stops at the first that does not fit.
 //  - max_error: the coarsest level whose quasi-static deformation under the scene's loads differs
 //    from the next finer level's by at most max_error (RMS of the surface displacement difference
 //    over the finer level's RMS displacement).
 
 #include "grid/branched_grid.hpp"
+#include "grid/label_grid.hpp"
 #include "io/scene.hpp"
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,18 +24,27 @@ namespace vox::sim {
 struct LevelTrial {
     int level = 0;
     std::size_t dofs = 0;
-    double step_ms = 0.0;  ///< budget: median measured step
+    double step_ms = 0.0;  ///< budget: median measured solver step
     double error = -1.0;   ///< max_error: difference from the next finer level (-1: not measured)
+    double frame_ms = 0.0; ///< budget: whole frame, 90th percentile of the judged frames
+    io::PreconditionerChoice preconditioner = io::PreconditionerChoice::automatic; ///< budget: the fastest
 };
 
 struct LevelChoice {
     int level = 3;
+    /// budget: the preconditioner the chosen level was fastest with (the run uses it).
+    io::PreconditionerChoice preconditioner = io::PreconditionerChoice::automatic;
     std::string reason;
     std::vector<LevelTrial> trials;
 };
 
 /// `grid` must hold levels up to 6 (or its object's coarsest). Throws the scene's InputError when
 /// max_error is asked of an object nothing holds (its equilibrium is undefined).
-[[nodiscard]] LevelChoice choose_level(const io::Scene& scene, const grid::BranchedGrid& grid);
+/// "cholesky", "jacobi", "multigrid" or "auto", as scene files write them.
+[[nodiscard]] const char* preconditioner_name(io::PreconditionerChoice p);
+
+/// `labels` are the grid's (trials build methods on copies of the grid).
+[[nodiscard]] LevelChoice choose_level(const io::Scene& scene, const grid::BranchedGrid& grid,
+                                       std::shared_ptr<const grid::LabelGrid> labels);
 
 } // namespace vox::sim

@@ -17,9 +17,12 @@ OpenedMethod open_method(const io::Scene& scene, std::shared_ptr<const grid::Lab
     }
     if (scene.object.auto_levels) { // every level is tried
         auto grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *labels, 6));
-        out.choice = choose_level(scene, *grid);
+        out.choice = choose_level(scene, *grid, labels);
         log::info("levels auto: {}", out.choice->reason);
-        out.method = std::make_unique<DbgMethod>(scene, std::move(labels), std::move(grid), out.choice->level);
+        io::Scene chosen = scene;
+        if (scene.solver.preconditioner == io::PreconditionerChoice::automatic)
+            chosen.solver.preconditioner = out.choice->preconditioner; // measured fastest (budget); "auto" otherwise
+        out.method = std::make_unique<DbgMethod>(chosen, std::move(labels), std::move(grid), out.choice->level);
         return out;
     }
     // Coarser levels than the simulated one serve only the multigrid preconditioner: every level
