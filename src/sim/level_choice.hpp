@@ -4,7 +4,7 @@
 //    whose frames fit it, judged on the frames the scene will have: from the first frame in which
 //    a tool touches the object (found by running the script at the coarsest level), with their
 //    contact and cuts; frames at rest when no tool ever touches it. Each level is timed on its own
-//    copy of the grid (a 90th percentile of 10 frames after 2 of warm-up), with each
+//    copy of the grid (the 90th percentile of 20 frames after 2 of warm-up), with each
 //    preconditioner when the scene says "auto" (the fastest is kept, and the run uses it). Levels
 //    are tried from the coarsest down and the search stops at the first that does not fit.
 //  - max_error: the coarsest level whose quasi-static deformation under the scene's loads differs
