@@ -6,6 +6,7 @@
 #include "bench/harness/compare.hpp"
 #include "bench/harness/conditioning.hpp"
 #include "bench/harness/cutting.hpp"
+#include "bench/harness/drilling.hpp"
 #include "bench/harness/haptics.hpp"
 #include "bench/harness/stability.hpp"
 #include "bench/harness/tradeoff.hpp"
@@ -44,6 +45,13 @@ void add_bench_command(CLI::App& app)
     CLI::App* cutting = bench->add_subcommand("cutting", "Cutting-frame time on the liver at level 4 during a 5 cm incision");
     cutting->add_option("--runs", *cutting_runs, "How many times to replay the incision (default 5)")->check(CLI::Range(1, 100));
     cutting->callback([cutting_runs] { run_cutting_bench(*cutting_runs); });
+
+    auto drilling_runs = std::make_shared<int>(3);
+    auto drilling_out = std::make_shared<std::string>("out");
+    CLI::App* drilling = bench->add_subcommand("drilling", "Whole-frame time while a burr drills the CT-like skull, elastic against rigid bone");
+    drilling->add_option("--runs", *drilling_runs, "How many times to drill each (default 3)")->check(CLI::Range(1, 100));
+    drilling->add_option("--out", *drilling_out, "Folder for drilling.md and drilling.json (default out)");
+    drilling->callback([drilling_runs, drilling_out] { run_drilling_bench(*drilling_runs, *drilling_out); });
 
     auto conditioning_out = std::make_shared<std::string>("out");
     CLI::App* conditioning = bench->add_subcommand(
