@@ -86,13 +86,16 @@ void add_check_command(CLI::App& app)
                     static_cast<unsigned long long>(labels.active_voxel_count()), voxel.x(), voxel.y(), voxel.z());
         for (const auto& [label, n] : labels.label_histogram()) {
             const io::Material& m = scene.material(label);
-            std::printf("  label %d: %llu voxels, E = %g Pa, nu = %g, rho = %g kg/m^3\n", label,
-                        static_cast<unsigned long long>(n), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3);
+            if (m.rigid)
+                std::printf("  label %d: %llu voxels, rigid, rho = %g kg/m^3\n", label, static_cast<unsigned long long>(n), m.density_kg_m3);
+            else
+                std::printf("  label %d: %llu voxels, E = %g Pa, nu = %g, rho = %g kg/m^3\n", label,
+                            static_cast<unsigned long long>(n), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3);
         }
         list_pieces(scene, labels, *path);
         if (scene.object.auto_levels) {
             if (scene.object.step_budget_ms)
-                std::printf("level: auto, the finest whose step fits %g ms\n", *scene.object.step_budget_ms);
+                std::printf("level: auto, the finest whose whole frames (tools, cuts, step) fit %g ms\n", *scene.object.step_budget_ms);
             else
                 std::printf("level: auto, the coarsest within %g %% of the next finer level\n", 100 * scene.object.max_error.value_or(0.0));
         } else {

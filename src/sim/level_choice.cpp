@@ -147,7 +147,8 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, st
             const FrameTimes t = time_frames(dynamic, *method, working, 10.0 * budget_ms);
             log::info("levels auto: level {} with {}: frames take {:.2f} ms (90th percentile; solver step {:.2f} ms, {} DOFs)", level,
                       method->linear_solver(), t.frame_ms, t.step_ms, method->dof_count());
-            if (!best || t.frame_ms < best->frame_ms) best = LevelTrial{level, method->dof_count(), t.step_ms, -1.0, t.frame_ms, p};
+            if (!best || t.frame_ms < best->frame_ms)
+                best = LevelTrial{level, method->dof_count(), t.step_ms, -1.0, t.frame_ms, p, method->linear_solver()};
         }
         if (!best) continue;
         out.trials.push_back(*best);
@@ -159,7 +160,7 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, st
     const auto fits = std::find_if(out.trials.rbegin(), out.trials.rend(), [&](const LevelTrial& t) { return t.frame_ms <= budget_ms; });
     const std::string judged = working > 0 ? "frames with the tools at work" : "frames at rest";
     const auto with = [&](const LevelTrial& t) {
-        return format_ms(t.frame_ms) + " with the " + preconditioner_name(t.preconditioner) + " preconditioner";
+        return format_ms(t.frame_ms) + " (" + t.linear_solver + ")";
     };
     const LevelTrial& chosen = fits == out.trials.rend() ? out.trials.front() : *fits;
     out.level = chosen.level;
@@ -216,7 +217,7 @@ LevelChoice by_error(const io::Scene& scene, const grid::BranchedGrid& grid, dou
             norm += finer[i].squaredNorm();
         }
         const double error = norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
-        out.trials.push_back({level, dofs, 0.0, error});
+        out.trials.push_back({level, dofs, 0.0, error, 0.0, io::PreconditionerChoice::automatic, {}});
         log::info("levels auto: level {} differs from level {} by {:.2f} %", level, level - 1, 100 * error);
         if (error <= max_error) {
             out.level = level;

@@ -28,6 +28,7 @@ struct LevelTrial {
     double error = -1.0;   ///< max_error: difference from the next finer level (-1: not measured)
     double frame_ms = 0.0; ///< budget: whole frame, 90th percentile of the judged frames
     io::PreconditionerChoice preconditioner = io::PreconditionerChoice::automatic; ///< budget: the fastest
+    std::string linear_solver; ///< budget: what it resolved to ("CG, warped Cholesky preconditioner", ...)
 };
 
 struct LevelChoice {
