@@ -1,6 +1,7 @@
 #include "sim/frame_loop.hpp"
 
 #include "core/error.hpp"
+#include "core/stopwatch.hpp"
 #include "sim/device_run.hpp"
 
 #include <cmath>
@@ -21,6 +22,7 @@ FrameLoop::FrameLoop(const io::Scene& scene, Method& method, ToolPolicy& tools, 
 
 FrameStats FrameLoop::next()
 {
+    Stopwatch clock;
     const double dt = m_scene.solver.dt_s;
     FrameStats out;
     out.frame = ++m_frame;
@@ -33,6 +35,7 @@ FrameStats FrameLoop::next()
     if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)))
         throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
                          " (non-finite energy); reduce solver.dt_s or check the materials");
+    out.frame_ms = clock.lap();
     return out;
 }
 

@@ -18,6 +18,7 @@ struct FrameStats {
     double t_s = 0.0; ///< simulated time at its end
     ToolsFrame tools;
     StepFigures step; ///< zero (and converged) while the object is held
+    double frame_ms = 0.0; ///< the whole frame, wall clock: device ticks, tools, cuts and step
 };
 
 /// A step whose state is no longer finite: what follows cannot be computed (an InputError, so a

@@ -56,9 +56,12 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_separated_faces += t.cut.separated_faces;
     m_separated_voxels += t.cut.separated_voxels;
     if (t.cut.changed()) m_cutting_ms.push_back(t.cutting_ms());
+    m_frame_ms.push_back(f.frame_ms);
     m_last = s;
     nlohmann::json frame{{"frame", f.frame},
                          {"t_s", f.t_s},
+                         {"level", method.level()},
+                         {"frame_ms", f.frame_ms},
                          {"step_ms", s.step_ms},
                          {"assembly_ms", s.assembly_ms},
                          {"solve_ms", s.solve_ms},
@@ -92,6 +95,9 @@ void RunRecord::finish(const Method& method)
                            {"total_step_ms", m_total_ms},
                            {"mean_step_ms", m_frames ? m_total_ms / m_frames : 0.0},
                            {"max_step_ms", m_max_ms},
+                           {"frame_ms_median", quantile(m_frame_ms, 0.5)},
+                           {"frame_ms_p95", quantile(m_frame_ms, 0.95)},
+                           {"frame_ms_max", quantile(m_frame_ms, 1.0)},
                            {"converged_frames", m_converged},
                            {"removed_voxels", m_removed},
                            {"separated_faces", m_separated_faces},
