@@ -80,7 +80,7 @@ StabilityResult run_case(const Object& object, const Case& c, int steps)
             const std::vector<Eigen::Vector3d> before = solver.positions();
             sim::StepFigures s;
             try {
-                s = loop.next().step; // refused (InputError) when the step created energy even split in 32
+                s = loop.next().step;
             } catch (const sim::Diverged& e) {
                 r.outcome = "diverged";
                 r.detail = e.what();
@@ -90,6 +90,7 @@ StabilityResult run_case(const Object& object, const Case& c, int steps)
                 budget += ((mass[n] - floor[n]) * gravity + sim.solver().external_forces()[n]).dot(solver.positions()[n] - before[n]);
             ++r.steps;
             r.unconverged_steps += !s.converged;
+            r.projected_steps += s.energy_projected;
             r.final_kinetic_j = s.kinetic_energy_j;
             r.final_elastic_j = s.elastic_energy_j.value_or(0.0);
             r.peak_kinetic_j = std::max(r.peak_kinetic_j, s.kinetic_energy_j);
@@ -119,6 +120,9 @@ StabilityResult run_case(const Object& object, const Case& c, int steps)
         if (r.unconverged_steps)
             r.detail += std::string(r.detail.empty() ? "" : "; ") + std::to_string(r.unconverged_steps) +
                         " steps stopped at the CG iteration cap";
+        if (r.projected_steps)
+            r.detail += std::string(r.detail.empty() ? "" : "; ") + std::to_string(r.projected_steps) +
+                        " steps created energy even solved fully at dt/32 and lost it again (energy projection)";
     } catch (const InputError& e) {
         r.outcome = "refused";
         r.detail = e.what();
@@ -265,7 +269,7 @@ void write_stability(const std::filesystem::path& dir, const std::vector<Stabili
         j.push_back({{"object", r.object}, {"case", r.variation}, {"outcome", r.outcome}, {"detail", r.detail}, {"steps", r.steps},
                      {"max_displacement_mm", r.max_displacement_mm}, {"peak_kinetic_j", r.peak_kinetic_j},
                      {"final_kinetic_j", r.final_kinetic_j}, {"final_elastic_j", r.final_elastic_j},
-                     {"unconverged_steps", r.unconverged_steps}});
+                     {"unconverged_steps", r.unconverged_steps}, {"projected_steps", r.projected_steps}});
     }
     std::filesystem::create_directories(dir);
     write_atomically(dir / "stability.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });

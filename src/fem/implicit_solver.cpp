@@ -685,14 +685,48 @@ void ImplicitSolver::advance(double dt, int depth, StepStats& s)
     const double newton_after = s.kinetic_energy_j + s.elastic_energy_j;
     physical = std::isfinite(newton_after) &&
                newton_after <= before + newton_work + 1e-3 * (before + std::abs(newton_work)) + 1e-15;
-    if (physical || depth == max_depth) {
-        s.energy_guarded = s.energy_guarded || !physical;
+    if (physical) return;
+    if (depth == max_depth) {
+        // Still gaining energy at 1/32 of the frame (the Newton solve stopped short: corotational
+        // forces are not the exact gradient of the energy, and under a slam its line search stalls).
+        // Rather than stop the session, the step keeps its direction and loses the energy it made.
+        project_energy(x0, before + newton_work, s);
         return;
     }
     undo();
     ++s.substeps;
     advance(0.5 * dt, depth + 1, s);
     advance(0.5 * dt, depth + 1, s);
+}
+
+void ImplicitSolver::project_energy(const std::vector<Eigen::Vector3d>& x0, double allowed, StepStats& s)
+{
+    // Kinetic energy first: the velocities are scaled so that kinetic plus elastic energy is what
+    // the step may hold. When the elastic energy alone is too much, the object stops and its
+    // positions go back along the step (bisection) until it is not.
+    s.energy_projected = true;
+    const double elastic = s.elastic_energy_j, kinetic = s.kinetic_energy_j;
+    if (std::isfinite(elastic) && std::isfinite(kinetic) && elastic <= allowed) {
+        const double scale = kinetic > 0.0 ? std::sqrt(std::max(0.0, allowed - elastic) / kinetic) : 0.0;
+        if (scale < 1.0)
+            for (Eigen::Vector3d& v : m_v) v *= scale;
+        s.kinetic_energy_j = kinetic * std::min(1.0, scale * scale);
+        return;
+    }
+    const std::vector<Eigen::Vector3d> x1 = m_x;
+    for (Eigen::Vector3d& v : m_v) v.setZero();
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 30; ++k) {
+        const double t = 0.5 * (lo + hi);
+        for (std::size_t i = 0; i < m_x.size(); ++i) m_x[i] = x0[i] + t * (x1[i] - x0[i]);
+        m_element_pass_current = false;
+        const double e = elastic_energy();
+        (std::isfinite(e) && e <= allowed ? lo : hi) = t;
+    }
+    for (std::size_t i = 0; i < m_x.size(); ++i) m_x[i] = x0[i] + lo * (x1[i] - x0[i]);
+    m_element_pass_current = false;
+    s.kinetic_energy_j = 0.0;
+    s.elastic_energy_j = elastic_energy();
 }
 
 StepStats ImplicitSolver::step()

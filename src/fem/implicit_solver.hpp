@@ -64,7 +64,9 @@ struct StepStats {
     double max_displacement_m = 0.0;
     bool converged = true;
     int substeps = 0;                 ///< dynamic: halvings taken because a step gained energy
-    bool energy_guarded = false;      ///< a step gained energy even at 1/32 of dt (kept, reported)
+    /// A step gained energy even solved fully at 1/32 of dt, and had the excess taken out
+    /// (project_energy): the session goes on, the frame says so.
+    bool energy_projected = false;
 };
 
 /// Penalty contact (a tool against the surface) gathered on one node, world frame.
@@ -177,8 +179,12 @@ private:
     double newton_step(double dt, StepStats& s, double& energy_before);
     /// Phi at the current velocities (positions x0 + dt v set): see newton_step.
     double incremental_potential(double dt, const std::vector<Eigen::Vector3d>& x0, const Eigen::VectorXd& m_v0);
+    /// After a step that gained energy at the smallest substep: scales the velocities, or failing
+    /// that stops the object part way along the step from `x0`, so that kinetic plus elastic
+    /// energy is at most `allowed` (J); updates the energies in `s`.
+    void project_energy(const std::vector<Eigen::Vector3d>& x0, double allowed, StepStats& s);
     /// A step of `dt` that must not create energy: linearised, else fully nonlinear, else halved
-    /// (recursively).
+    /// (recursively), else with the excess energy taken out.
     void advance(double dt, int depth, StepStats& s);
 
     const HexModel& m_model;

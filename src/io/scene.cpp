@@ -481,7 +481,10 @@ Load read_load(JsonReader r)
 {
     Load l;
     std::tie(l.box_min_mm, l.box_max_mm) = read_box(r.required_node("box_mm"));
-    l.force_n = finite_vector(r.required_node("force_n"));
+    const JsonNode force = r.required_node("force_n");
+    l.force_n = finite_vector(force);
+    if (l.force_n.norm() > 1e6) // a hundred tonnes: no scene of a body means it, and the step only projects energy away
+        force.fail("is stronger than 1e6 N (about 100 tonnes), the most a load may ask");
     r.finish();
     return l;
 }

@@ -198,7 +198,7 @@ StepFigures DbgMethod::step()
     out.kinetic_energy_j = s.kinetic_energy_j;
     out.elastic_energy_j = s.elastic_energy_j;
     out.max_displacement_mm = s.max_displacement_m * 1e3;
-    out.energy_guarded = s.energy_guarded;
+    out.energy_projected = s.energy_projected;
     return out;
 }
 

@@ -8,13 +8,6 @@
 
 namespace vox::sim {
 
-std::string energy_guard_message(const io::Scene& scene, int frame)
-{
-    return scene.source + ": frame " + std::to_string(frame) +
-           ": the step creates energy even split into 32 substeps, so its result cannot be trusted; "
-           "the forces are too large for this object (or solver.dt_s too long): reduce the loads or dt_s";
-}
-
 FrameLoop::FrameLoop(const io::Scene& scene, Method& method, ToolPolicy& tools, DeviceRun* device)
     : m_scene(scene), m_method(&method), m_tools(tools), m_device(device)
 {
@@ -31,7 +24,6 @@ FrameStats FrameLoop::next()
     out.tools = m_tools.frame(*m_method, out.t_s, dt);
     if (!out.tools.hold_object) out.step = m_method->step(); // held: a two-phase cut is being marked
     const StepFigures& s = out.step;
-    if (s.energy_guarded) throw InputError(energy_guard_message(m_scene, m_frame));
     if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)))
         throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
                          " (non-finite energy); reduce solver.dt_s or check the materials");

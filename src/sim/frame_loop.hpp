@@ -28,17 +28,12 @@ public:
     using InputError::InputError;
 };
 
-/// The message of a step that still created energy at 1/32 of dt: the loads or the time step are
-/// beyond what this object and level can follow.
-[[nodiscard]] std::string energy_guard_message(const io::Scene& scene, int frame);
-
 class FrameLoop {
 public:
     /// Keeps references to all four (`device` may be null: the tools follow the script).
     FrameLoop(const io::Scene& scene, Method& method, ToolPolicy& tools, DeviceRun* device = nullptr);
 
-    /// The next frame. Throws Diverged when its state is no longer finite, InputError when its
-    /// step created energy even split into 32 substeps: what follows could not be trusted.
+    /// The next frame. Throws Diverged when its state is no longer finite.
     FrameStats next();
 
     /// Frames done so far.

@@ -41,7 +41,7 @@ struct StepFigures {
     double kinetic_energy_j = 0.0;
     std::optional<double> elastic_energy_j; ///< empty where the method does not measure it
     double max_displacement_mm = 0.0;       ///< of any node from rest
-    bool energy_guarded = false;            ///< the step created energy even split into 32 substeps
+    bool energy_projected = false;          ///< the step created energy even split into 32 substeps, and lost it again
 };
 
 /// What one tool's cut did in one frame (added over a frame's tools). Phases as the branched-grid

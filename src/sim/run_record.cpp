@@ -52,6 +52,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_total_ms += s.step_ms;
     m_max_ms = std::max(m_max_ms, s.step_ms);
     m_converged += s.converged;
+    m_projected += s.energy_projected;
     m_removed += t.cut.removed_voxels;
     m_separated_faces += t.cut.separated_faces;
     m_separated_voxels += t.cut.separated_voxels;
@@ -70,6 +71,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"residual", s.residual},
                          {"converged", s.converged},
                          {"substeps", s.substeps},
+                         {"energy_projected", s.energy_projected},
                          {"kinetic_energy_j", s.kinetic_energy_j},
                          {"elastic_energy_j", s.elastic_energy_j ? nlohmann::json(*s.elastic_energy_j) : nlohmann::json()},
                          {"max_displacement_mm", s.max_displacement_mm},
@@ -99,6 +101,7 @@ void RunRecord::finish(const Method& method)
                            {"frame_ms_p95", quantile(m_frame_ms, 0.95)},
                            {"frame_ms_max", quantile(m_frame_ms, 1.0)},
                            {"converged_frames", m_converged},
+                           {"energy_projected_frames", m_projected},
                            {"removed_voxels", m_removed},
                            {"separated_faces", m_separated_faces},
                            {"separated_voxels", m_separated_voxels},

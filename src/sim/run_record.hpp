@@ -39,6 +39,7 @@ private:
     int m_frames = 0, m_converged = 0;
     double m_total_ms = 0.0, m_max_ms = 0.0;
     std::size_t m_removed = 0, m_separated_faces = 0, m_separated_voxels = 0;
+    std::size_t m_projected = 0;      ///< frames whose step lost the energy it created (StepFigures::energy_projected)
     std::vector<double> m_frame_ms;   ///< whole frames, wall clock
     std::vector<double> m_cutting_ms; ///< frames that cut: collision + propagation + grid update + remesh
     StepFigures m_last;

@@ -159,7 +159,7 @@ TEST(SolverContact, StiffContactOnALightNodeStaysBoundedAndDissipates)
     for (int k = 0; k < 100; ++k) {
         const StepStats s = solver.step();
         ASSERT_TRUE(std::isfinite(s.kinetic_energy_j) && std::isfinite(s.elastic_energy_j)) << "step " << k;
-        EXPECT_FALSE(s.energy_guarded) << "step " << k;
+        EXPECT_FALSE(s.energy_projected) << "step " << k;
         EXPECT_EQ(s.substeps, 0) << "step " << k; // stable at the full dt, no halving needed
         const double e = total_energy(s);
         EXPECT_LE(e, previous + 1e-12 * std::abs(force * force / stiffness)) << "step " << k;
