@@ -35,6 +35,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_v.assign(n, Eigen::Vector3d::Zero());
     m_external.assign(n, Eigen::Vector3d::Zero());
     m_fixed.assign(3 * n, 0);
+    m_held.assign(3 * n, 0);
     m_contact_of_node.assign(n, -1);
     m_rotation.assign(model.elements().size(), Eigen::Quaterniond::Identity());
     m_node_rotation.assign(n, Eigen::Quaterniond::Identity());
@@ -165,9 +166,21 @@ void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
 void ImplicitSolver::fix(std::uint32_t node, unsigned axes)
 {
     for (int a = 0; a < 3; ++a)
-        if (axes & (1u << a)) m_fixed[3 * node + static_cast<std::size_t>(a)] = 1;
+        if (axes & (1u << a)) m_fixed[3 * node + static_cast<std::size_t>(a)] = m_held[3 * node + static_cast<std::size_t>(a)] = 1;
     if (m_preconditioner) m_preconditioner->invalidate(); // built with other rows held
     m_active_current = false;
+}
+
+void ImplicitSolver::set_asleep(const std::vector<unsigned char>& asleep)
+{
+    m_fixed = m_held;
+    for (std::size_t n = 0; n < asleep.size() && n < m_x.size(); ++n)
+        if (asleep[n]) {
+            m_fixed[3 * n] = m_fixed[3 * n + 1] = m_fixed[3 * n + 2] = 1;
+            m_v[n].setZero();
+        }
+    m_active_current = false; // asleep elements are skipped
+    if (m_preconditioner) m_preconditioner->invalidate(); // built with other rows held
 }
 
 void ImplicitSolver::update_active()
@@ -686,10 +699,12 @@ void ImplicitSolver::advance(double dt, int depth, StepStats& s)
     physical = std::isfinite(newton_after) &&
                newton_after <= before + newton_work + 1e-3 * (before + std::abs(newton_work)) + 1e-15;
     if (physical) return;
-    if (depth == max_depth) {
+    if (depth == max_depth || m_projected_this_step) {
         // Still gaining energy at 1/32 of the frame (the Newton solve stopped short: corotational
         // forces are not the exact gradient of the energy, and under a slam its line search stalls).
         // Rather than stop the session, the step keeps its direction and loses the energy it made.
+        // Once a frame has had to do this its other substeps are not halved further: halving to
+        // 1/32 everywhere cost up to 63 full solves a frame (seconds) for no better answer.
         project_energy(x0, before + newton_work, s);
         return;
     }
@@ -705,6 +720,7 @@ void ImplicitSolver::project_energy(const std::vector<Eigen::Vector3d>& x0, doub
     // the step may hold. When the elastic energy alone is too much, the object stops and its
     // positions go back along the step (bisection) until it is not.
     s.energy_projected = true;
+    m_projected_this_step = true;
     const double elastic = s.elastic_energy_j, kinetic = s.kinetic_energy_j;
     if (std::isfinite(elastic) && std::isfinite(kinetic) && elastic <= allowed) {
         const double scale = kinetic > 0.0 ? std::sqrt(std::max(0.0, allowed - elastic) / kinetic) : 0.0;
@@ -734,6 +750,7 @@ StepStats ImplicitSolver::step()
     const auto start = std::chrono::steady_clock::now();
     StepStats s;
     if (!m_options.quasi_static) {
+        m_projected_this_step = false;
         advance(m_options.dt_s, 0, s);
     } else {
         m_update_plastic = !m_plastic.empty(); // plastic strain creeps once per frame, at its start

@@ -84,6 +84,11 @@ public:
 
     /// Holds node `node` (dense index) along the axes whose bits are set in `axes` (1 x, 2 y, 4 z).
     void fix(std::uint32_t node, unsigned axes);
+    /// Whether fix() holds `node` on all three axes.
+    [[nodiscard]] bool held(std::uint32_t node) const { return m_held[3 * node] && m_held[3 * node + 1] && m_held[3 * node + 2]; }
+    /// Nodes at rest held until woken (per node, 1: asleep), on top of those fix() holds; their
+    /// velocities are zeroed. An empty vector wakes every node.
+    void set_asleep(const std::vector<unsigned char>& asleep);
     /// Uniform acceleration of every mass, m/s^2 (gravity).
     void set_gravity(const Eigen::Vector3d& g) { m_gravity = g; }
     /// Extra external forces per node, N (point forces, tool contact); zero by default.
@@ -190,7 +195,8 @@ private:
     const HexModel& m_model;
     SolverOptions m_options;
     std::vector<Eigen::Vector3d> m_x, m_v, m_external;
-    std::vector<unsigned char> m_fixed; ///< per dof
+    std::vector<unsigned char> m_fixed; ///< per dof: held by fix() or asleep
+    std::vector<unsigned char> m_held;  ///< per dof: held by fix()
     std::vector<unsigned char> m_active; ///< per element: some node of it free (update_active)
     bool m_active_current = false;
     std::vector<NodeContact> m_contact;
@@ -223,6 +229,7 @@ private:
     double m_step_dt = 0.0;                 ///< the (sub)step being taken, s
     double m_last_dt = 0.0;                 ///< of the last dynamic solve
     bool m_element_pass_current = false;    ///< rotations and element forces match m_x
+    bool m_projected_this_step = false;     ///< a substep of this frame's step lost energy it made (project_energy)
 };
 
 } // namespace vox::fem

@@ -63,6 +63,7 @@ void DbgMethod::begin_tools(std::size_t tool_count)
     m_fresh.assign(tool_count, false);
     m_previous_section.resize(tool_count);
     m_marked_from.resize(tool_count);
+    m_tool_reach.clear();
 }
 
 const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at,
@@ -70,6 +71,7 @@ const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolS
 {
     const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
     m_touch[tool] = cut::touch_surface(m_sim->surface(), m_sim->solver().positions(), at, parameters, from);
+    m_tool_reach.push_back(at.world_bounds(k_sleep_tool_mm)); // wakes what sleeps near it
     m_touched[tool] = true;
     m_fresh[tool] = true;
     return m_touch[tool].contact;
@@ -181,6 +183,8 @@ void DbgMethod::end_tools()
         cut::merge_node_contacts(nodes, m_touch[k].nodes);
     }
     m_sim->solver().set_contact(std::move(nodes));
+    m_sim->set_tool_reach(std::move(m_tool_reach));
+    m_tool_reach.clear();
 }
 
 StepFigures DbgMethod::step()
@@ -199,6 +203,7 @@ StepFigures DbgMethod::step()
     out.elastic_energy_j = s.elastic_energy_j;
     out.max_displacement_mm = s.max_displacement_m * 1e3;
     out.energy_projected = s.energy_projected;
+    out.asleep_pieces = m_sim->asleep_piece_count();
     return out;
 }
 

@@ -148,7 +148,89 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     return t;
 }
 
+void DbgSimulation::find_pieces()
+{
+    const fem::HexModel& model = *m_model;
+    fem::ImplicitSolver& solver = *m_solver;
+    m_pieces.clear();
+    const std::vector<std::uint32_t> piece = cut::element_pieces(model);
+    const std::size_t count = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
+    m_pieces.resize(count);
+    std::vector<unsigned char> listed(model.node_count(), 0), plastic(count, 0);
+    const std::vector<io::Material> materials = io::material_table(m_scene).scene_materials;
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        Piece& p = m_pieces[piece[e]];
+        for (std::uint32_t n : model.elements()[e].dof_node)
+            if (!listed[n]++) p.nodes.push_back(n);
+        const auto material = static_cast<std::size_t>(model.elements()[e].material);
+        if (material < materials.size() && materials[material].plasticity) plastic[piece[e]] = 1;
+    }
+    if (m_scene.solver.mode != io::SolverMode::dynamic) return; // a static frame is at rest already
+    for (std::size_t k = 0; k < count; ++k) {
+        Piece& p = m_pieces[k];
+        bool free = false, loaded = false, body = false;
+        for (std::uint32_t n : p.nodes) {
+            free = free || !solver.held(n);
+            loaded = loaded || solver.external_forces()[n].squaredNorm() > 0.0;
+            body = body || m_body_of_node[n] >= 0;
+        }
+        p.can_sleep = free && !loaded && !body && !plastic[k];
+    }
+}
+
+void DbgSimulation::apply_sleep()
+{
+    std::vector<unsigned char> asleep(m_model->node_count(), 0);
+    for (const Piece& p : m_pieces)
+        if (p.asleep)
+            for (std::uint32_t n : p.nodes) asleep[n] = 1;
+    m_solver->set_asleep(asleep);
+}
+
+std::size_t DbgSimulation::asleep_piece_count() const
+{
+    return static_cast<std::size_t>(std::count_if(m_pieces.begin(), m_pieces.end(), [](const Piece& p) { return p.asleep; }));
+}
+
 fem::StepStats DbgSimulation::step()
+{
+    const auto near_tool = [&](const Eigen::AlignedBox3d& box) {
+        return std::any_of(m_tool_reach.begin(), m_tool_reach.end(), [&](const Eigen::AlignedBox3d& t) { return t.intersects(box); });
+    };
+    bool changed = false;
+    for (Piece& p : m_pieces)
+        if (p.asleep && near_tool(p.box_mm)) {
+            p.asleep = false;
+            p.rest_s = 0.0;
+            changed = true;
+        }
+    if (changed) apply_sleep();
+    fem::StepStats s = step_awake();
+    // Pieces that came to rest fall asleep.
+    fem::ImplicitSolver& solver = *m_solver;
+    std::vector<unsigned char> touched(m_model->node_count(), 0);
+    for (const fem::NodeContact& c : solver.contact()) touched[c.node] = 1;
+    changed = false;
+    for (Piece& p : m_pieces) {
+        if (!p.can_sleep || p.asleep) continue;
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        bool resting = true;
+        for (std::uint32_t n : p.nodes) {
+            resting = resting && !touched[n] && solver.velocities()[n].norm() < k_sleep_speed_m_s;
+            box.extend(solver.positions()[n] * 1e3);
+        }
+        p.rest_s = resting && !near_tool(box) ? p.rest_s + m_scene.solver.dt_s : 0.0;
+        if (p.rest_s + 1e-9 < k_sleep_after_s) continue;
+        p.asleep = true;
+        p.box_mm = box;
+        changed = true;
+    }
+    if (changed) apply_sleep();
+    return s;
+}
+
+fem::StepStats DbgSimulation::step_awake()
 {
     if (m_bodies.empty()) return m_solver->step();
     // The bodies' state from their nodes, which then stand still in the finite-element solve
@@ -293,6 +375,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
     }
+    find_pieces();
 }
 
 void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained, std::vector<unsigned>& held_axes)

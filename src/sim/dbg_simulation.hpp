@@ -38,6 +38,13 @@ namespace vox::sim {
 /// pass band (surface/embedded_surface.hpp), strong enough to take out the terraces of 1.5 mm
 /// CT slices while keeping the shape and, exactly, the enclosed volume.
 inline constexpr int k_smoothing_iterations = 20;
+
+/// A piece sleeps (is not stepped) once every node of it has been slower than this for
+/// k_sleep_after_s, with no tool within k_sleep_tool_mm and no scene load on it; a tool coming
+/// that near, or a cut, wakes it.
+inline constexpr double k_sleep_speed_m_s = 1e-3;
+inline constexpr double k_sleep_after_s = 0.5;
+inline constexpr double k_sleep_tool_mm = 10.0;
 inline constexpr double k_smoothing_passband = 0.05;
 
 /// Smooths a scene's surface at rest, once, as it is extracted (both methods), unless the
@@ -69,8 +76,14 @@ public:
     /// "Jacobi (matrix-free)", "warped Cholesky", "multigrid (3 levels)".
     [[nodiscard]] const std::string& linear_solver() const { return m_linear_solver; }
 
-    /// One frame's step: the finite elements, then the rigid bodies under the same contact.
+    /// One frame's step: the finite elements, then the rigid bodies under the same contact; pieces
+    /// at rest sleep (see k_sleep_speed_m_s) until a tool comes near or a cut rebuilds the model.
     fem::StepStats step();
+    /// Where the tools are this frame: world boxes (mm) around each placed tool. A sleeping piece
+    /// whose box meets one wakes; an awake piece within one does not fall asleep.
+    void set_tool_reach(std::vector<Eigen::AlignedBox3d> boxes_mm) { m_tool_reach = std::move(boxes_mm); }
+    /// Pieces asleep now.
+    [[nodiscard]] std::size_t asleep_piece_count() const;
 
     /// Removes fine voxels and disconnects faces of `grid` (the grid this simulation was built
     /// on), updates the surface locally and rebuilds the model, carrying positions, velocities,
@@ -104,6 +117,22 @@ private:
     std::string m_linear_solver;
     io::PreconditionerChoice m_choice = io::PreconditionerChoice::automatic; ///< resolved, at the last build
     std::size_t m_rigid_elements = 0;
+    /// A piece of the model (elements joined through nodes) that may sleep.
+    struct Piece {
+        std::vector<std::uint32_t> nodes;
+        bool can_sleep = false; ///< dynamic, some node free, no scene load, nothing plastic, not a rigid body
+        double rest_s = 0.0;    ///< how long every node has been slower than k_sleep_speed_m_s
+        bool asleep = false;
+        Eigen::AlignedBox3d box_mm; ///< where it sleeps, world mm
+    };
+    /// The pieces of the model as built (all awake).
+    void find_pieces();
+    /// Hands the asleep nodes to the solver.
+    void apply_sleep();
+    /// The step of the awake pieces and the rigid bodies.
+    fem::StepStats step_awake();
+    std::vector<Piece> m_pieces;
+    std::vector<Eigen::AlignedBox3d> m_tool_reach;
     std::vector<fem::RigidBody> m_bodies;
     std::vector<std::int32_t> m_body_of_node; ///< per node: its body, or -1
 };

@@ -72,6 +72,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"converged", s.converged},
                          {"substeps", s.substeps},
                          {"energy_projected", s.energy_projected},
+                         {"asleep_pieces", s.asleep_pieces},
                          {"kinetic_energy_j", s.kinetic_energy_j},
                          {"elastic_energy_j", s.elastic_energy_j ? nlohmann::json(*s.elastic_energy_j) : nlohmann::json()},
                          {"max_displacement_mm", s.max_displacement_mm},
