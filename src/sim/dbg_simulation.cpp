@@ -293,7 +293,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
-    const std::vector<unsigned char> rigid_element = rigid_elements(grid, model, m_rigid_material);
+    const std::vector<RigidContent> rigid_element = rigid_content(grid, model, m_rigid_material);
     if (scene.object.unheld == io::UnheldPieces::hold)
         hold_unheld_pieces(first, anchoring_nodes(model, rigid_element, constrained), held_axes);
     std::vector<unsigned char> held(model.node_count(), 0);

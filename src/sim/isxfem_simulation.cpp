@@ -50,7 +50,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
-    const std::vector<unsigned char> rigid_element = rigid_elements(grid, hex, rigid_materials(scene));
+    const std::vector<RigidContent> rigid_element = rigid_content(grid, hex, rigid_materials(scene));
     if (scene.object.unheld == io::UnheldPieces::hold) {
         // Pieces no constraint reaches stay where they are: every node of theirs fixed.
         std::vector<unsigned char> constrained(hex.node_count(), 0);
