@@ -153,6 +153,7 @@ void DbgSimulation::find_pieces()
     const fem::HexModel& model = *m_model;
     fem::ImplicitSolver& solver = *m_solver;
     m_pieces.clear();
+    m_solver_asleep.assign(model.node_count(), 0);
     const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     const std::size_t count = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
     m_pieces.resize(count);
@@ -174,17 +175,30 @@ void DbgSimulation::find_pieces()
             loaded = loaded || solver.external_forces()[n].squaredNorm() > 0.0;
             body = body || m_body_of_node[n] >= 0;
         }
+        p.free = free;
         p.can_sleep = free && !loaded && !body && !plastic[k];
     }
 }
 
+bool DbgSimulation::all_asleep() const
+{
+    return m_bodies.empty() && std::any_of(m_pieces.begin(), m_pieces.end(), [](const Piece& p) { return p.asleep; }) &&
+           std::all_of(m_pieces.begin(), m_pieces.end(), [](const Piece& p) { return p.asleep || !p.free; });
+}
+
 void DbgSimulation::apply_sleep()
 {
+    // When everything that could move sleeps, the solve is skipped whole and the solver keeps the
+    // holds it was built with: waking then takes no new factor (the common case: one object left
+    // alone, then touched again). Otherwise the sleeping pieces are held in the solve.
     std::vector<unsigned char> asleep(m_model->node_count(), 0);
-    for (const Piece& p : m_pieces)
-        if (p.asleep)
-            for (std::uint32_t n : p.nodes) asleep[n] = 1;
+    if (!all_asleep())
+        for (const Piece& p : m_pieces)
+            if (p.asleep)
+                for (std::uint32_t n : p.nodes) asleep[n] = 1;
+    if (asleep == m_solver_asleep) return;
     m_solver->set_asleep(asleep);
+    m_solver_asleep = std::move(asleep);
 }
 
 std::size_t DbgSimulation::asleep_piece_count() const
@@ -205,7 +219,16 @@ fem::StepStats DbgSimulation::step()
             changed = true;
         }
     if (changed) apply_sleep();
-    fem::StepStats s = step_awake();
+    fem::StepStats s;
+    if (all_asleep()) { // nothing to step: the object is at rest and still
+        Stopwatch clock;
+        for (Eigen::Vector3d& v : m_solver->velocities()) v.setZero();
+        s.elastic_energy_j = m_resting.elastic_energy_j;
+        s.max_displacement_m = m_resting.max_displacement_m;
+        s.step_ms = clock.lap();
+    } else {
+        s = m_resting = step_awake();
+    }
     // Pieces that came to rest fall asleep.
     fem::ImplicitSolver& solver = *m_solver;
     std::vector<unsigned char> touched(m_model->node_count(), 0);

@@ -120,6 +120,7 @@ private:
     /// A piece of the model (elements joined through nodes) that may sleep.
     struct Piece {
         std::vector<std::uint32_t> nodes;
+        bool free = false;      ///< some node of it is not held
         bool can_sleep = false; ///< dynamic, some node free, no scene load, nothing plastic, not a rigid body
         double rest_s = 0.0;    ///< how long every node has been slower than k_sleep_speed_m_s
         bool asleep = false;
@@ -127,11 +128,15 @@ private:
     };
     /// The pieces of the model as built (all awake).
     void find_pieces();
-    /// Hands the asleep nodes to the solver.
+    /// Every piece that could move sleeps (and no rigid body moves): the step is skipped whole.
+    [[nodiscard]] bool all_asleep() const;
+    /// Hands the asleep nodes to the solver, unless all_asleep().
     void apply_sleep();
     /// The step of the awake pieces and the rigid bodies.
     fem::StepStats step_awake();
     std::vector<Piece> m_pieces;
+    std::vector<unsigned char> m_solver_asleep; ///< per node: what the solver was last told (set_asleep)
+    fem::StepStats m_resting;                   ///< the last step taken, whose energy a skipped step reports
     std::vector<Eigen::AlignedBox3d> m_tool_reach;
     std::vector<fem::RigidBody> m_bodies;
     std::vector<std::int32_t> m_body_of_node; ///< per node: its body, or -1

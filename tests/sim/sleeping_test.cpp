@@ -48,6 +48,8 @@ TEST(Sleeping, ASettledPieceStopsBeingSteppedUntilAToolComesNear)
         if (s.step.asleep_pieces == 1 && !first_asleep) {
             first_asleep = f;
             settled = method->surface_displacements_mm();
+        } else if (first_asleep) {
+            EXPECT_EQ(s.step.cg_iterations, 0) << "frame " << f << ": the whole object sleeps, nothing is solved";
         }
     }
     ASSERT_GT(first_asleep, 50) << "it sleeps only after half a second at rest";
