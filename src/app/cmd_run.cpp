@@ -53,7 +53,7 @@ nlohmann::json level_choice_json(const sim::LevelChoice& choice)
         } else {
             j["frame_ms"] = t.frame_ms;
             j["step_ms"] = t.step_ms;
-            j["preconditioner"] = sim::preconditioner_name(t.preconditioner);
+            j["preconditioner"] = std::string(io::preconditioner_name(t.preconditioner));
         }
         trials.push_back(j);
     }

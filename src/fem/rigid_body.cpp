@@ -1,6 +1,7 @@
 #include "fem/rigid_body.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 #include <stdexcept>
@@ -62,8 +63,13 @@ RigidBody::State RigidBody::state(const std::vector<Eigen::Vector3d>& x, const s
     Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
     d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
     s.rotation = svd.matrixU() * d * svd.matrixV().transpose();
-    // A body of collinear nodes has a singular inertia: no spin about that line.
-    s.angular_velocity = world_inertia(s.rotation).completeOrthogonalDecomposition().solve(momentum);
+    // A body of collinear nodes has a singular inertia: no spin about that line (the symmetric
+    // pseudo-inverse).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> inertia(world_inertia(s.rotation));
+    Eigen::Vector3d inverse = inertia.eigenvalues();
+    const double tiny = 1e-12 * inverse.cwiseAbs().maxCoeff();
+    for (int i = 0; i < 3; ++i) inverse[i] = inverse[i] > tiny ? 1.0 / inverse[i] : 0.0;
+    s.angular_velocity = inertia.eigenvectors() * inverse.asDiagonal() * (inertia.eigenvectors().transpose() * momentum);
     return s;
 }
 
@@ -72,10 +78,10 @@ double RigidBody::kinetic_energy(const State& s) const
     return 0.5 * m_mass * s.velocity.squaredNorm() + 0.5 * s.angular_velocity.dot(world_inertia(s.rotation) * s.angular_velocity);
 }
 
-void RigidBody::advance(const State& s, double dt, double damping_per_s, const Eigen::Vector3d& gravity,
-                        const std::vector<Eigen::Vector3d>& external, std::span<const NodeContact> contact,
-                        const std::vector<std::int32_t>& body_of_node, std::int32_t self, std::vector<Eigen::Vector3d>& x,
-                        std::vector<Eigen::Vector3d>& v) const
+RigidBody::State RigidBody::advance(const State& s, double dt, double damping_per_s, const Eigen::Vector3d& gravity,
+                                   const std::vector<Eigen::Vector3d>& external, std::span<const NodeContact> contact,
+                                   const std::vector<std::int32_t>& body_of_node, std::int32_t self, std::vector<Eigen::Vector3d>& x,
+                                   std::vector<Eigen::Vector3d>& v) const
 {
     // Implicit Euler on (v, w): (1 + alpha dt) M6 P' + dt^2 sum J^T K J P' = M6 P + dt (F + gyroscopic),
     // J = [I, -[r]x] mapping P to a point's velocity, K the contact stiffness at that point.
@@ -116,6 +122,7 @@ void RigidBody::advance(const State& s, double dt, double damping_per_s, const E
         x[m_nodes[k]] = centre + r;
         v[m_nodes[k]] = velocity + spin.cross(r);
     }
+    return {centre, rotation, velocity, spin};
 }
 
 } // namespace vox::fem

@@ -41,10 +41,10 @@ public:
     [[nodiscard]] State state(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& v) const;
     [[nodiscard]] double kinetic_energy(const State& s) const;
 
-    /// Steps `s` by dt and places the nodes (x, v). `external` holds per node the loads on it
+    /// Steps `s` by dt, places the nodes (x, v) and returns the new state. `external` holds per node the loads on it
     /// (N); `contact` may list nodes of other bodies, which are ignored. `damping_per_s` is the
     /// mass-proportional Rayleigh damping of the scene.
-    void advance(const State& s, double dt, double damping_per_s, const Eigen::Vector3d& gravity,
+    State advance(const State& s, double dt, double damping_per_s, const Eigen::Vector3d& gravity,
                  const std::vector<Eigen::Vector3d>& external, std::span<const NodeContact> contact,
                  const std::vector<std::int32_t>& body_of_node, std::int32_t self, std::vector<Eigen::Vector3d>& x,
                  std::vector<Eigen::Vector3d>& v) const;

@@ -685,6 +685,13 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     return scene;
 }
 
+std::string_view preconditioner_name(PreconditionerChoice p)
+{
+    for (const auto& [name, value] : preconditioners)
+        if (value == p) return name;
+    return "auto";
+}
+
 CutMode default_cut_mode(SolverType type) { return type == SolverType::isxfem ? CutMode::separate : CutMode::remove; }
 
 void use_method(Scene& scene, SolverType type)

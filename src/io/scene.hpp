@@ -116,6 +116,9 @@ struct WetRegion {
 /// The preconditioner of the conjugate-gradient solves.
 enum class PreconditionerChoice { automatic, jacobi, cholesky, multigrid };
 
+/// "auto", "jacobi", "cholesky" or "multigrid", as scene files write it.
+[[nodiscard]] std::string_view preconditioner_name(PreconditionerChoice p);
+
 /// The cutting approach (see DESIGN.md): dynamic branched grid, or tetrahedra with Is-XFEM.
 enum class SolverType { dbg, isxfem };
 

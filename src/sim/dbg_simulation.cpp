@@ -50,6 +50,18 @@ io::PreconditionerChoice resolve(io::PreconditionerChoice choice, std::size_t do
     return coarser_level ? io::PreconditionerChoice::multigrid : io::PreconditionerChoice::jacobi;
 }
 
+/// Per grid element of `level`: 1 when the change `report` created or updated it.
+std::vector<unsigned char> changed_elements(const grid::BranchedGrid& grid, int level, const grid::UpdateReport& report)
+{
+    std::vector<unsigned char> changed(grid.level(level).elements.size(), 0);
+    if (static_cast<std::size_t>(level) < report.levels.size()) {
+        const grid::LevelChange& c = report.levels[static_cast<std::size_t>(level)];
+        for (const auto& [e, from] : c.created) changed[e] = 1;
+        for (std::uint32_t e : c.updated) changed[e] = 1;
+    }
+    return changed;
+}
+
 } // namespace
 
 bool wants_multigrid(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
@@ -128,12 +140,7 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 &&
         old_model->grid_node() == m_model->grid_node()) {
         // Every node kept its number: the factor goes on, patched where elements changed.
-        const grid::Level& lv = grid.level(m_level);
-        std::vector<unsigned char> changed(lv.elements.size(), 0);
-        if (static_cast<std::size_t>(m_level) < report.levels.size()) {
-            for (const auto& [e, from] : report.levels[static_cast<std::size_t>(m_level)].created) changed[e] = 1;
-            for (std::uint32_t e : report.levels[static_cast<std::size_t>(m_level)].updated) changed[e] = 1;
-        }
+        const std::vector<unsigned char> changed = changed_elements(grid, m_level, report);
         std::vector<std::uint32_t> nodes;
         for (const fem::HexElement& el : m_model->elements())
             if (changed[el.grid_element]) nodes.insert(nodes.end(), el.dof_node.begin(), el.dof_node.end());
@@ -148,13 +155,12 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     return t;
 }
 
-void DbgSimulation::find_pieces()
+void DbgSimulation::find_pieces(const std::vector<std::uint32_t>& piece)
 {
     const fem::HexModel& model = *m_model;
     fem::ImplicitSolver& solver = *m_solver;
     m_pieces.clear();
     m_solver_asleep.assign(model.node_count(), 0);
-    const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     const std::size_t count = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
     m_pieces.resize(count);
     std::vector<unsigned char> listed(model.node_count(), 0), plastic(count, 0);
@@ -268,9 +274,10 @@ fem::StepStats DbgSimulation::step_awake()
     fem::StepStats s = solver.step();
     const double damping = m_scene.solver.rayleigh_mass_per_s;
     for (std::size_t k = 0; k < m_bodies.size(); ++k) {
-        m_bodies[k].advance(states[k], m_scene.solver.dt_s, damping, m_scene.gravity_m_s2, solver.external_forces(), solver.contact(),
-                            m_body_of_node, static_cast<std::int32_t>(k), solver.positions(), solver.velocities());
-        s.kinetic_energy_j += m_bodies[k].kinetic_energy(m_bodies[k].state(solver.positions(), solver.velocities()));
+        const fem::RigidBody::State next =
+            m_bodies[k].advance(states[k], m_scene.solver.dt_s, damping, m_scene.gravity_m_s2, solver.external_forces(), solver.contact(),
+                                m_body_of_node, static_cast<std::int32_t>(k), solver.positions(), solver.velocities());
+        s.kinetic_energy_j += m_bodies[k].kinetic_energy(next);
         for (std::uint32_t n : m_bodies[k].nodes())
             s.max_displacement_m = std::max(s.max_displacement_m, (solver.positions()[n] - m_model->rest_positions()[n]).norm());
     }
@@ -286,13 +293,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
     const int level = m_level;
     if (previous && level >= 1) {
         // The elements the change touched; all others keep their matrices.
-        std::vector<unsigned char> changed(grid.level(level).elements.size(), 0);
-        if (static_cast<std::size_t>(level) < report->levels.size()) {
-            const grid::LevelChange& c = report->levels[static_cast<std::size_t>(level)];
-            for (const auto& [e, from] : c.created) changed[e] = 1;
-            for (std::uint32_t e : c.updated) changed[e] = 1;
-        }
-        m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);
+        m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed_elements(grid, level, *report));
     } else {
         m_model = std::make_unique<fem::HexModel>(grid, level);
     }
@@ -316,12 +317,13 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
+    const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     const std::vector<RigidContent> rigid_element = rigid_content(grid, model, m_rigid_material);
     if (scene.object.unheld == io::UnheldPieces::hold)
-        hold_unheld_pieces(first, anchoring_nodes(model, rigid_element, constrained), held_axes);
+        hold_unheld_pieces(first, anchoring_nodes(model, piece, rigid_element, constrained), held_axes);
     std::vector<unsigned char> held(model.node_count(), 0);
     for (std::uint32_t n = 0; n < model.node_count(); ++n) held[n] = held_axes[n] != 0u;
-    const RigidParts rigid = rigid_parts(model, rigid_element, held, scene.object.unheld == io::UnheldPieces::rigid);
+    const RigidParts rigid = rigid_parts(model, piece, rigid_element, held, scene.object.unheld == io::UnheldPieces::rigid);
     m_rigid_elements = rigid.rigid_elements;
     m_bodies.clear();
     m_body_of_node.assign(model.node_count(), -1);
@@ -398,7 +400,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
     }
-    find_pieces();
+    find_pieces(piece);
 }
 
 void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained, std::vector<unsigned>& held_axes)

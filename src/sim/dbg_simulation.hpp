@@ -126,8 +126,8 @@ private:
         bool asleep = false;
         Eigen::AlignedBox3d box_mm; ///< where it sleeps, world mm
     };
-    /// The pieces of the model as built (all awake).
-    void find_pieces();
+    /// The pieces of the model as built (all awake); `piece` per element (cut::element_pieces).
+    void find_pieces(const std::vector<std::uint32_t>& piece);
     /// Every piece that could move sleeps (and no rigid body moves): the step is skipped whole.
     [[nodiscard]] bool all_asleep() const;
     /// Hands the asleep nodes to the solver, unless all_asleep().

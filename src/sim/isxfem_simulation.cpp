@@ -50,12 +50,13 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
         for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
+    const std::vector<std::uint32_t> piece = cut::element_pieces(hex);
     const std::vector<RigidContent> rigid_element = rigid_content(grid, hex, rigid_materials(scene));
     if (scene.object.unheld == io::UnheldPieces::hold) {
         // Pieces no constraint reaches stay where they are: every node of theirs fixed.
         std::vector<unsigned char> constrained(hex.node_count(), 0);
         for (const auto& [n, axes] : m_fixed) constrained[n] = 1;
-        const std::vector<unsigned char> unheld = cut::unheld_elements(hex, anchoring_nodes(hex, rigid_element, constrained), m_held_pieces);
+        const std::vector<unsigned char> unheld = cut::unheld_elements(hex, anchoring_nodes(hex, piece, rigid_element, constrained), m_held_pieces);
         std::vector<unsigned char> held(hex.node_count(), 0);
         for (std::uint32_t e = 0; e < hex.elements().size(); ++e)
             if (unheld[e])
@@ -66,7 +67,7 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     // Rigid material is held in place, with the soft material attached to it.
     std::vector<unsigned char> held(hex.node_count(), 0);
     for (const auto& [n, axes] : m_fixed) held[n] = 1;
-    const RigidParts rigid = rigid_parts(hex, rigid_element, held, false);
+    const RigidParts rigid = rigid_parts(hex, piece, rigid_element, held, false);
     m_rigid_elements = rigid.rigid_elements;
     if (!rigid.bodies.empty())
         throw scene.error("materials", "a piece of rigid material that nothing holds would move as a rigid body, which \"isxfem\" "

@@ -3,7 +3,6 @@
 #include "sim/dbg_method.hpp"
 #include "sim/dbg_simulation.hpp"
 #include "sim/frame_loop.hpp"
-#include "core/stopwatch.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 
@@ -14,17 +13,6 @@
 #include <optional>
 
 namespace vox::sim {
-
-const char* preconditioner_name(io::PreconditionerChoice p)
-{
-    switch (p) {
-    case io::PreconditionerChoice::cholesky: return "cholesky";
-    case io::PreconditionerChoice::multigrid: return "multigrid";
-    case io::PreconditionerChoice::jacobi: return "jacobi";
-    default: return "auto";
-    }
-}
-
 namespace {
 
 /// Levels worth trying: 1 .. max, plus 0 for objects small enough to simulate voxel by voxel.
@@ -85,9 +73,8 @@ FrameTimes time_frames(const io::Scene& scene, Method& method, int from, double 
     for (int k = 0; k < k_warm_up_frames || (!cut && k < k_warm_up_frames + 8); ++k) cut = loop.next().tools.cut.changed() || cut;
     std::vector<double> frame, step;
     for (int k = 0; k < k_timed_frames; ++k) {
-        Stopwatch clock;
         const FrameStats s = loop.next();
-        frame.push_back(clock.lap());
+        frame.push_back(s.frame_ms);
         step.push_back(s.step.step_ms);
         if (frame.back() > give_up_ms) return {frame.back(), step.back()};
     }

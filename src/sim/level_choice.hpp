@@ -41,9 +41,6 @@ struct LevelChoice {
 
 /// `grid` must hold levels up to 6 (or its object's coarsest). Throws the scene's InputError when
 /// max_error is asked of an object nothing holds (its equilibrium is undefined).
-/// "cholesky", "jacobi", "multigrid" or "auto", as scene files write them.
-[[nodiscard]] const char* preconditioner_name(io::PreconditionerChoice p);
-
 /// `labels` are the grid's (trials build methods on copies of the grid).
 [[nodiscard]] LevelChoice choose_level(const io::Scene& scene, const grid::BranchedGrid& grid,
                                        std::shared_ptr<const grid::LabelGrid> labels);

@@ -1,6 +1,5 @@
 #include "sim/rigid_parts.hpp"
 
-#include "cut/pieces.hpp"
 #include "io/scene_object.hpp"
 
 #include <algorithm>
@@ -46,11 +45,10 @@ std::vector<RigidContent> rigid_content(const grid::BranchedGrid& grid, const fe
     return out;
 }
 
-std::vector<unsigned char> anchoring_nodes(const fem::HexModel& model, const std::vector<RigidContent>& rigid,
-                                           std::vector<unsigned char> constrained)
+std::vector<unsigned char> anchoring_nodes(const fem::HexModel& model, const std::vector<std::uint32_t>& piece,
+                                           const std::vector<RigidContent>& rigid, std::vector<unsigned char> constrained)
 {
     if (std::none_of(rigid.begin(), rigid.end(), [](const RigidContent& r) { return r.corners != 0; })) return constrained;
-    const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     std::vector<unsigned char> soft(piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1, 0);
     for (std::uint32_t e = 0; e < model.elements().size(); ++e)
         if (rigid[e].soft || rigid[e].corners == 0) soft[piece[e]] = 1;
@@ -61,14 +59,13 @@ std::vector<unsigned char> anchoring_nodes(const fem::HexModel& model, const std
     return constrained;
 }
 
-RigidParts rigid_parts(const fem::HexModel& model, const std::vector<RigidContent>& rigid, const std::vector<unsigned char>& held,
-                       bool unheld_rigid)
+RigidParts rigid_parts(const fem::HexModel& model, const std::vector<std::uint32_t>& piece, const std::vector<RigidContent>& rigid,
+                       const std::vector<unsigned char>& held, bool unheld_rigid)
 {
     RigidParts out;
     out.anchored.assign(model.node_count(), 0);
     out.rigid_elements = static_cast<std::size_t>(std::count_if(rigid.begin(), rigid.end(), [](const RigidContent& r) { return r.corners != 0; }));
     if (out.rigid_elements == 0 && !unheld_rigid) return out;
-    const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     const std::size_t pieces = piece.empty() ? 0 : *std::max_element(piece.begin(), piece.end()) + 1;
     std::vector<unsigned char> reached(pieces, 0), all_rigid(pieces, 1);
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {

@@ -30,9 +30,10 @@ struct RigidContent {
                                                       const std::vector<unsigned char>& rigid_material);
 
 /// `constrained` (per node) with the held corners of rigid material added in pieces that also
-/// hold soft material: such a piece is held by its rigid material, as by a constraint.
-[[nodiscard]] std::vector<unsigned char> anchoring_nodes(const fem::HexModel& model, const std::vector<RigidContent>& rigid,
-                                                         std::vector<unsigned char> constrained);
+/// hold soft material: such a piece is held by its rigid material, as by a constraint. `piece`:
+/// each element's piece (cut::element_pieces).
+[[nodiscard]] std::vector<unsigned char> anchoring_nodes(const fem::HexModel& model, const std::vector<std::uint32_t>& piece,
+                                                         const std::vector<RigidContent>& rigid, std::vector<unsigned char> constrained);
 
 struct RigidParts {
     std::vector<unsigned char> anchored;            ///< per node: held in place by rigid material
@@ -43,7 +44,7 @@ struct RigidParts {
 /// `held`: per node, held by a constraint or by "unheld_pieces": "hold" (a piece with such a
 /// node never moves as a body). `unheld_rigid`: every piece with no held node moves as a body,
 /// whatever its material ("unheld_pieces": "rigid").
-[[nodiscard]] RigidParts rigid_parts(const fem::HexModel& model, const std::vector<RigidContent>& rigid,
-                                     const std::vector<unsigned char>& held, bool unheld_rigid);
+[[nodiscard]] RigidParts rigid_parts(const fem::HexModel& model, const std::vector<std::uint32_t>& piece,
+                                     const std::vector<RigidContent>& rigid, const std::vector<unsigned char>& held, bool unheld_rigid);
 
 } // namespace vox::sim
