@@ -19,6 +19,7 @@
 #include "sim/device_run.hpp"
 #include "sim/journal.hpp"
 #include "sim/frame_loop.hpp"
+#include "sim/level_governor.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/run_record.hpp"
 
@@ -132,7 +133,8 @@ void add_run_command(CLI::App& app)
         const int frames = args->frames.value_or(duration > 0 ? static_cast<int>(std::ceil(duration / dt)) : 100);
         const std::filesystem::path out = args->out.empty() ? scene.output.dir : std::filesystem::path(args->out);
         // A resumed run starts where its journal's last stroke ended, the object cut as it was then.
-        const sim::JournalHeader header = sim::journal_header(args->scene, method);
+        sim::JournalHeader header = sim::journal_header(args->scene, method);
+        header.any_level = scene.object.auto_levels; // the run may have moved between levels
         int first_frame = 1;
         if (!args->resume.empty()) {
             const sim::Journal journal = sim::read_journal(args->resume, header);
@@ -161,10 +163,21 @@ void add_run_command(CLI::App& app)
         std::vector<sim::ForceSample> tool_forces; // without a device: the first placed tool's, per frame
         sim::FrameLoop loop(scene, method, tools, device.get());
         loop.go_on_from(first_frame - 1);
+        // A device run keeps the budget as it goes: a level coarser while frames miss it, and back.
+        if (device && opened.choice)
+            if (auto governor = sim::level_governor(scene, *opened.choice, method.coarsest_level())) {
+                log::info("levels {} to {}: the run moves coarser when its frames miss {:g} ms for a second, and back when there is room{}",
+                          governor->settings().finest, governor->settings().coarsest, governor->settings().budget_ms,
+                          device->replaying() ? " (a replay follows the recording's levels)" : "");
+                loop.govern_levels(std::move(*governor));
+            }
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
         for (int f = first_frame; f <= frames; ++f) {
             const sim::FrameStats frame = loop.next();
             record.add(frame, method);
+            if (journal && frame.level_change) // a journal holds one level's motion: a new one, with the cuts so far
+                journal = std::make_unique<sim::JournalWriter>(sim::journal_path(out), sim::journal_header(args->scene, method), method,
+                                                               frame.frame, frame.t_s);
             if (journal && stroke_ends.after_frame(frame)) journal->end_stroke(method, frame.frame, frame.t_s);
             if (!device)
                 for (const sim::ToolFrame& t : frame.tools.tools)

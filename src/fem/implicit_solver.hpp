@@ -86,6 +86,8 @@ public:
     void fix(std::uint32_t node, unsigned axes);
     /// Whether fix() holds `node` on all three axes.
     [[nodiscard]] bool held(std::uint32_t node) const { return m_held[3 * node] && m_held[3 * node + 1] && m_held[3 * node + 2]; }
+    /// Axis `axis` (0..2) of `node` is held by fix().
+    [[nodiscard]] bool held_axis(std::uint32_t node, int axis) const { return m_held[3 * node + static_cast<std::size_t>(axis)] != 0; }
     /// Nodes at rest held until woken (per node, 1: asleep), on top of those fix() holds; their
     /// velocities are zeroed. An empty vector wakes every node.
     void set_asleep(const std::vector<unsigned char>& asleep);

@@ -14,7 +14,16 @@
 namespace vox::haptics {
 namespace {
 
-constexpr const char* k_header = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n";
+constexpr const char* k_header_v1 = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n";
+constexpr const char* k_header = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change";
+
+/// A reason as one CSV field: no commas, no line breaks.
+std::string field_text(std::string text)
+{
+    for (char& c : text)
+        if (c == ',' || c == '\n' || c == '\r') c = ';';
+    return text;
+}
 
 } // namespace
 
@@ -26,9 +35,10 @@ void write_recording(const std::filesystem::path& path, const std::vector<Record
         std::fprintf(f, "%s\n", k_header);
         for (const RecordedTick& t : ticks) {
             const auto& s = t.state;
-            std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%u,%.17g,%.17g,%.17g\n", s.t_s, s.position_mm.x(),
+            std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%u,%.17g,%.17g,%.17g,%d,%s\n", s.t_s, s.position_mm.x(),
                          s.position_mm.y(), s.position_mm.z(), s.orientation.w(), s.orientation.x(), s.orientation.y(),
-                         s.orientation.z(), static_cast<unsigned>(s.buttons), t.force_n.x(), t.force_n.y(), t.force_n.z());
+                         s.orientation.z(), static_cast<unsigned>(s.buttons), t.force_n.x(), t.force_n.y(), t.force_n.z(), t.level,
+                         field_text(t.level_change).c_str());
         }
         if (std::fclose(f) != 0) throw file_error(tmp.string(), "could not be written completely");
     });
@@ -42,15 +52,19 @@ std::vector<RecordedTick> read_recording(const std::filesystem::path& path)
     std::string line;
     if (!std::getline(in, line)) throw file_error(name, "is empty; a recording starts with the line " + std::string(k_header));
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line != k_header) throw file_error(name, "line 1: expected the header " + std::string(k_header));
+    if (line != k_header && line != k_header_v1) throw file_error(name, "line 1: expected the header " + std::string(k_header));
+    const bool levels = line == k_header; // older recordings have no level columns
+    const std::size_t expected = levels ? 14 : 12;
     std::vector<RecordedTick> ticks;
     for (std::size_t row = 2; std::getline(in, line); ++row) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const std::size_t fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
-        if (fields != 12) throw file_error(name, "line " + std::to_string(row) + ": expected 12 comma-separated fields, got " + std::to_string(fields));
-        double v[12];
+        if (fields != expected)
+            throw file_error(name, "line " + std::to_string(row) + ": expected " + std::to_string(expected) + " comma-separated fields, got " +
+                                       std::to_string(fields));
+        double v[13];
         std::size_t count = 0, start = 0;
-        while (count < 12) {
+        while (count < (levels ? 13u : 12u)) {
             const std::size_t comma = line.find(',', start);
             const std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
             char* end = nullptr;
@@ -73,6 +87,12 @@ std::vector<RecordedTick> read_recording(const std::filesystem::path& path)
             throw file_error(name, "line " + std::to_string(row) + ": buttons must be a whole number bit mask");
         t.state.buttons = static_cast<std::uint32_t>(v[8]);
         t.force_n = {v[9], v[10], v[11]};
+        if (levels) {
+            if (v[12] < 0 || v[12] != std::floor(v[12]) || v[12] > 64)
+                throw file_error(name, "line " + std::to_string(row) + ": level must be a whole number from 0 to 64");
+            t.level = static_cast<int>(v[12]);
+            t.level_change = line.substr(line.rfind(',') + 1);
+        }
         if (!ticks.empty() && t.state.t_s < ticks.back().state.t_s)
             throw file_error(name, "line " + std::to_string(row) + ": time goes backwards");
         ticks.push_back(t);

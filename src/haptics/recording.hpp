@@ -6,6 +6,7 @@
 #include "haptics/device.hpp"
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace vox::haptics {
@@ -13,12 +14,15 @@ namespace vox::haptics {
 struct RecordedTick {
     DeviceState state;
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+    int level = 0;            ///< the level the simulation ran at (0: not recorded, as in older recordings)
+    std::string level_change; ///< on the first tick after the simulation moved to `level`: why (no commas)
 };
 
 /// Writes atomically (a temporary file renamed into place).
 void write_recording(const std::filesystem::path& path, const std::vector<RecordedTick>& ticks);
 /// Throws InputError naming the file and line for anything malformed (header, field count,
-/// non-numbers, non-finite values, time going backwards).
+/// non-numbers, non-finite values, time going backwards, a level that is not a whole number).
+/// Recordings without the level columns (written before them) read with level 0.
 [[nodiscard]] std::vector<RecordedTick> read_recording(const std::filesystem::path& path);
 
 /// Plays a recording back: the state of the last tick at or before the asked time.
@@ -28,6 +32,7 @@ public:
     [[nodiscard]] std::string name() const override { return "replay"; }
     [[nodiscard]] const DeviceLimits& limits() const override { return m_limits; }
     bool read(double t_s, DeviceState& state) noexcept override;
+    [[nodiscard]] const std::vector<RecordedTick>& ticks() const { return m_ticks; }
 
 private:
     std::vector<RecordedTick> m_ticks;

@@ -15,6 +15,8 @@ namespace {
 
 struct DbgCheckpoint final : Checkpoint {
     std::size_t cuts = 0;
+    int level = 1; ///< a run may have moved since (move_to_level): restoring goes back to it
+    io::PreconditionerChoice preconditioner = io::PreconditionerChoice::automatic;
     std::vector<Eigen::Vector3d> positions, velocities;
     std::vector<double> water;
     std::vector<Eigen::Matrix3d> plastic;
@@ -276,6 +278,18 @@ std::unique_ptr<Method> DbgMethod::at_level(int level) const
     return out;
 }
 
+bool DbgMethod::move_to_level(int level, io::PreconditionerChoice preconditioner)
+{
+    if (level == m_level && preconditioner == m_scene.solver.preconditioner) return true;
+    if (level < 1 || m_level < 1 || level > m_grid->max_level()) return false;
+    auto moved = std::make_unique<DbgSimulation>(*m_sim, level, preconditioner); // throws with m_sim untouched
+    m_sim = std::move(moved);
+    m_level = level;
+    m_scene.solver.preconditioner = preconditioner;
+    std::fill(m_fresh.begin(), m_fresh.end(), false); // contacts go onto the new level's nodes
+    return true;
+}
+
 std::size_t DbgMethod::cut_count() const { return m_cuts.size(); }
 
 nlohmann::json DbgMethod::cuts_since(std::size_t from) const
@@ -377,6 +391,8 @@ std::unique_ptr<Checkpoint> DbgMethod::checkpoint() const
     auto c = std::make_unique<DbgCheckpoint>();
     const fem::ImplicitSolver& s = m_sim->solver();
     c->cuts = m_cuts.size();
+    c->level = m_level;
+    c->preconditioner = m_scene.solver.preconditioner;
     c->positions = s.positions();
     c->velocities = s.velocities();
     for (std::uint32_t e = 0; e < m_sim->model().elements().size(); ++e) {
@@ -393,6 +409,8 @@ void DbgMethod::restore(const Checkpoint& checkpoint)
     // The grid as it was after the first c.cuts cuts: rebuilt from the voxels and the cuts
     // replayed, the same model node for node.
     m_sim.reset();
+    m_level = c.level;
+    m_scene.solver.preconditioner = c.preconditioner;
     m_grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(m_scene, *m_labels, m_grid_levels));
     m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
     m_cuts.resize(std::min(m_cuts.size(), c.cuts));

@@ -60,6 +60,8 @@ public:
     void add_summary_figures(nlohmann::json& summary) const override;
 
     [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
+    bool move_to_level(int level, io::PreconditionerChoice preconditioner) override;
+    [[nodiscard]] int coarsest_level() const override { return m_grid->max_level(); }
     [[nodiscard]] std::size_t cut_count() const override;
     [[nodiscard]] nlohmann::json cuts_since(std::size_t from) const override;
     void replay_cuts(const nlohmann::json& cuts) override;

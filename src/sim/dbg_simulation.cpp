@@ -115,10 +115,35 @@ std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fe
 DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
     : m_scene(scene), m_grid(&grid), m_rigid_material(rigid_materials(scene)), m_level(level)
 {
-    build(true);
+    build(Build::first);
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
     smooth_scene_surface(scene, grid, *m_surface);
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
+}
+
+DbgSimulation::DbgSimulation(DbgSimulation& from, int level, io::PreconditionerChoice preconditioner)
+    : m_scene(from.m_scene), m_grid(from.m_grid), m_rigid_material(from.m_rigid_material), m_held_voxels(from.m_held_voxels),
+      m_held_pieces(from.m_held_pieces), m_level(level)
+{
+    if (level < 1 || from.m_level < 1) throw std::invalid_argument("DbgSimulation: levels change between 1 and the grid's coarsest");
+    m_scene.solver.preconditioner = preconditioner;
+    build(Build::level_change);
+    cut::transfer_between_levels(*m_grid, *from.m_model, *from.m_solver, *m_model, *m_solver);
+    // What is held stays at rest (constraints, rigid anchoring, held pieces: the interpolation
+    // would move a held node by the old level's field beside it); a rigid body's nodes are where
+    // its body put them.
+    fem::ImplicitSolver& solver = *m_solver;
+    for (std::uint32_t n = 0; n < m_model->node_count(); ++n) {
+        if (m_body_of_node[n] >= 0) continue;
+        for (int a = 0; a < 3; ++a)
+            if (solver.held_axis(n, a)) {
+                solver.positions()[n][a] = m_model->rest_positions()[n][a];
+                solver.velocities()[n][a] = 0.0;
+            }
+    }
+    m_surface = std::move(from.m_surface);
+    m_surface->reembed(*m_grid, level);
+    m_model_surface = std::make_unique<cut::ModelSurface>(*m_grid, *m_model, *m_surface);
 }
 
 CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
@@ -135,7 +160,7 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
     const io::PreconditionerChoice old_choice = m_choice;
-    build(false, old_model.get(), &report, old_solver.get());
+    build(Build::cut, old_model.get(), &report, old_solver.get());
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
     if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 &&
         old_model->grid_node() == m_model->grid_node()) {
@@ -285,7 +310,7 @@ fem::StepStats DbgSimulation::step_awake()
     return s;
 }
 
-void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid::UpdateReport* report,
+void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid::UpdateReport* report,
                           const fem::ImplicitSolver* previous_solver)
 {
     const io::Scene& scene = m_scene;
@@ -313,14 +338,14 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
             constrained[n] = 1;
             caught = true;
         }
-        if (!caught && first)
+        if (!caught && kind != Build::cut)
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
     const std::vector<std::uint32_t> piece = cut::element_pieces(model);
     const std::vector<RigidContent> rigid_element = rigid_content(grid, model, m_rigid_material);
     if (scene.object.unheld == io::UnheldPieces::hold)
-        hold_unheld_pieces(first, anchoring_nodes(model, piece, rigid_element, constrained), held_axes);
+        hold_unheld_pieces(kind == Build::first, anchoring_nodes(model, piece, rigid_element, constrained), held_axes);
     std::vector<unsigned char> held(model.node_count(), 0);
     for (std::uint32_t n = 0; n < model.node_count(); ++n) held[n] = held_axes[n] != 0u;
     const RigidParts rigid = rigid_parts(model, piece, rigid_element, held, scene.object.unheld == io::UnheldPieces::rigid);
@@ -378,7 +403,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
         behaviour.push_back(b);
     }
     solver.set_materials(std::move(behaviour));
-    for (std::size_t k = 0; first && k < scene.wet_regions.size(); ++k) {
+    for (std::size_t k = 0; kind == Build::first && k < scene.wet_regions.size(); ++k) {
         const io::WetRegion& w = scene.wet_regions[k];
         bool caught = false;
         for (std::uint32_t e = 0; e < model.elements().size(); ++e)
@@ -395,7 +420,7 @@ void DbgSimulation::build(bool first, const fem::HexModel* previous, const grid:
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
         const io::Load& load = scene.loads[k];
         const std::vector<std::uint32_t> caught = box_nodes(load.box_min_mm, load.box_max_mm);
-        if (caught.empty() && !first) continue; // the cut took the loaded material
+        if (caught.empty() && kind == Build::cut) continue; // the cut took the loaded material
         if (caught.empty())
             throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
         for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());

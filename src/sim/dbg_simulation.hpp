@@ -63,6 +63,14 @@ public:
     /// Throws the scene's InputError when a constraint or load box catches no node at `level`.
     /// Keeps a reference to `grid`.
     DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
+    /// The simulation `from` at another level of the same grid, with `preconditioner` (the scene's
+    /// choice, "auto" resolved there), carrying everything over: positions, velocities, water and
+    /// plastic strain (cut/state_transfer.hpp), the surface with its cuts and smoothing
+    /// (re-embedded), and the pieces "unheld_pieces": "hold" holds. `from` gives its surface up and
+    /// is left only to be destroyed. Throws the scene's InputError when a constraint or load box
+    /// catches no node at `level`, or the multigrid has no coarser level there; `from` is then
+    /// unchanged.
+    DbgSimulation(DbgSimulation& from, int level, io::PreconditionerChoice preconditioner);
 
     [[nodiscard]] const fem::HexModel& model() const { return *m_model; }
     [[nodiscard]] fem::ImplicitSolver& solver() { return *m_solver; }
@@ -92,11 +100,14 @@ public:
                          std::span<const std::pair<grid::Coord, int>> faces);
 
 private:
-    /// Model, solver, preconditioner, materials, constraints and loads at m_level; `first`: also
-    /// the wet regions, and boxes that catch no node are errors (after a cut they may catch none).
-    /// After a cut, `previous` and `report` let unchanged elements keep their matrices, and
-    /// `previous_solver` lends its matrix pattern when the elements sit on the same nodes.
-    void build(bool first, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr,
+    /// What a build starts from: the scene (the wet regions are applied and the pieces to hold
+    /// found), another level's simulation, or the same level before a cut. Boxes that catch no node
+    /// are errors except after a cut (it may have taken their material).
+    enum class Build { first, level_change, cut };
+    /// Model, solver, preconditioner, materials, constraints and loads at m_level. After a cut,
+    /// `previous` and `report` let unchanged elements keep their matrices, and `previous_solver`
+    /// lends its matrix pattern when the elements sit on the same nodes.
+    void build(Build kind, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr,
                const fem::ImplicitSolver* previous_solver = nullptr);
 
     /// "unheld_pieces": "hold": fixes every node of the pieces no constraint reaches (found when

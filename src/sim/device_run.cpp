@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 namespace vox::sim {
 namespace {
@@ -34,7 +35,9 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const Devi
         m_tool = static_cast<std::size_t>(found - scene.tools.begin());
     }
     if (options.replay) {
-        m_device = std::make_unique<haptics::ReplayDevice>(haptics::read_recording(*options.replay));
+        auto replay = std::make_unique<haptics::ReplayDevice>(haptics::read_recording(*options.replay));
+        m_replay = replay.get();
+        m_device = std::move(replay);
     } else {
         std::vector<haptics::KeyFrame> frames;
         for (const io::ScriptEntry& e : scene.script)
@@ -68,7 +71,7 @@ void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, doub
         haptics::DeviceState first;
         m_device->read(t0_s, first);
         m_coupled->update(first, m_snapshot, k_tick_s);
-        m_recording.push_back({first, Eigen::Vector3d::Zero()});
+        m_recording.push_back({first, Eigen::Vector3d::Zero(), method.level(), {}});
         m_started = true;
     }
     const io::ToolSpec& spec = m_scene.tools[m_tool];
@@ -83,10 +86,37 @@ void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, doub
     for (int i = 1; i <= ticks; ++i) {
         const double t = t0_s + i * dt_s / ticks;
         const Eigen::Vector3d f = m_loop->tick(t);
-        m_recording.push_back({m_loop->state(), f});
+        m_recording.push_back({m_loop->state(), f, method.level(), std::exchange(m_level_change, {})});
         m_forces.push_back({t, m_coupled->proxy().position, f});
     }
     tools.drive(m_tool, m_coupled->proxy().position, m_coupled->proxy().orientation);
+}
+
+namespace {
+
+/// The first recorded tick after `t0_s`, or null.
+const haptics::RecordedTick* tick_after(const haptics::ReplayDevice* replay, double t0_s)
+{
+    if (!replay) return nullptr;
+    const auto& ticks = replay->ticks();
+    const auto it = std::upper_bound(ticks.begin(), ticks.end(), t0_s + 1e-9,
+                                     [](double t, const haptics::RecordedTick& tick) { return t < tick.state.t_s; });
+    return it == ticks.end() ? nullptr : &*it;
+}
+
+} // namespace
+
+std::optional<int> DeviceRun::recorded_level(double t0_s) const
+{
+    const haptics::RecordedTick* tick = tick_after(m_replay, t0_s);
+    if (!tick || tick->level <= 0) return std::nullopt;
+    return tick->level;
+}
+
+std::string DeviceRun::recorded_reason(double t0_s) const
+{
+    const haptics::RecordedTick* tick = tick_after(m_replay, t0_s);
+    return tick && !tick->level_change.empty() ? tick->level_change : "the recording's level";
 }
 
 void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title)

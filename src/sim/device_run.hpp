@@ -5,6 +5,7 @@
 // near it, published once per frame; the proxy's pose is where the simulation puts the tool.
 // Every tick can be recorded (docs/recording-format.md) and replayed bit for bit.
 
+#include "sim/level_governor.hpp"
 #include "sim/method.hpp"
 #include "sim/tool_policy.hpp"
 #include "contact/surface_points.hpp"
@@ -50,10 +51,21 @@ public:
     [[nodiscard]] const std::vector<haptics::RecordedTick>& recording() const { return m_recording; }
     [[nodiscard]] std::string device_name() const { return m_device->name(); }
 
+    /// A recording is being replayed: the run follows its levels, not a governor.
+    [[nodiscard]] bool replaying() const { return m_replay != nullptr; }
+    /// Replaying: the level the recording's first tick after `t0_s` ran at, and the reason it
+    /// gave for being there; nothing without a replay or for a recording without levels.
+    [[nodiscard]] std::optional<int> recorded_level(double t0_s) const;
+    [[nodiscard]] std::string recorded_reason(double t0_s) const;
+    /// The simulation moved to another level: the next tick recorded says so, and why.
+    void level_changed(const LevelChange& change) { m_level_change = change.reason; }
+
 private:
     const io::Scene& m_scene;
     std::size_t m_tool = 0;
     std::unique_ptr<haptics::Device> m_device;
+    const haptics::ReplayDevice* m_replay = nullptr; ///< m_device, when it replays a recording
+    std::string m_level_change;                       ///< for the next tick recorded
     std::unique_ptr<haptics::CoupledTool> m_coupled;
     contact::SurfacePoints m_snapshot;
     std::unique_ptr<haptics::HapticLoop> m_loop;

@@ -1,6 +1,7 @@
 #include "sim/frame_loop.hpp"
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/stopwatch.hpp"
 #include "sim/device_run.hpp"
 
@@ -20,6 +21,15 @@ FrameStats FrameLoop::next()
     FrameStats out;
     out.frame = ++m_frame;
     out.t_s = m_frame * dt;
+    // A replay goes where the recording went; a live run where the governor decided.
+    if (const std::optional<int> recorded = m_device ? m_device->recorded_level((m_frame - 1) * dt) : std::nullopt;
+        recorded && *recorded != m_method->level()) {
+        out.level_change = move_to_level(*recorded, "as recorded: " + m_device->recorded_reason((m_frame - 1) * dt));
+    } else if (m_pending) {
+        out.level_change = move_to_level(m_pending->to, m_pending->reason);
+    }
+    m_pending.reset();
+    out.level = m_method->level();
     if (m_device) m_device->frame(*m_method, m_tools, (m_frame - 1) * dt, dt);
     out.tools = m_tools.frame(*m_method, out.t_s, dt);
     if (!out.tools.hold_object) out.step = m_method->step(); // held: a two-phase cut is being marked
@@ -28,7 +38,33 @@ FrameStats FrameLoop::next()
         throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
                          " (non-finite energy); reduce solver.dt_s or check the materials");
     out.frame_ms = clock.lap();
+    if (m_governor && !(m_device && m_device->replaying())) m_pending = m_governor->after_frame(out.level, out.frame_ms);
     return out;
+}
+
+std::optional<LevelChange> FrameLoop::move_to_level(int level, std::string reason)
+{
+    const int from = m_method->level();
+    if (level == from) return std::nullopt;
+    Stopwatch clock;
+    const io::PreconditionerChoice preconditioner = m_governor ? m_governor->preconditioner(level) : m_scene.solver.preconditioner;
+    try {
+        if (!m_method->move_to_level(level, preconditioner)) {
+            log::warn("level {}: the {} method cannot move there with its state", level, m_method->name());
+            if (m_governor) m_governor->refused(level);
+            return std::nullopt;
+        }
+    } catch (const InputError& e) {
+        log::warn("level {}: not moved there: {}", level, e.what());
+        if (m_governor) m_governor->refused(level);
+        return std::nullopt;
+    }
+    LevelChange change{from, level, std::move(reason), clock.lap()};
+    if (m_governor) m_governor->moved(from, level);
+    if (m_device) m_device->level_changed(change);
+    log::info("frame {}: level {} -> {} ({} elements, {:.0f} ms to move): {}", m_frame, from, level, m_method->element_count(), change.ms,
+              change.reason);
+    return change;
 }
 
 } // namespace vox::sim

@@ -2,11 +2,17 @@
 // The one frame loop: a device's haptic ticks (when a device drives a tool), the tools (contact,
 // cuts, wetting: sim/tool_policy.hpp), then the method's step, unless a two-phase tool holds the
 // object while it marks its cut. `voxsculpt run`, the viewer, device runs, every bench and the
-// tests step through it, so they simulate the same thing.
+// tests step through it, so they simulate the same thing. With a level governor (view and device
+// runs of a budget scene: sim/level_governor.hpp) a frame may begin by moving the method to
+// another level; a replayed recording moves it where the recording says instead.
 
 #include "core/error.hpp"
+#include "sim/level_governor.hpp"
 #include "sim/method.hpp"
 #include "sim/tool_policy.hpp"
+
+#include <optional>
+#include <string>
 
 namespace vox::sim {
 
@@ -16,6 +22,8 @@ class DeviceRun;
 struct FrameStats {
     int frame = 0;   ///< from 1
     double t_s = 0.0; ///< simulated time at its end
+    int level = 0;    ///< the level it was simulated at
+    std::optional<LevelChange> level_change; ///< the frame began by moving to `level` (its time is in frame_ms)
     ToolsFrame tools;
     StepFigures step; ///< zero (and converged) while the object is held
     double frame_ms = 0.0; ///< the whole frame, wall clock: device ticks, tools, cuts and step
@@ -44,12 +52,22 @@ public:
     void set_method(Method& method) { m_method = &method; }
     [[nodiscard]] Method& method() { return *m_method; }
 
+    /// From now on the governor moves the method between levels (its decisions taken at the end
+    /// of a frame, carried out at the start of the next).
+    void govern_levels(LevelGovernor governor) { m_governor = std::move(governor); }
+    [[nodiscard]] LevelGovernor* governor() { return m_governor ? &*m_governor : nullptr; }
+    /// Moves the method to `level` now (the viewer's level keys), carrying its state: the change,
+    /// or nothing when the method cannot (the reason is logged). Throws nothing.
+    std::optional<LevelChange> move_to_level(int level, std::string reason);
+
 private:
     const io::Scene& m_scene;
     Method* m_method;
     ToolPolicy& m_tools;
     DeviceRun* m_device;
     int m_frame = 0;
+    std::optional<LevelGovernor> m_governor;
+    std::optional<LevelChange> m_pending; ///< decided at the end of the last frame
 };
 
 } // namespace vox::sim

@@ -61,7 +61,7 @@ JournalHeader check_header(const nlohmann::json& j, const std::string& name, con
     if (h.scene_hash != expected.scene_hash)
         throw file_error(name, "written for another scene: " + h.scene + " as it was then, not " + expected.scene +
                                    " as it is now (their contents differ)");
-    if (h.method != expected.method || h.level != expected.level)
+    if (h.method != expected.method || (h.level != expected.level && !expected.any_level))
         throw file_error(name, "written for the " + h.method + " method at level " + std::to_string(h.level) +
                                    "; this simulates " + expected.method + " at level " + std::to_string(expected.level) +
                                    " (give the same --solver and level)");
@@ -174,6 +174,18 @@ void resume(Method& method, const Journal& journal)
 {
     const std::string name = journal.path.string();
     if (method.cut_count() != 0) throw file_error(name, "the object already has cuts: a journal is resumed on an uncut object");
+    if (journal.header.level != method.level()) { // written after the run moved between levels
+        bool moved = false;
+        try {
+            moved = method.move_to_level(journal.header.level, io::PreconditionerChoice::automatic);
+        } catch (const InputError& e) {
+            throw file_error(name, "written at level " + std::to_string(journal.header.level) + ": " + e.what());
+        }
+        if (!moved)
+            throw file_error(name, "written at level " + std::to_string(journal.header.level) + ", which the " + method.name() +
+                                       " method cannot move to");
+        log::info("{}: written at level {}: the run resumes there", name, journal.header.level);
+    }
     try {
         method.replay_cuts(journal.cuts());
     } catch (const InputError& e) {

@@ -35,6 +35,9 @@ struct JournalHeader {
     std::string scene_hash;   ///< FNV-1a (64 bits, hex) of the scene file's bytes
     std::string method;       ///< Method::name()
     int level = 0;            ///< Method::level()
+    /// Reading: a journal of another level is accepted (a run that moves between levels,
+    /// "levels": "auto"), and resume() moves the method to it.
+    bool any_level = false;
 };
 
 /// The header for `method` simulating the scene file `scene` with this program. Throws InputError
@@ -70,8 +73,8 @@ struct Journal {
 /// bytes differ), another method or level than `expected`.
 [[nodiscard]] Journal read_journal(const std::filesystem::path& path, const JournalHeader& expected);
 
-/// Makes the journal's cuts on `method` (which has none yet) and puts back how it moved: the object
-/// as the journal's last stroke left it. Throws InputError "JOURNAL: problem" for cuts that do not
+/// Makes the journal's cuts on `method` (which has none yet), at the journal's level, and puts
+/// back how it moved: the object as the journal's last stroke left it. Throws InputError "JOURNAL: problem" for cuts that do not
 /// fit the object; a state that does not fit is said and left out (the object starts at rest).
 void resume(Method& method, const Journal& journal);
 

@@ -147,6 +147,15 @@ public:
     /// The same object at another level, from rest: the branched grid keeps its cuts (replayed on
     /// the new level's grid); Is-XFEM starts uncut (its cuts live in the tetrahedra of one level).
     [[nodiscard]] virtual std::unique_ptr<Method> at_level(int level) const = 0;
+    /// Moves this simulation to `level` carrying its state on: positions, velocities, water,
+    /// plastic strain, cuts and surface (a run whose frames miss their budget moves coarser:
+    /// sim/level_governor.hpp). `preconditioner` as the scene's key says. False where the method
+    /// cannot (Is-XFEM: its cracks live in one level's tetrahedra) or has no such level. Throws
+    /// InputError when the object cannot be simulated there (a constraint box catching no node),
+    /// changing nothing.
+    virtual bool move_to_level(int /*level*/, io::PreconditionerChoice /*preconditioner*/) { return false; }
+    /// The coarsest level move_to_level() reaches.
+    [[nodiscard]] virtual int coarsest_level() const { return level(); }
 
     // --- The cuts as a record (session journals: sim/journal.hpp). ---
 

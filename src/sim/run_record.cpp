@@ -41,6 +41,7 @@ RunRecord::RunRecord(const std::string& scene_path, const Method& method, double
                   {"dofs", method.dof_count()},
                   {"dt_s", dt_s},
                   {"linear_solver", method.linear_solver()},
+                  {"level_changes", nlohmann::json::array()},
                   {"frames", nlohmann::json::array()}};
 }
 
@@ -61,7 +62,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_last = s;
     nlohmann::json frame{{"frame", f.frame},
                          {"t_s", f.t_s},
-                         {"level", method.level()},
+                         {"level", f.level},
                          {"frame_ms", f.frame_ms},
                          {"step_ms", s.step_ms},
                          {"assembly_ms", s.assembly_ms},
@@ -88,6 +89,12 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"dofs", method.dof_count()},
                          {"object_held", t.hold_object},
                          {"tools", tool_frames_json(t.tools)}};
+    if (f.level_change) {
+        const LevelChange& c = *f.level_change;
+        const nlohmann::json change{{"frame", f.frame}, {"t_s", f.t_s}, {"from", c.from}, {"to", c.to}, {"reason", c.reason}, {"ms", c.ms}};
+        frame["level_change"] = change;
+        m_document["level_changes"].push_back(change);
+    }
     method.add_frame_figures(frame);
     m_document["frames"].push_back(std::move(frame));
 }
@@ -101,6 +108,8 @@ void RunRecord::finish(const Method& method)
                            {"frame_ms_median", quantile(m_frame_ms, 0.5)},
                            {"frame_ms_p95", quantile(m_frame_ms, 0.95)},
                            {"frame_ms_max", quantile(m_frame_ms, 1.0)},
+                           {"level_changes", m_document["level_changes"].size()},
+                           {"final_level", method.level()},
                            {"converged_frames", m_converged},
                            {"energy_projected_frames", m_projected},
                            {"removed_voxels", m_removed},

@@ -203,6 +203,13 @@ void EmbeddedSurface::embed(const grid::BranchedGrid& grid, SurfaceVertex& v) co
     v.local = (v.rest - grid::BranchedGrid::cell_corner_index(cell, m_level, 0)) / static_cast<double>(1 << m_level);
 }
 
+void EmbeddedSurface::reembed(const grid::BranchedGrid& grid, int level)
+{
+    m_level = level;
+    for (SurfaceVertex& v : m_vertices)
+        if (v.users) embed(grid, v);
+}
+
 void EmbeddedSurface::release_vertex(std::uint32_t id)
 {
     SurfaceVertex& v = m_vertices[id];

@@ -46,6 +46,9 @@ public:
                 std::span<const std::pair<grid::Coord, int>> faces, const grid::UpdateReport& report);
 
     [[nodiscard]] int level() const { return m_level; }
+    /// The same surface embedded at another level (1 .. grid.max_level()) of the same grid: a
+    /// simulation moving to another level keeps its surface, cuts and smoothing included.
+    void reembed(const grid::BranchedGrid& grid, int level);
     [[nodiscard]] std::size_t vertex_count() const { return m_vertex_count; }
     [[nodiscard]] std::size_t triangle_count() const { return m_triangle_count; }
     /// True when the index-to-world map mirrors: the triangle slots' corner order then gives

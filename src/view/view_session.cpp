@@ -13,6 +13,7 @@
 #include "sim/dbg_method.hpp"
 #include "sim/isxfem_method.hpp"
 #include "sim/journal.hpp"
+#include "sim/method_factory.hpp"
 #include "view/scene_pictures.hpp"
 #include "view/view_channels.hpp"
 #include "view/view_simulation.hpp"
@@ -45,10 +46,23 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     const auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     const int level = std::max(scene.object.levels, 1);
     // The branched grid has two levels above the scene's, for the coarser-level key.
-    const int grid_levels = std::min(6, level + 2);
+    int grid_levels = std::min(6, level + 2);
     std::unique_ptr<sim::Method> method;
-    if (scene.solver.type == io::SolverType::isxfem) method = std::make_unique<sim::IsxfemMethod>(scene, labels, level);
-    else method = std::make_unique<sim::DbgMethod>(scene, labels, level, grid_levels);
+    std::optional<sim::LevelGovernor> governor;
+    if (scene.solver.type == io::SolverType::isxfem) {
+        method = std::make_unique<sim::IsxfemMethod>(scene, labels, level);
+    } else if (scene.object.auto_levels) {
+        // The level chosen as `run` chooses it, on the frames the scene's script makes (the
+        // viewer's tools follow the user, but the script says where the work will be).
+        io::Scene scripted = loaded;
+        if (!options.solver.empty()) io::use_method(scripted, scene.solver.type);
+        sim::OpenedMethod opened = sim::open_method(scripted, labels);
+        method = std::move(opened.method);
+        grid_levels = method->coarsest_level();
+        if (opened.choice) governor = sim::level_governor(scene, *opened.choice, grid_levels);
+    } else {
+        method = std::make_unique<sim::DbgMethod>(scene, labels, level, grid_levels);
+    }
     sim::ToolPolicy tools(scene);
 
     // The session journal (docs/journal.md): OUT/SCENE.journal. With --resume, the object starts as
@@ -56,7 +70,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     // offered (J) until the first cut.
     const std::filesystem::path session_journal =
         std::filesystem::path(options.out_dir) / (std::filesystem::path(scene_path).stem().string() + ".journal");
-    const sim::JournalHeader header = sim::journal_header(scene_path, *method);
+    sim::JournalHeader header = sim::journal_header(scene_path, *method);
+    header.any_level = scene.object.auto_levels; // the session may have moved between levels
     std::optional<sim::Journal> offered;
     if (!options.resume.empty()) {
         const sim::Journal journal = sim::read_journal(options.resume, header);
@@ -142,6 +157,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     sim_options.scene_file = scene_path;
     sim_options.journal = session_journal;
     sim_options.offered = std::move(offered);
+    sim_options.governor = std::move(governor);
     ViewSimulation simulation(scene, std::move(method), tools, channels, sim_options);
     // The simulation thread: from here on the only one to touch the method, the tools and the
     // scene's tool settings.

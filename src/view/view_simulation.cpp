@@ -15,6 +15,12 @@ ViewSimulation::ViewSimulation(io::Scene& scene, std::unique_ptr<sim::Method> me
     : m_scene(scene), m_method(std::move(method)), m_tools(tools), m_channels(channels), m_options(options),
       m_loop(scene, *m_method, tools), m_level(m_method->level())
 {
+    if (m_options.governor) {
+        log::info("levels {} to {}: the session moves coarser when its frames miss {:g} ms for a second, and back when there is room",
+                  m_options.governor->settings().finest, m_options.governor->settings().coarsest, m_options.governor->settings().budget_ms);
+        m_loop.govern_levels(std::move(*m_options.governor));
+        m_options.governor.reset();
+    }
     m_pose.shape = &tools.shape(0);
     m_pose.position = m_heading = options.start_mm;
     start_journal();
@@ -47,6 +53,15 @@ void ViewSimulation::resume_offered()
     m_options.offered.reset();
 }
 
+void ViewSimulation::now_at_level(const std::string& why, double now_s)
+{
+    const int from = m_level;
+    m_level = m_method->level();
+    start_journal(); // the journal holds one level's motion; the undo history carries its levels
+    m_level_notice = "level " + std::to_string(from) + " -> " + std::to_string(m_level) + ": " + why;
+    m_level_notice_until_s = now_s + 4.0;
+}
+
 void ViewSimulation::let_go()
 {
     m_tools.reset();
@@ -60,20 +75,29 @@ void ViewSimulation::take_requests()
     if (const int d = r.level_change.exchange(0); d != 0) {
         const int at = std::clamp(m_level + d, 1, m_options.grid_levels);
         if (at != m_level) {
-            m_method = m_method->at_level(at);
-            m_loop.set_method(*m_method);
-            let_go();
-            m_level = at;
-            m_history.clear(); // the deformation restarts from rest at the new level
-            start_journal();   // the journal holds one level's cuts
-            log::info("level {}: {} elements ({}the deformation from rest)", at, m_method->element_count(),
-                      m_method->name() == std::string("dbg") ? "the cuts kept, " : "uncut: Is-XFEM cannot carry cuts across levels yet; ");
+            if (sim::LevelGovernor* g = m_loop.governor()) g->set_finest(at); // the user's level is the finest it returns to
+            if (m_loop.move_to_level(at, "the level keys")) { // the state carried on (the branched grid)
+                now_at_level("the level keys", m_now_s);
+            } else { // Is-XFEM: its cracks live in one level's tetrahedra
+                m_method = m_method->at_level(at);
+                m_loop.set_method(*m_method);
+                let_go();
+                m_level = at;
+                m_history.clear(); // the deformation restarts from rest at the new level
+                start_journal();   // the journal holds one level's cuts
+                log::info("level {}: {} elements (uncut: Is-XFEM cannot carry cuts across levels yet; the deformation from rest)", at,
+                          m_method->element_count());
+            }
         }
     }
     if (r.undo.exchange(false)) {
         if (m_history.undo(*m_method)) {
             let_go();
             log::info("undo: back to before the last stroke");
+            if (m_method->level() != m_level) { // the stroke began at another level
+                if (sim::LevelGovernor* g = m_loop.governor()) g->moved(m_level, m_method->level());
+                now_at_level("undo", m_now_s);
+            }
             if (m_journal) {
                 m_journal->rewound(*m_method);
                 m_journal->end_stroke(*m_method, m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
@@ -95,6 +119,7 @@ void ViewSimulation::take_requests()
 bool ViewSimulation::step(double now_s)
 {
     ViewRequests& r = m_channels.requests;
+    m_now_s = now_s;
     take_requests();
     if (r.paused.load() && !r.step_once.exchange(false)) return false;
     if (m_channels.proxies.update()) {
@@ -110,6 +135,7 @@ bool ViewSimulation::step(double now_s)
     if (m_driven >= 0) m_tools.drive(static_cast<std::size_t>(m_driven), m_pose.position, m_pose.orientation);
     try {
         const sim::FrameStats frame = m_loop.next();
+        if (frame.level_change) now_at_level(frame.level_change->reason, now_s);
         // A stroke ends when the button goes up, or (a 6-DoF controller) when a cut ends or the tool rests.
         const bool released = r.stroke_ended.exchange(false);
         if (m_stroke_ends.after_frame(frame) || released)
@@ -175,7 +201,8 @@ void ViewSimulation::make_picture()
     r.notice = m_options.offered && m_method->cut_count() == 0
                    ? "An earlier session with this scene left " + std::to_string(m_options.offered->strokes.size()) +
                          " stroke(s) in its journal: press J to resume them"
-                   : std::string();
+               : m_now_s < m_level_notice_until_s ? m_level_notice
+                                                  : std::string();
     const io::ToolSpec& tool = m_scene.tools[static_cast<std::size_t>(q.active.load())];
     r.tool = tool.name + " (" +
              (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")

@@ -29,6 +29,9 @@ struct ViewSimulationOptions {
     std::filesystem::path scene_file;
     /// An earlier session's journal of this scene, offered until the first cut: J resumes it.
     std::optional<sim::Journal> offered;
+    /// "levels": "auto" with a budget: moves the session between levels as its frames take
+    /// (sim/level_governor.hpp).
+    std::optional<sim::LevelGovernor> governor;
 };
 
 class ViewSimulation {
@@ -57,6 +60,8 @@ private:
     void make_picture();
     /// A new journal for the method as it now is (the session's start, another level).
     void start_journal();
+    /// The session is now at the method's level (moved by the keys or the governor).
+    void now_at_level(const std::string& why, double now_s);
     /// The earlier session's cuts made on the object, when it has none yet.
     void resume_offered();
 
@@ -70,6 +75,9 @@ private:
     std::unique_ptr<sim::JournalWriter> m_journal;
     sim::StrokeEnds m_stroke_ends; ///< a 6-DoF controller's strokes (no button says when they end)
     int m_level = 1;
+    std::string m_level_notice; ///< the last move between levels, shown for a few seconds
+    double m_level_notice_until_s = 0.0;
+    double m_now_s = 0.0;
     int m_driven = -1; ///< the tool the device drives (-1: none yet)
     contact::PlacedShape m_pose;
     Eigen::Vector3d m_heading = Eigen::Vector3d::Zero();
