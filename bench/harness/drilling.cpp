@@ -2,7 +2,8 @@
 // the step: the frame loop's own frame_ms) while a burr drills through the bundled CT-like
 // skull, with the bone elastic (E 15 GPa) and rigid. Each run opens the scene afresh with
 // "levels": "auto" and a 16 ms budget, so the level and preconditioner are chosen as a user's
-// run would choose them, then replays the whole script. Reported over the frames that removed
+// run would choose them, then replays the whole script with the level governor a device run has
+// (it moves coarser while frames miss the budget, where the scene can be simulated coarser). Reported over the frames that removed
 // bone, and over all frames: median, 95th percentile and largest.
 
 #include "bench/harness/drilling.hpp"
@@ -13,6 +14,7 @@
 #include "io/scene_object.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/level_choice.hpp"
+#include "sim/level_governor.hpp"
 #include "sim/method_factory.hpp"
 
 #include <nlohmann/json.hpp>
@@ -35,6 +37,8 @@ struct DrillingRun {
     double drilling_p50 = 0, drilling_p95 = 0, drilling_max = 0;
     double all_p50 = 0, all_p95 = 0;
     double choice_s = 0; ///< the level choice's own trials
+    int level_changes = 0;
+    int final_level = 0;
 };
 
 DrillingRun drill_once(const char* file, const char* bone)
@@ -52,17 +56,20 @@ DrillingRun drill_once(const char* file, const char* bone)
     r.linear_solver = opened.method->linear_solver();
     sim::ToolPolicy tools(scene);
     sim::FrameLoop loop(scene, *opened.method, tools);
+    if (auto governor = sim::level_governor(scene, *opened.choice, opened.method->coarsest_level())) loop.govern_levels(std::move(*governor));
     const int frames = static_cast<int>(std::ceil(scene.script.back().t_s / scene.solver.dt_s - 1e-9));
     std::vector<double> all, drilling;
     for (int f = 1; f <= frames; ++f) {
         const sim::FrameStats s = loop.next();
         const double ms = s.frame_ms;
         all.push_back(ms);
+        r.level_changes += s.level_change.has_value();
         if (s.tools.cut.removed_voxels == 0) continue;
         drilling.push_back(ms);
         r.removed_voxels += s.tools.cut.removed_voxels;
     }
     r.drilling_frames = drilling.size();
+    r.final_level = opened.method->level();
     r.drilling_p50 = quantile(drilling, 0.5);
     r.drilling_p95 = quantile(drilling, 0.95);
     r.drilling_max = quantile(drilling, 1.0);
@@ -90,24 +97,27 @@ void run_drilling_bench(int runs, const std::filesystem::path& dir)
           "through the vertex of the bundled CT-like skull in 3 s, 350 frames of 10 ms) with the bone "
           "elastic (E 15 GPa) and rigid (`skull_burr_hole_rigid.json`). Every run opens the scene with "
           "`\"levels\": \"auto\"` and `\"step_budget_ms\": 16` (the level and preconditioner chosen as a "
-          "user's run chooses them, on frames with the burr at work) and replays the script. A frame is "
+          "user's run chooses them, on frames with the burr at work) and replays the script with the level "
+          "governor of a device run (one level coarser while the frames of a second miss the budget, where the "
+          "skull can still be held at its base). A frame is "
           "timed whole around the frame loop: the burr's contact, the bone it removes, the grid, surface "
           "and model updates, and the step. Machine: "
        << machine_description() << ".\n\n";
     md << "| run | bone | level, solver | frames removing bone | voxels removed | those frames: median / p95 / max (ms) | "
-          "all frames: median / p95 (ms) | level choice (s) |\n|---|---|---|---|---|---|---|---|\n";
+          "all frames: median / p95 (ms) | level choice (s) | level moves (final level) |\n|---|---|---|---|---|---|---|---|---|\n";
     nlohmann::json j = nlohmann::json::array();
     for (std::size_t k = 0; k < results.size(); ++k) {
         const DrillingRun& r = results[k];
         char line[512];
-        std::snprintf(line, sizeof line, "| %zu | %s | %d, %s | %zu | %zu | %.2f / %.2f / %.2f | %.2f / %.2f | %.1f |\n", k / 2 + 1,
+        std::snprintf(line, sizeof line, "| %zu | %s | %d, %s | %zu | %zu | %.2f / %.2f / %.2f | %.2f / %.2f | %.1f | %d (%d) |\n", k / 2 + 1,
                       r.bone.c_str(), r.level, r.linear_solver.c_str(), r.drilling_frames, r.removed_voxels, r.drilling_p50, r.drilling_p95,
-                      r.drilling_max, r.all_p50, r.all_p95, r.choice_s);
+                      r.drilling_max, r.all_p50, r.all_p95, r.choice_s, r.level_changes, r.final_level);
         md << line;
         j.push_back({{"run", k / 2 + 1}, {"bone", r.bone}, {"level", r.level}, {"linear_solver", r.linear_solver},
                      {"drilling_frames", r.drilling_frames}, {"removed_voxels", r.removed_voxels},
                      {"drilling_frame_ms", {{"median", r.drilling_p50}, {"p95", r.drilling_p95}, {"max", r.drilling_max}}},
                      {"frame_ms", {{"median", r.all_p50}, {"p95", r.all_p95}}}, {"level_choice_s", r.choice_s},
+                     {"level_changes", r.level_changes}, {"final_level", r.final_level},
                      {"budget_ms", k_budget_ms}, {"machine", machine_description()}});
     }
     md << "\nMedian over the runs of each row's p95 while drilling:";

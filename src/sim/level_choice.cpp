@@ -127,6 +127,7 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, st
                 }
             } catch (const InputError& e) { // a scene whose boxes catch nothing at a coarse level can still run at a finer one
                 log::info("levels auto: level {} skipped: {}", level, e.what());
+                out.unusable.push_back(level);
                 break;
             }
             if (std::find(tried.begin(), tried.end(), method->linear_solver()) != tried.end()) continue;

@@ -22,7 +22,7 @@ std::string ms_text(double ms)
 
 } // namespace
 
-LevelGovernor::LevelGovernor(Settings settings) : m_settings(std::move(settings)) {}
+LevelGovernor::LevelGovernor(Settings settings) : m_settings(std::move(settings)), m_refused(m_settings.unusable) {}
 
 io::PreconditionerChoice LevelGovernor::preconditioner(int level) const
 {
@@ -110,6 +110,7 @@ std::optional<LevelGovernor> level_governor(const io::Scene& scene, const LevelC
     s.finest = choice.level;
     s.coarsest = std::max(coarsest_level, choice.level);
     s.scene_preconditioner = scene.solver.preconditioner;
+    s.unusable = choice.unusable;
     for (const LevelTrial& t : choice.trials) {
         s.measured_ms[t.level] = t.frame_ms;
         s.preconditioner[t.level] = t.preconditioner;

@@ -49,6 +49,7 @@ public:
         std::map<int, double> measured_ms;
         std::map<int, io::PreconditionerChoice> preconditioner;
         io::PreconditionerChoice scene_preconditioner = io::PreconditionerChoice::automatic;
+        std::vector<int> unusable; ///< levels the object cannot be simulated at: never tried
     };
 
     explicit LevelGovernor(Settings settings);
