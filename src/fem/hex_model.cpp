@@ -124,11 +124,10 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
 
     // Dense numbering of the nodes the alive elements use.
     m_dense_node.assign(lv.node_users.size(), grid::no_index);
-    std::size_t alive = 0, partial = 0;
+    std::size_t alive = 0;
     for (std::uint32_t e = 0; e < lv.elements.size(); ++e) {
         if (!lv.elements[e].alive) continue;
         ++alive;
-        partial += !grid.is_full(level, e);
         for (std::uint32_t n : lv.elements[e].nodes)
             if (m_dense_node[n] == grid::no_index) {
                 m_dense_node[n] = static_cast<std::uint32_t>(m_grid_node.size());
@@ -142,7 +141,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
 
     for (const grid::ElasticMaterial& m : grid.materials())
         m_full_stiffness.push_back(cell * grid::hex8_stiffness(h, m.lame));
-    m_partial_stiffness.reserve(partial); // elements point into it: no reallocation allowed
+    m_partial_stiffness.reserve(alive);
     m_elements.reserve(alive);
     for (std::uint32_t e = 0; e < lv.elements.size(); ++e) {
         const grid::Element& g = lv.elements[e];
@@ -153,12 +152,12 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
         const HexElement* old = previous && kept[e] != grid::no_index ? &previous->elements()[kept[e]] : nullptr;
         if (grid.is_full(level, e)) {
             el.stiffness = &m_full_stiffness[static_cast<std::size_t>(g.content[0].material)];
+            m_partial_stiffness.emplace_back();
         } else if (old) {
-            m_partial_stiffness.push_back(*old->stiffness); // fictitious material included
-            el.stiffness = &m_partial_stiffness.back();
+            m_partial_stiffness.push_back(previous->m_partial_stiffness[kept[e]]); // fictitious material included
+            el.stiffness = m_partial_stiffness.back().get();
         } else {
-            m_partial_stiffness.push_back(grid.stiffness(level, e));
-            el.stiffness = &m_partial_stiffness.back();
+            auto k = std::make_shared<Matrix24d>(grid.stiffness(level, e));
             // The element's nodes get their material's stiffness times a small fraction from the
             // empty part of the cell (the finite cell method's fictitious material), matching the
             // mass floor: a corner far from the element's few voxels otherwise has almost no
@@ -166,7 +165,9 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
             // corotational forces (seen on the liver at level 3: 35 m/s^2 on a one-voxel element).
             const auto dominant = static_cast<std::size_t>(std::max_element(g.content.begin(), g.content.end(),
                 [](const grid::MaterialMoments& a, const grid::MaterialMoments& b) { return a.voxels < b.voxels; })->material);
-            m_partial_stiffness.back() += k_fictitious_fraction * m_full_stiffness[dominant];
+            *k += k_fictitious_fraction * m_full_stiffness[dominant];
+            el.stiffness = k.get();
+            m_partial_stiffness.push_back(std::move(k));
         }
         el.mass = old ? old->mass : grid.mass(level, e);
         for (int c = 0; c < 8; ++c) {

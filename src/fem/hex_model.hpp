@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace vox::fem {
@@ -69,7 +70,10 @@ private:
 
     int m_level = 1;
     std::vector<HexElement> m_elements;
-    std::vector<Matrix24d> m_partial_stiffness; ///< owned by partial elements
+    /// Per element: the stiffness a partial element owns (null for a full one), shared with the
+    /// models rebuilt after later cuts while the element stays unchanged (copying them took
+    /// milliseconds per cut on a CT skull's thousand partial elements).
+    std::vector<std::shared_ptr<const Matrix24d>> m_partial_stiffness;
     std::vector<Matrix24d> m_full_stiffness;    ///< per material, shared by full cells
     std::vector<Eigen::Vector3d> m_rest_world;
     std::vector<std::uint32_t> m_grid_node, m_dense_node;

@@ -7,11 +7,13 @@
 #include "sim/dbg_method.hpp"
 #include "sim/isxfem_method.hpp"
 #include "sim/journal.hpp"
+#include "sim/level_governor.hpp"
 #include "test_support.hpp"
 #include "view/view_simulation.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 namespace vox::view {
@@ -132,6 +134,59 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeIsJournaledWhenTheButtonGoesUpAndANewS
     // The new session's journal holds the resumed cuts, so it can be resumed in turn.
     const sim::Journal now = sim::read_journal(journal, sim::journal_header(scene_file, simulation.method()));
     EXPECT_EQ(now.cuts(), earlier.cuts());
+}
+
+TEST(ViewSimulationLevels, ASessionOverBudgetMovesCoarserCarryingTheObjectAndSaysSo)
+{
+    io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json");
+    io::use_method(scene, io::SolverType::dbg);
+    scene.script.clear();
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    sim::ToolPolicy tools(scene);
+    ViewChannels channels(20000);
+    ViewSimulationOptions options;
+    options.grid_levels = 3;
+    options.out_dir = vox::test::fresh_dir("view_simulation_levels");
+    options.journal = options.out_dir / "session.journal";
+    options.scene_file = VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json";
+    sim::LevelGovernor::Settings budget; // a budget no frame meets: coarser after each second
+    budget.budget_ms = 1e-6;
+    budget.dt_s = scene.solver.dt_s;
+    budget.finest = 1;
+    budget.coarsest = 3;
+    options.governor = sim::LevelGovernor(budget);
+    ViewSimulation simulation(scene, std::make_unique<sim::DbgMethod>(scene, labels, 1, 3), tools, channels, options);
+    ViewRequests& keys = channels.requests;
+    // The blade cuts into the bar, then the session runs on.
+    keys.stroke_started = true;
+    const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
+    const int frames_per_second = static_cast<int>(std::lround(1.0 / scene.solver.dt_s));
+    int moved_at = 0;
+    for (int f = 0; f < 2 * frames_per_second && !moved_at; ++f) {
+        const double depth = std::min(f, 12) * 1.2;
+        channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - depth), turned}, Eigen::Vector3d(50.3, 5, 20.5 - depth)};
+        channels.proxies.publish();
+        keys.picture_taken = true;
+        ASSERT_TRUE(simulation.step(0.01 * f));
+        if (simulation.level() == 2) moved_at = f + 1;
+    }
+    ASSERT_GT(moved_at, 0) << "a second of frames over budget (at most 100 frames of 10 ms: fewer when frames take longer)";
+    EXPECT_EQ(simulation.method().level(), 2);
+    EXPECT_GT(simulation.method().cut_count(), 0u) << "the cuts kept";
+    EXPECT_EQ(simulation.history().size(), 1u) << "the undo history kept";
+    ASSERT_TRUE(channels.pictures.update());
+    EXPECT_EQ(channels.pictures.read_slot().level, 2);
+    EXPECT_EQ(channels.pictures.read_slot().notice.rfind("level 1 -> 2: frames over budget", 0), 0u) << channels.pictures.read_slot().notice;
+    // The journal started again at the new level, its first line holding the cuts so far.
+    sim::JournalHeader header = sim::journal_header(options.scene_file, simulation.method());
+    const sim::Journal journal = sim::read_journal(options.journal, header);
+    EXPECT_EQ(journal.header.level, 2);
+    EXPECT_EQ(journal.cuts().size(), simulation.method().cut_count());
+    // Undo goes back to before the stroke, at the level it began at.
+    keys.undo = true;
+    ASSERT_TRUE(simulation.step(3.0));
+    EXPECT_EQ(simulation.level(), 1);
+    EXPECT_EQ(simulation.method().cut_count(), 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, ViewSimulationOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
