@@ -3,7 +3,8 @@
 // is interpolated trilinearly in the model element holding it (level 0: its own voxel's element;
 // coarser levels: the branched element the surface embedded it in). Also where contact and
 // cutting look things up: the vertices of each element, the triangles of each vertex, and the
-// deformed centre of any fine voxel.
+// deformed centre of any fine voxel. It holds only the map from grid to model elements: made
+// anew after every cut, it costs a pass over the elements, not over the surface.
 
 #include "fem/hex_model.hpp"
 #include "surface/embedded_surface.hpp"
@@ -33,20 +34,20 @@ public:
     /// Deformed position of surface vertex slot `v`, world mm (node positions in m).
     [[nodiscard]] Eigen::Vector3d vertex_mm(std::uint32_t v, const std::vector<Eigen::Vector3d>& node_positions) const;
     /// Rest position of vertex slot `v`, world mm.
-    [[nodiscard]] const Eigen::Vector3d& vertex_rest_mm(std::uint32_t v) const { return m_rest_mm[v]; }
+    [[nodiscard]] Eigen::Vector3d vertex_rest_mm(std::uint32_t v) const { return m_grid.voxels().world_mm(m_surface.vertices()[v].rest); }
     /// Model element holding vertex slot `v` (no_index for a free slot), and its trilinear coordinates there.
-    [[nodiscard]] std::uint32_t vertex_element(std::uint32_t v) const { return m_element[v]; }
-    [[nodiscard]] const Eigen::Vector3d& vertex_local(std::uint32_t v) const { return m_local[v]; }
-    /// Vertex slots embedded in model element `e`.
-    [[nodiscard]] std::span<const std::uint32_t> element_vertices(std::uint32_t e) const
+    [[nodiscard]] std::uint32_t vertex_element(std::uint32_t v) const;
+    [[nodiscard]] Eigen::Vector3d vertex_local(std::uint32_t v) const;
+    /// Calls f(slot) for each vertex slot embedded in model element `e`.
+    template <class F> void for_each_element_vertex(std::uint32_t e, F&& f) const
     {
-        return {m_element_vertices.data() + m_element_start[e], m_element_start[e + 1] - m_element_start[e]};
+        const std::uint32_t ge = m_model.elements()[e].grid_element;
+        if (m_model.level() == 0) m_surface.for_each_voxel_vertex(ge, f); // the element is one voxel
+        else
+            for (std::uint32_t v : m_surface.element_vertices(ge)) f(v);
     }
     /// Triangle slots using vertex slot `v`.
-    [[nodiscard]] std::span<const std::uint32_t> vertex_triangles(std::uint32_t v) const
-    {
-        return {m_vertex_triangles.data() + m_triangle_start[v], m_triangle_start[v + 1] - m_triangle_start[v]};
-    }
+    [[nodiscard]] std::span<const std::uint32_t> vertex_triangles(std::uint32_t v) const { return m_surface.vertex_triangles(v); }
 
     /// Model element holding alive fine voxel `v` (slot), and the voxel centre's trilinear coordinates in it.
     [[nodiscard]] std::uint32_t voxel_element(std::uint32_t v, Eigen::Vector3d& local) const;
@@ -64,12 +65,10 @@ private:
     const grid::BranchedGrid& m_grid;
     const fem::HexModel& m_model;
     const surface::EmbeddedSurface& m_surface;
-    std::vector<std::uint32_t> m_model_element; ///< per grid element of the level (level 0: voxel slot)
-    std::vector<std::uint32_t> m_element;       ///< per vertex slot: model element (no_index: free)
-    std::vector<Eigen::Vector3d> m_local;       ///< per vertex slot: trilinear coordinates in it
-    std::vector<Eigen::Vector3d> m_rest_mm;     ///< per vertex slot: rest position, world mm
-    std::vector<std::uint32_t> m_element_start, m_element_vertices;  ///< vertex slots by model element
-    std::vector<std::uint32_t> m_triangle_start, m_vertex_triangles; ///< triangle slots by vertex slot
+    /// Per grid element of the level (level 0: voxel slot): its model element. All else is the
+    /// surface's own (its vertices' elements and coordinates, its lists by element and vertex),
+    /// so a model rebuilt after a cut maps the surface without going over it.
+    std::vector<std::uint32_t> m_model_element;
 };
 
 } // namespace vox::cut

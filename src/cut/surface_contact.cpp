@@ -29,11 +29,11 @@ void vertices_in(const ModelSurface& surface, const std::vector<Eigen::Vector3d>
         for (std::uint32_t n : el.dof_node) spread = std::max(spread, (1e3 * (node_positions[n] - model.rest_positions()[n]) - mean).norm());
         const Eigen::AlignedBox3d rest_reach(reach.min() - mean - Eigen::Vector3d::Constant(spread),
                                              reach.max() - mean + Eigen::Vector3d::Constant(spread));
-        for (std::uint32_t v : surface.element_vertices(e)) {
-            if (!rest_reach.contains(surface.vertex_rest_mm(v))) continue;
+        surface.for_each_element_vertex(e, [&](std::uint32_t v) {
+            if (!rest_reach.contains(surface.vertex_rest_mm(v))) return;
             const Eigen::Vector3d p = surface.vertex_mm(v, node_positions);
             if (reach.contains(p)) visit(v, p);
-        }
+        });
     }
 }
 

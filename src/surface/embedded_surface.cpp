@@ -119,6 +119,10 @@ void EmbeddedSurface::extract_cube(const grid::BranchedGrid& grid, const grid::C
             id = static_cast<std::uint32_t>(m_triangles.size());
             m_triangles.push_back(t);
         }
+        for (std::uint32_t v : t) {
+            std::vector<std::uint32_t>& list = m_vertex_triangles[v];
+            list.insert(std::upper_bound(list.begin(), list.end(), id), id);
+        }
         ids.push_back(id);
         ++m_triangle_count;
     }
@@ -129,7 +133,11 @@ void EmbeddedSurface::clear_cube(std::uint64_t key)
     const auto it = m_cube_triangles.find(key);
     if (it == m_cube_triangles.end()) return;
     for (std::uint32_t id : it->second) {
-        for (std::uint32_t v : m_triangles[id]) release_vertex(v);
+        for (std::uint32_t v : m_triangles[id]) {
+            std::vector<std::uint32_t>& list = m_vertex_triangles[v];
+            list.erase(std::lower_bound(list.begin(), list.end(), id));
+            release_vertex(v);
+        }
         m_triangles[id] = {grid::no_index, grid::no_index, grid::no_index};
         m_free_triangles.push_back(id);
         --m_triangle_count;
@@ -180,6 +188,8 @@ std::uint32_t EmbeddedSurface::vertex_for(const grid::BranchedGrid& grid, const 
     } else {
         id = static_cast<std::uint32_t>(m_vertices.size());
         m_vertices.emplace_back();
+        m_vertex_triangles.emplace_back();
+        m_list_place.push_back(grid::no_index);
     }
     SurfaceVertex& v = m_vertices[id];
     const auto p = cube_vertex_position(cv);
@@ -189,7 +199,7 @@ std::uint32_t EmbeddedSurface::vertex_for(const grid::BranchedGrid& grid, const 
     v.label = grid.voxels().label(voxel);
     v.users = 1;
     ++m_owned[voxel];
-    embed(grid, v);
+    place(grid, id);
     m_vertex_index.insert(key, id);
     if (cv.kind != CubeVertex::Kind::crossing) m_centre_vertices.emplace(voxel, id);
     ++m_vertex_count;
@@ -206,14 +216,39 @@ void EmbeddedSurface::embed(const grid::BranchedGrid& grid, SurfaceVertex& v) co
 void EmbeddedSurface::reembed(const grid::BranchedGrid& grid, int level)
 {
     m_level = level;
-    for (SurfaceVertex& v : m_vertices)
-        if (v.users) embed(grid, v);
+    m_element_vertices.clear();
+    std::fill(m_list_place.begin(), m_list_place.end(), grid::no_index);
+    for (std::uint32_t v = 0; v < m_vertices.size(); ++v)
+        if (m_vertices[v].users) place(grid, v);
+}
+
+void EmbeddedSurface::unlist(std::uint32_t v)
+{
+    const std::uint32_t at = m_list_place[v];
+    if (at == grid::no_index) return;
+    std::vector<std::uint32_t>& list = m_element_vertices[m_vertices[v].element];
+    m_list_place[list.back()] = at; // the last one takes its place
+    list[at] = list.back();
+    list.pop_back();
+    m_list_place[v] = grid::no_index;
+}
+
+void EmbeddedSurface::place(const grid::BranchedGrid& grid, std::uint32_t v)
+{
+    unlist(v);
+    SurfaceVertex& vertex = m_vertices[v];
+    embed(grid, vertex);
+    if (m_element_vertices.size() <= vertex.element) m_element_vertices.resize(grid.level(m_level).elements.size());
+    std::vector<std::uint32_t>& list = m_element_vertices[vertex.element];
+    m_list_place[v] = static_cast<std::uint32_t>(list.size());
+    list.push_back(v);
 }
 
 void EmbeddedSurface::release_vertex(std::uint32_t id)
 {
     SurfaceVertex& v = m_vertices[id];
     if (--v.users > 0) return;
+    unlist(id);
     m_vertex_index.insert(v.key, grid::CoordMap::missing);
     --m_owned[v.voxel];
     if ((v.key & 3) != 0) {
@@ -257,10 +292,10 @@ void EmbeddedSurface::update(const grid::BranchedGrid& grid, std::span<const gri
             if (m_owned[voxel] == 0) continue; // most voxels of an element hold no surface vertex
             for (std::uint64_t dir = 0; dir < 6; ++dir) {
                 const std::uint32_t id = m_vertex_index.find((std::uint64_t{voxel} * 6 + dir) << 2);
-                if (id != grid::CoordMap::missing) embed(grid, m_vertices[id]);
+                if (id != grid::CoordMap::missing) place(grid, id);
             }
             auto [first, last] = m_centre_vertices.equal_range(voxel);
-            for (auto it = first; it != last; ++it) embed(grid, m_vertices[it->second]);
+            for (auto it = first; it != last; ++it) place(grid, it->second);
         }
 }
 

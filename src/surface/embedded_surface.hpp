@@ -57,6 +57,24 @@ public:
     /// Vertex slots (users == 0: free) and triangle slots (a free one has vertex no_index).
     [[nodiscard]] const std::vector<SurfaceVertex>& vertices() const { return m_vertices; }
     [[nodiscard]] const std::vector<std::array<std::uint32_t, 3>>& triangles() const { return m_triangles; }
+    /// Triangle slots using vertex slot `v`, in increasing order (kept up to date as cuts change
+    /// the surface, so that a model rebuilt after a cut does not group them again).
+    [[nodiscard]] std::span<const std::uint32_t> vertex_triangles(std::uint32_t v) const { return m_vertex_triangles[v]; }
+    /// Vertex slots embedded in element `element` of the level (kept up to date likewise).
+    [[nodiscard]] std::span<const std::uint32_t> element_vertices(std::uint32_t element) const
+    {
+        return element < m_element_vertices.size() ? std::span<const std::uint32_t>(m_element_vertices[element])
+                                                    : std::span<const std::uint32_t>();
+    }
+    /// Calls f(slot) for each vertex slot belonging to fine voxel `voxel`.
+    template <class F> void for_each_voxel_vertex(std::uint32_t voxel, F&& f) const
+    {
+        if (voxel >= m_owned.size() || m_owned[voxel] == 0) return;
+        for (std::uint64_t dir = 0; dir < 6; ++dir) // crossings on the voxel's six edges' directions
+            if (const std::uint32_t id = m_vertex_index.find((std::uint64_t{voxel} * 6 + dir) << 2); id != grid::CoordMap::missing) f(id);
+        auto [first, last] = m_centre_vertices.equal_range(voxel);
+        for (auto it = first; it != last; ++it) f(it->second);
+    }
 
     /// Deformed vertex positions (per vertex slot, world mm) from the level's node positions
     /// (per node id, world mm): x = sum over corners of N_c(local) * node position.
@@ -87,6 +105,9 @@ private:
     std::uint32_t vertex_for(const grid::BranchedGrid& grid, const grid::Coord& cube, const CubeVertex& v,
                              const std::array<std::uint32_t, 8>& corners);
     void embed(const grid::BranchedGrid& grid, SurfaceVertex& v) const;
+    /// embed(), and the vertex moved to its element's list.
+    void place(const grid::BranchedGrid& grid, std::uint32_t v);
+    void unlist(std::uint32_t v);
     void release_vertex(std::uint32_t v);
     /// Each used vertex slot's neighbours along triangle edges (sorted, unique).
     [[nodiscard]] std::vector<std::vector<std::uint32_t>> vertex_neighbours() const;
@@ -107,6 +128,11 @@ private:
     /// Per voxel slot: how many vertices belong to it, so that re-embedding after a cut visits
     /// only the few voxels of an element that carry surface.
     std::vector<std::uint16_t> m_owned;
+    /// Per vertex slot: its triangle slots (sorted); per element of the level: its vertex slots,
+    /// and per vertex slot its place in that list (no_index: listed nowhere).
+    std::vector<std::vector<std::uint32_t>> m_vertex_triangles;
+    std::vector<std::vector<std::uint32_t>> m_element_vertices;
+    std::vector<std::uint32_t> m_list_place;
     std::size_t m_vertex_count = 0;
     std::size_t m_triangle_count = 0;
     bool m_flip = false; ///< the index-to-world transform mirrors: flip windings in world space

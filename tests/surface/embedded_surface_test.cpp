@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <map>
 #include <queue>
 #include <random>
@@ -225,6 +227,32 @@ TEST(EmbeddedSurface, RestDeformationAndAffineMotionAreReproduced)
         EXPECT_LT((m.positions[i] - (a * at_rest.positions[i] + b)).norm(), 1e-9);
 }
 
+/// The lists the surface keeps up to date (triangles by vertex, vertices by element) hold exactly
+/// what a count over its slots finds.
+void expect_lists_match_slots(const BranchedGrid& grid, const EmbeddedSurface& s)
+{
+    const auto& vertices = s.vertices();
+    std::vector<std::vector<std::uint32_t>> triangles(vertices.size());
+    for (std::uint32_t t = 0; t < s.triangles().size(); ++t)
+        if (s.triangles()[t][0] != grid::no_index)
+            for (std::uint32_t v : s.triangles()[t]) triangles[v].push_back(t);
+    std::vector<std::vector<std::uint32_t>> by_element(grid.level(s.level()).elements.size());
+    for (std::uint32_t v = 0; v < vertices.size(); ++v) {
+        const auto listed = s.vertex_triangles(v);
+        ASSERT_TRUE(std::equal(listed.begin(), listed.end(), triangles[v].begin(), triangles[v].end())) << "vertex " << v;
+        if (vertices[v].users) {
+            ASSERT_EQ(vertices[v].element, grid.element_of(vertices[v].voxel, s.level())) << "vertex " << v;
+            by_element[vertices[v].element].push_back(v);
+        }
+    }
+    for (std::uint32_t e = 0; e < by_element.size(); ++e) {
+        const auto span = s.element_vertices(e);
+        std::vector<std::uint32_t> listed(span.begin(), span.end());
+        std::sort(listed.begin(), listed.end());
+        ASSERT_EQ(listed, by_element[e]) << "element " << e;
+    }
+}
+
 TEST(EmbeddedSurface, LocalUpdatesEqualFreshExtraction)
 {
     std::mt19937 rng(5);
@@ -268,7 +296,10 @@ TEST(EmbeddedSurface, LocalUpdatesEqualFreshExtraction)
         EXPECT_TRUE(a.triangles == b.triangles);
         EXPECT_TRUE(a.embedding == b.embedding);
         expect_closed_oriented(s.mesh(grid));
+        expect_lists_match_slots(grid, s);
     }
+    s.reembed(grid, 3); // another level: the lists follow
+    expect_lists_match_slots(grid, s);
 }
 
 TEST(EmbeddedSurface, APartialCutLeavesOneClosedPieceWithAVisibleSlit)
