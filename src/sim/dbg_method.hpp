@@ -44,7 +44,10 @@ public:
                                         const contact::PlacedShape* from) override;
     CutFigures follow(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
                       const CutOrder& order) override;
-    void lift(std::size_t) override {}
+    void lift(std::size_t tool) override
+    {
+        if (tool < m_stroke.size()) m_stroke[tool].going = false;
+    }
     void wet(std::size_t tool, double water) override;
     CutFigures drill(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at, double volume_mm3) override;
     void end_tools() override;
@@ -103,6 +106,18 @@ private:
     std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
     /// Two-phase tools: the section where the marking began (rest space).
     std::vector<std::vector<Eigen::Vector3d>> m_marked_from;
+    /// A separating tool's stroke: the blade's plane normal and the material's displacement across
+    /// it (mm) where the stroke began. A stroke goes on while the blade turns by less than
+    /// k_stroke_turn_cos a frame (as Is-XFEM's blade strokes: sim/blade_stroke.hpp).
+    struct StrokeCarry {
+        bool going = false;
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+        double across_mm = 0.0;
+        double plane_mm = 0.0; ///< the blade's plane (normal . position) where the stroke began
+    };
+    std::vector<StrokeCarry> m_stroke;
+    static constexpr double k_stroke_turn_cos = 0.98480775301220802; // cos 10 degrees
+    static constexpr double k_stroke_waver_mm = 1.0;
 };
 
 } // namespace vox::sim
