@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <random>
 
 namespace vox::sim {
 namespace {
@@ -58,6 +59,33 @@ TEST(OneSheet, ARodHeldAtBothEndsCutStraightDown)
     EXPECT_EQ(n.parallel_pairs, 0u);
     EXPECT_EQ(n.slivers, 0u);
     EXPECT_EQ(n.pieces, 2u);
+}
+
+TEST(OneSheet, RandomStraightStrokesThroughASaggingRodEachOpenOneSheet)
+{
+    // A fixed sample of strokes: where along the rod, the blade's plane turned about the vertical
+    // and then tilted about the rod's axis, the rod soft enough to sag and swing as it is cut.
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> along(30.0, 70.0), turn(-0.35, 0.35), tilt(-0.5, 0.5);
+    for (int k = 0; k < 4; ++k) {
+        const double x = along(rng), yaw = turn(rng), roll = tilt(rng);
+        const Eigen::Quaterniond o = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(M_PI / 2 + yaw, Eigen::Vector3d::UnitZ());
+        const nlohmann::json q = {o.w(), o.x(), o.y(), o.z()};
+        // Edge first, along the blade's own plane (a blade moved across its plane is not yet
+        // one sheet: see docs/cutting.md).
+        const Eigen::Vector3d from(x, 5, 5), way = o * -Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d start = from - 40.0 * way, end = from + 30.0 * way;
+        SCOPED_TRACE(testing::Message() << "stroke " << k << " at x " << x << ", turned " << yaw << ", tilted " << roll);
+        const test::SheetCount n = cut_and_count(
+            blade_scene({{"phantom", {{"shape", "beam"}, {"size_mm", {100, 10, 10}}, {"voxel_mm", 1.0}}}, {"levels", 2}}, 5e4,
+                        {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {2, 11, 11}}}}, {{"type", "fixed"}, {"box_mm", {{98, -1, -1}, {101, 11, 11}}}}},
+                        {{{"t_s", 0.0}, {"tool", "blade"}, {"position_mm", {start.x(), start.y(), start.z()}}, {"orientation_wxyz", q}},
+                         {{"t_s", 1.0}, {"tool", "blade"}, {"position_mm", {end.x(), end.y(), end.z()}}, {"orientation_wxyz", q}}}),
+            "random_rod.json");
+        EXPECT_EQ(n.sheets, 1u);
+        EXPECT_EQ(n.parallel_pairs, 0u);
+        EXPECT_EQ(n.slivers, 0u);
+    }
 }
 
 TEST(OneSheet, ADroopingSlabCutByATiltedBlade)
