@@ -18,9 +18,9 @@
 namespace vox::sim {
 namespace {
 
-test::SheetCount cut_and_count(const nlohmann::json& doc, const char* name)
+/// Runs the scene's whole script on the branched grid at its level and counts what its cuts opened.
+test::SheetCount run_and_count(const io::Scene& scene, const char* name)
 {
-    const io::Scene scene = io::parse_scene(doc, ::testing::TempDir(), name);
     auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     DbgMethod method(scene, labels, scene.object.levels, scene.object.levels);
     ToolPolicy tools(scene);
@@ -33,6 +33,11 @@ test::SheetCount cut_and_count(const nlohmann::json& doc, const char* name)
     std::printf("%s: %zu faces, %zu sheets, %zu parallel pairs, %zu pieces, %zu slivers\n", name, n.faces, n.sheets, n.parallel_pairs,
                 n.pieces, n.slivers);
     return n;
+}
+
+test::SheetCount cut_and_count(const nlohmann::json& doc, const char* name)
+{
+    return run_and_count(io::parse_scene(doc, ::testing::TempDir(), name), name);
 }
 
 nlohmann::json blade_scene(const nlohmann::json& object, double youngs_pa, const nlohmann::json& constraints, const nlohmann::json& script)
@@ -107,24 +112,10 @@ TEST(OneSheet, ADroopingSlabCutByATiltedBlade)
     EXPECT_EQ(n.slivers, 0u);
 }
 
-} // namespace
-} // namespace vox::sim
-
-namespace vox::sim {
-namespace {
-
 TEST(OneSheet, TheBundledLiverIncisionIsOneSheetLeavingOnePiece)
 {
-    const io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/liver_incision.json");
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-    DbgMethod method(scene, labels, scene.object.levels, scene.object.levels);
-    ToolPolicy tools(scene);
-    FrameLoop loop(scene, method, tools);
-    const int frames = static_cast<int>(std::lround(scene.script.back().t_s / scene.solver.dt_s));
-    for (int f = 0; f < frames; ++f) loop.next();
-    std::vector<std::pair<grid::Coord, int>> faces;
-    for (const CutRecord& c : method.cuts()) faces.insert(faces.end(), c.faces.begin(), c.faces.end());
-    const test::SheetCount n = test::count_sheets(method.grid().voxels(), faces);
+    const test::SheetCount n =
+        run_and_count(io::load_scene(VOX_SOURCE_DIR "/data/scenes/liver_incision.json"), "liver_incision.json");
     // A 50 mm incision about 8 mm deep: about 400 mm^2 of 0.62 x 0.62 mm faces.
     const double area_mm2 = static_cast<double>(n.faces) * 0.617188 * 0.617188;
     EXPECT_GT(area_mm2, 250.0);
