@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <utility>
 
 namespace vox::sim {
@@ -80,7 +81,7 @@ const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolS
     return m_touch[tool].contact;
 }
 
-CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose&, const contact::PlacedShape& at,
+CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
                              const CutOrder& order)
 {
     // A separating tool's section, carried back to rest space (cut/voxel_cut.hpp): each frame
@@ -98,17 +99,42 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
         // by a tilted blade came apart in 29 pieces, 9 of them slivers). Along the plane it
         // follows the material, so the cut is as deep as the blade is in the material as it is.
         // A stroke ends when the tool leaves the scene, turns by more than 10 degrees in a frame or
-        // moves off its plane by more than 1 mm (another cut, elsewhere).
+        // has touched nothing for k_stroke_gap_s (it went to cut elsewhere).
         const Eigen::Vector3d normal = at.orientation * Eigen::Vector3d::UnitY();
         if (m_stroke.size() <= tool) m_stroke.resize(tool + 1);
         StrokeCarry& stroke = m_stroke[tool];
-        const double plane_mm = normal.dot(at.position);
-        if (m_previous_section[tool].empty() || !stroke.going || normal.dot(stroke.normal) < k_stroke_turn_cos ||
-            std::abs(plane_mm - stroke.plane_mm) > k_stroke_waver_mm)
-            stroke = {true, normal, normal.dot(moved), plane_mm};
+        stroke.untouched_s = order.touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
+        const bool goes_on = !m_previous_section[tool].empty() && stroke.going && normal.dot(stroke.normal) >= k_stroke_turn_cos &&
+                             stroke.untouched_s < k_stroke_gap_s;
+        if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0};
         stroke.normal = normal; // it may turn by up to 10 degrees a frame and go on
         moved += (stroke.across_mm - normal.dot(moved)) * normal;
         for (Eigen::Vector3d& p : rest_section) p -= moved;
+        // The sheet is what the edge sweeps: a blade held at a slant to the way it moves (as a hand
+        // holds it) would otherwise open each frame's section a little beside the last, a
+        // staircase of sheets. The section is laid into the plane through the last one that
+        // holds the edge and the way it moves (the blade's own plane when it moves along it).
+        const bool edged = spec.shape == io::ToolShape::blade || spec.shape == io::ToolShape::scalpel;
+        const Eigen::Vector3d way = at.position - from.position_mm;
+        if (goes_on && edged && way.allFinite() && way.norm() > 1e-9) {
+            const Eigen::Vector3d swept = (at.orientation * Eigen::Vector3d::UnitX()).cross(way);
+            if (swept.norm() > 0.2 * way.norm()) stroke.cut_normal = swept.normalized() * (swept.dot(normal) < 0.0 ? -1.0 : 1.0);
+        }
+        if (goes_on) { // through the last section's edge (its side lowest in the tool's frame), where it cuts
+            const std::vector<Eigen::Vector3d>& last = m_previous_section[tool];
+            const Eigen::Vector3d up = at.orientation * Eigen::Vector3d::UnitZ();
+            double lowest = std::numeric_limits<double>::infinity();
+            for (const Eigen::Vector3d& p : last) lowest = std::min(lowest, up.dot(p));
+            Eigen::Vector3d through = Eigen::Vector3d::Zero();
+            int on_edge = 0;
+            for (const Eigen::Vector3d& p : last)
+                if (up.dot(p) < lowest + 1e-6) {
+                    through += p;
+                    ++on_edge;
+                }
+            through /= on_edge;
+            for (Eigen::Vector3d& p : rest_section) p -= stroke.cut_normal.dot(p - through) * stroke.cut_normal;
+        }
     }
     std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[tool], rest_section);
     // Two-phase: the whole path marked since the first touch is cut at once.

@@ -106,18 +106,20 @@ private:
     std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
     /// Two-phase tools: the section where the marking began (rest space).
     std::vector<std::vector<Eigen::Vector3d>> m_marked_from;
-    /// A separating tool's stroke: the blade's plane normal and the material's displacement across
-    /// it (mm) where the stroke began. A stroke goes on while the blade turns by less than
-    /// k_stroke_turn_cos a frame (as Is-XFEM's blade strokes: sim/blade_stroke.hpp).
+    /// A separating tool's stroke: the blade's plane normal, the material's displacement across it
+    /// (mm) where the stroke began, and the plane its edge sweeps. A stroke goes on while the
+    /// blade turns by less than k_stroke_turn_cos a frame (as Is-XFEM's blade strokes:
+    /// sim/blade_stroke.hpp) and touches the object at least every k_stroke_gap_s.
     struct StrokeCarry {
         bool going = false;
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
         double across_mm = 0.0;
-        double plane_mm = 0.0; ///< the blade's plane (normal . position) where the stroke began
+        Eigen::Vector3d cut_normal = Eigen::Vector3d::Zero(); ///< of the plane the edge sweeps
+        double untouched_s = 0.0;                              ///< since the blade last touched
     };
     std::vector<StrokeCarry> m_stroke;
     static constexpr double k_stroke_turn_cos = 0.98480775301220802; // cos 10 degrees
-    static constexpr double k_stroke_waver_mm = 1.0;
+    static constexpr double k_stroke_gap_s = 0.2;
 };
 
 } // namespace vox::sim

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -72,13 +73,15 @@ TEST(OneSheet, RandomStraightStrokesThroughASaggingRodEachOpenOneSheet)
     // and then tilted about the rod's axis, the rod soft enough to sag and swing as it is cut.
     std::mt19937 rng(21);
     std::uniform_real_distribution<double> along(30.0, 70.0), turn(-0.35, 0.35), tilt(-0.5, 0.5);
-    for (int k = 0; k < 4; ++k) {
-        const double x = along(rng), yaw = turn(rng), roll = tilt(rng);
+    std::array<std::array<double, 3>, 4> drawn{};
+    for (auto& d : drawn) d = {along(rng), turn(rng), tilt(rng)};
+    for (int k = 0; k < 8; ++k) {
+        const auto [x, yaw, roll] = drawn[static_cast<std::size_t>(k % 4)];
         const Eigen::Quaterniond o = Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(M_PI / 2 + yaw, Eigen::Vector3d::UnitZ());
         const nlohmann::json q = {o.w(), o.x(), o.y(), o.z()};
-        // Edge first, along the blade's own plane (a blade moved across its plane is not yet
-        // one sheet: see docs/cutting.md).
-        const Eigen::Vector3d from(x, 5, 5), way = o * -Eigen::Vector3d::UnitZ();
+        // Edge first: each blade along its own plane, then the same blades straight down, held at a
+        // slant to the way they move.
+        const Eigen::Vector3d from(x, 5, 5), way = k < 4 ? Eigen::Vector3d(o * -Eigen::Vector3d::UnitZ()) : Eigen::Vector3d(0, 0, -1);
         const Eigen::Vector3d start = from - 40.0 * way, end = from + 30.0 * way;
         SCOPED_TRACE(testing::Message() << "stroke " << k << " at x " << x << ", turned " << yaw << ", tilted " << roll);
         const test::SheetCount n = cut_and_count(
