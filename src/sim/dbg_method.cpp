@@ -89,52 +89,7 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
     std::vector<Eigen::Vector3d> rest_section;
     if (spec.cut_mode == io::CutMode::separate) {
         rest_section = cut::section_polygon(*at.shape, 0.0, at);
-        Eigen::AlignedBox3d box;
-        box.setEmpty();
-        for (const Eigen::Vector3d& p : rest_section) box.extend(p);
-        Eigen::Vector3d moved = cut::mean_displacement_mm(m_sim->surface(), m_sim->solver().positions(), box);
-        // Across the blade's plane the carry stays where the stroke began: the mean displacement
-        // around the blade jumps as the material bends under it or the sides part, and each jump
-        // started a second sheet beside the first, with a slice between them (a drooping slab cut
-        // by a tilted blade came apart in 29 pieces, 9 of them slivers). Along the plane it
-        // follows the material, so the cut is as deep as the blade is in the material as it is.
-        // A stroke ends when the tool leaves the scene, turns by more than 10 degrees in a frame or
-        // has touched nothing for k_stroke_gap_s (it went to cut elsewhere).
-        const Eigen::Vector3d normal = at.orientation * Eigen::Vector3d::UnitY();
-        if (m_stroke.size() <= tool) m_stroke.resize(tool + 1);
-        StrokeCarry& stroke = m_stroke[tool];
-        stroke.untouched_s = order.touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
-        const bool goes_on = !m_previous_section[tool].empty() && stroke.going && normal.dot(stroke.normal) >= k_stroke_turn_cos &&
-                             stroke.untouched_s < k_stroke_gap_s;
-        if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0};
-        stroke.normal = normal; // it may turn by up to 10 degrees a frame and go on
-        moved += (stroke.across_mm - normal.dot(moved)) * normal;
-        for (Eigen::Vector3d& p : rest_section) p -= moved;
-        // The sheet is what the edge sweeps: a blade held at a slant to the way it moves (as a hand
-        // holds it) would otherwise open each frame's section a little beside the last, a
-        // staircase of sheets. The section is laid into the plane through the last one that
-        // holds the edge and the way it moves (the blade's own plane when it moves along it).
-        const bool edged = spec.shape == io::ToolShape::blade || spec.shape == io::ToolShape::scalpel;
-        const Eigen::Vector3d way = at.position - from.position_mm;
-        if (goes_on && edged && way.allFinite() && way.norm() > 1e-9) {
-            const Eigen::Vector3d swept = (at.orientation * Eigen::Vector3d::UnitX()).cross(way);
-            if (swept.norm() > 0.2 * way.norm()) stroke.cut_normal = swept.normalized() * (swept.dot(normal) < 0.0 ? -1.0 : 1.0);
-        }
-        if (goes_on) { // through the last section's edge (its side lowest in the tool's frame), where it cuts
-            const std::vector<Eigen::Vector3d>& last = m_previous_section[tool];
-            const Eigen::Vector3d up = at.orientation * Eigen::Vector3d::UnitZ();
-            double lowest = std::numeric_limits<double>::infinity();
-            for (const Eigen::Vector3d& p : last) lowest = std::min(lowest, up.dot(p));
-            Eigen::Vector3d through = Eigen::Vector3d::Zero();
-            int on_edge = 0;
-            for (const Eigen::Vector3d& p : last)
-                if (up.dot(p) < lowest + 1e-6) {
-                    through += p;
-                    ++on_edge;
-                }
-            through /= on_edge;
-            for (Eigen::Vector3d& p : rest_section) p -= stroke.cut_normal.dot(p - through) * stroke.cut_normal;
-        }
+        carry_to_rest(tool, spec, from, at, order.touching, rest_section);
     }
     std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[tool], rest_section);
     // Two-phase: the whole path marked since the first touch is cut at once.
@@ -158,6 +113,57 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
     }
     if (removed.empty() && faces.empty()) return {};
     return apply(std::move(removed), std::move(faces));
+}
+
+void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
+                              bool touching, std::vector<Eigen::Vector3d>& rest_section)
+{
+    Eigen::AlignedBox3d box;
+    box.setEmpty();
+    for (const Eigen::Vector3d& p : rest_section) box.extend(p);
+    Eigen::Vector3d moved = cut::mean_displacement_mm(m_sim->surface(), m_sim->solver().positions(), box);
+    // Across the blade's plane the carry stays where the stroke began: the mean displacement
+    // around the blade jumps as the material bends under it or the sides part, and each jump
+    // started a second sheet beside the first, with a slice between them (a drooping slab cut
+    // by a tilted blade came apart in 29 pieces, 9 of them slivers). Along the plane it
+    // follows the material, so the cut is as deep as the blade is in the material as it is.
+    // A stroke ends when the tool leaves the scene, turns by more than 10 degrees in a frame or
+    // has touched nothing for k_stroke_gap_s (it went to cut elsewhere).
+    const Eigen::Vector3d normal = at.orientation * Eigen::Vector3d::UnitY();
+    if (m_stroke.size() <= tool) m_stroke.resize(tool + 1);
+    StrokeCarry& stroke = m_stroke[tool];
+    stroke.untouched_s = touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
+    const bool goes_on = !m_previous_section[tool].empty() && stroke.going && normal.dot(stroke.normal) >= k_stroke_turn_cos &&
+                         stroke.untouched_s < k_stroke_gap_s;
+    if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0};
+    stroke.normal = normal; // it may turn by up to 10 degrees a frame and go on
+    moved += (stroke.across_mm - normal.dot(moved)) * normal;
+    for (Eigen::Vector3d& p : rest_section) p -= moved;
+    // The sheet is what the edge sweeps: a blade held at a slant to the way it moves (as a hand
+    // holds it) would otherwise open each frame's section a little beside the last, a
+    // staircase of sheets. The section is laid into the plane through the last one that
+    // holds the edge and the way it moves (the blade's own plane when it moves along it).
+    const bool edged = spec.shape == io::ToolShape::blade || spec.shape == io::ToolShape::scalpel;
+    const Eigen::Vector3d way = at.position - from.position_mm;
+    if (goes_on && edged && way.allFinite() && way.norm() > 1e-9) {
+        const Eigen::Vector3d swept = (at.orientation * Eigen::Vector3d::UnitX()).cross(way);
+        if (swept.norm() > 0.2 * way.norm()) stroke.cut_normal = swept.normalized() * (swept.dot(normal) < 0.0 ? -1.0 : 1.0);
+    }
+    if (goes_on) { // through the last section's edge (its side lowest in the tool's frame), where it cuts
+        const std::vector<Eigen::Vector3d>& last = m_previous_section[tool];
+        const Eigen::Vector3d up = at.orientation * Eigen::Vector3d::UnitZ();
+        double lowest = std::numeric_limits<double>::infinity();
+        for (const Eigen::Vector3d& p : last) lowest = std::min(lowest, up.dot(p));
+        Eigen::Vector3d through = Eigen::Vector3d::Zero();
+        int on_edge = 0;
+        for (const Eigen::Vector3d& p : last)
+            if (up.dot(p) < lowest + 1e-6) {
+                through += p;
+                ++on_edge;
+            }
+        through /= on_edge;
+        for (Eigen::Vector3d& p : rest_section) p -= stroke.cut_normal.dot(p - through) * stroke.cut_normal;
+    }
 }
 
 CutFigures DbgMethod::apply(std::vector<grid::Coord> removed, std::vector<std::pair<grid::Coord, int>> faces)

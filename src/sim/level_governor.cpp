@@ -4,6 +4,7 @@
 #include "sim/level_choice.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace vox::sim {
@@ -52,6 +53,9 @@ std::optional<LevelChange> LevelGovernor::after_frame(int level, double frame_ms
         return std::nullopt;
     }
     m_frames_ms.push_back(frame_ms);
+    // The longest window looked at holds at most k_room_s / dt frames: older ones are dropped.
+    if (const auto keep = static_cast<std::size_t>(std::ceil(k_room_s / m_settings.dt_s)) + 1; m_frames_ms.size() > 2 * keep)
+        m_frames_ms.erase(m_frames_ms.begin(), m_frames_ms.end() - static_cast<std::ptrdiff_t>(keep));
     const auto usable = [&](int l) { return std::find(m_refused.begin(), m_refused.end(), l) == m_refused.end(); };
     const double budget = m_settings.budget_ms;
     if (const auto p90 = recent_p90(k_judge_s); p90 && *p90 > budget) {

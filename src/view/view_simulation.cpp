@@ -53,13 +53,13 @@ void ViewSimulation::resume_offered()
     m_options.offered.reset();
 }
 
-void ViewSimulation::now_at_level(const std::string& why, double now_s)
+void ViewSimulation::now_at_level(const std::string& why)
 {
     const int from = m_level;
     m_level = m_method->level();
     start_journal(); // the journal holds one level's motion; the undo history carries its levels
     m_level_notice = "level " + std::to_string(from) + " -> " + std::to_string(m_level) + ": " + why;
-    m_level_notice_until_s = now_s + 4.0;
+    m_level_notice_until_s = m_now_s + 4.0;
 }
 
 void ViewSimulation::let_go()
@@ -77,7 +77,7 @@ void ViewSimulation::take_requests()
         if (at != m_level) {
             if (sim::LevelGovernor* g = m_loop.governor()) g->set_finest(at); // the user's level is the finest it returns to
             if (m_loop.move_to_level(at, "the level keys")) { // the state carried on (the branched grid)
-                now_at_level("the level keys", m_now_s);
+                now_at_level("the level keys");
             } else { // Is-XFEM: its cracks live in one level's tetrahedra
                 m_method = m_method->at_level(at);
                 m_loop.set_method(*m_method);
@@ -96,7 +96,7 @@ void ViewSimulation::take_requests()
             log::info("undo: back to before the last stroke");
             if (m_method->level() != m_level) { // the stroke began at another level
                 if (sim::LevelGovernor* g = m_loop.governor()) g->moved(m_level, m_method->level());
-                now_at_level("undo", m_now_s);
+                now_at_level("undo");
             }
             if (m_journal) {
                 m_journal->rewound(*m_method);
@@ -135,7 +135,7 @@ bool ViewSimulation::step(double now_s)
     if (m_driven >= 0) m_tools.drive(static_cast<std::size_t>(m_driven), m_pose.position, m_pose.orientation);
     try {
         const sim::FrameStats frame = m_loop.next();
-        if (frame.level_change) now_at_level(frame.level_change->reason, now_s);
+        if (frame.level_change) now_at_level(frame.level_change->reason);
         // A stroke ends when the button goes up, or (a 6-DoF controller) when a cut ends or the tool rests.
         const bool released = r.stroke_ended.exchange(false);
         if (m_stroke_ends.after_frame(frame) || released)

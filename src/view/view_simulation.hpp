@@ -61,7 +61,7 @@ private:
     /// A new journal for the method as it now is (the session's start, another level).
     void start_journal();
     /// The session is now at the method's level (moved by the keys or the governor).
-    void now_at_level(const std::string& why, double now_s);
+    void now_at_level(const std::string& why);
     /// The earlier session's cuts made on the object, when it has none yet.
     void resume_offered();
 
