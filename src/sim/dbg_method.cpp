@@ -89,7 +89,7 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
     std::vector<Eigen::Vector3d> rest_section;
     if (spec.cut_mode == io::CutMode::separate) {
         rest_section = cut::section_polygon(*at.shape, 0.0, at);
-        carry_to_rest(tool, spec, from, at, order.touching, rest_section);
+        carry_to_rest(tool, spec, from, at, order, rest_section);
     }
     std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[tool], rest_section);
     // Two-phase: the whole path marked since the first touch is cut at once.
@@ -116,7 +116,7 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
 }
 
 void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
-                              bool touching, std::vector<Eigen::Vector3d>& rest_section)
+                              const CutOrder& order, std::vector<Eigen::Vector3d>& rest_section)
 {
     Eigen::AlignedBox3d box;
     box.setEmpty();
@@ -132,7 +132,7 @@ void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const 
     const Eigen::Vector3d normal = at.orientation * Eigen::Vector3d::UnitY();
     if (m_stroke.size() <= tool) m_stroke.resize(tool + 1);
     StrokeCarry& stroke = m_stroke[tool];
-    stroke.untouched_s = touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
+    stroke.untouched_s = order.touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
     const bool goes_on = !m_previous_section[tool].empty() && stroke.going && normal.dot(stroke.normal) >= k_stroke_turn_cos &&
                          stroke.untouched_s < k_stroke_gap_s;
     if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0};
@@ -144,6 +144,8 @@ void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const 
     // staircase of sheets. The section is laid into the plane through the last one that
     // holds the edge and the way it moves (the blade's own plane when it moves along it).
     const bool edged = spec.shape == io::ToolShape::blade || spec.shape == io::ToolShape::scalpel;
+    // A two-phase tool marks while the object is held still: nothing gives way under its edge.
+    if (edged && order.cut && !order.marking) reach_past_edge(tool, at, spec.push_margin_mm, rest_section);
     const Eigen::Vector3d way = at.position - from.position_mm;
     if (goes_on && edged && way.allFinite() && way.norm() > 1e-9) {
         const Eigen::Vector3d swept = (at.orientation * Eigen::Vector3d::UnitX()).cross(way);
@@ -164,6 +166,44 @@ void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const 
         through /= on_edge;
         for (Eigen::Vector3d& p : rest_section) p -= stroke.cut_normal.dot(p - through) * stroke.cut_normal;
     }
+}
+
+void DbgMethod::reach_past_edge(std::size_t tool, const contact::PlacedShape& at, double margin_mm, std::vector<Eigen::Vector3d>& rest_section) const
+{
+    // The material an edge presses on is cut, not pushed ahead of it: carried by the material's
+    // mean displacement, a section that pushes a compliant object along stays where it was in
+    // rest space and cuts nothing more (a drooping slab was bent away under the blade, never cut
+    // through). So the section reaches just past the rest position of every surface point in the
+    // edge's contact zone (below the edge or less than the push margin above it, within the
+    // blade's length): half a voxel and a little more, across the centres of the voxels under
+    // that point. Pressed on, the cut goes a voxel deeper a frame; once the blade stops pressing,
+    // the cut stops about one contact zone below its edge.
+    if (!m_fresh[tool] || rest_section.empty()) return;
+    const Eigen::Quaterniond to_tool = at.orientation.conjugate();
+    double edge_z = std::numeric_limits<double>::infinity(); // the section's lowest side, tool frame
+    double x_min = edge_z, x_max = -edge_z;                  // and its extent along the edge
+    for (const Eigen::Vector3d& p : cut::section_polygon(*at.shape, 0.0, at)) {
+        const Eigen::Vector3d local = to_tool * (p - at.position);
+        edge_z = std::min(edge_z, local.z());
+        x_min = std::min(x_min, local.x());
+        x_max = std::max(x_max, local.x());
+    }
+    const Eigen::Vector3d h = 1e3 * m_grid->voxels().voxel_size_m();
+    const Eigen::Vector3d up = at.orientation * Eigen::Vector3d::UnitZ();
+    const double reach = 0.55 * h.dot(up.cwiseAbs()); // half a voxel's extent along `up`, and a little more
+    double section_low = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& p : rest_section) section_low = std::min(section_low, up.dot(p));
+    double deepest = section_low;
+    const cut::SurfaceContact& touch = m_touch[tool];
+    const std::vector<Eigen::Vector3d>& positions = m_sim->solver().positions();
+    for (const contact::PointContact& c : touch.contact.points) {
+        const std::uint32_t slot = touch.vertices[c.point];
+        const Eigen::Vector3d local = to_tool * (m_sim->surface().vertex_mm(slot, positions) - at.position);
+        if (local.z() > edge_z + margin_mm || local.x() < x_min || local.x() > x_max) continue;
+        deepest = std::min(deepest, up.dot(m_sim->surface().vertex_rest_mm(slot)) - reach);
+    }
+    if (deepest < section_low)
+        for (Eigen::Vector3d& p : rest_section) p -= (section_low - deepest) * up;
 }
 
 CutFigures DbgMethod::apply(std::vector<grid::Coord> removed, std::vector<std::pair<grid::Coord, int>> faces)

@@ -86,8 +86,11 @@ private:
     /// Carries a separating tool's section (world mm) back to rest space for this frame of its
     /// stroke: by the material's mean displacement around it, held across the blade's plane for
     /// the stroke, and laid into the plane its edge sweeps.
-    void carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at, bool touching,
-                       std::vector<Eigen::Vector3d>& rest_section);
+    void carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
+                       const CutOrder& order, std::vector<Eigen::Vector3d>& rest_section);
+    /// An edge cutting as it presses: the section reaches past the rest position of the surface
+    /// points the edge presses on.
+    void reach_past_edge(std::size_t tool, const contact::PlacedShape& at, double margin_mm, std::vector<Eigen::Vector3d>& rest_section) const;
     /// Applies one cut, logging it; the tools' contacts are carried over to the rebuilt model.
     CutFigures apply(std::vector<grid::Coord> removed, std::vector<std::pair<grid::Coord, int>> faces);
 

@@ -107,9 +107,11 @@ TEST(OneSheet, ADroopingSlabCutByATiltedBlade)
                      {{"t_s", 1.5}, {"tool", "blade"}, {"position_mm", {45.3, 20, -60}}, {"orientation_wxyz", q}}}),
         "slab.json");
     // Before the carry across the blade's plane was held for the stroke: 3,291 faces, 2,390
-    // parallel pairs, 29 pieces of which 9 slivers. The blade does not yet get through: the slab
-    // gives way under it and the cut follows the material (issue 22 goes on from here).
-    EXPECT_GT(n.faces, 40u) << "it cut into the slab";
+    // parallel pairs, 29 pieces of which 9 slivers. Before the section reached past what the edge
+    // presses: 73 faces (the slab bent away under the blade). Now about 275 of the section's 320:
+    // the blade's edge slopes, and the far piece, hanging by the last corner, swings under it and
+    // is pressed on its top, away from the cut.
+    EXPECT_GT(n.faces, 200u) << "it cut most of the way through the slab";
     EXPECT_EQ(n.sheets, 1u);
     EXPECT_EQ(n.parallel_pairs, 0u);
     EXPECT_EQ(n.slivers, 0u);
@@ -119,7 +121,8 @@ TEST(OneSheet, TheBundledLiverIncisionIsOneSheetLeavingOnePiece)
 {
     const test::SheetCount n =
         run_and_count(io::load_scene(VOX_SOURCE_DIR "/data/scenes/liver_incision.json"), "liver_incision.json");
-    // A 50 mm incision about 8 mm deep: about 400 mm^2 of 0.62 x 0.62 mm faces.
+    // A 50 mm incision about 8 mm deep: about 400 mm^2 of 0.62 x 0.62 mm faces, and up to one
+    // contact zone (1 mm) more under the edge (about 500 mm^2 are opened).
     const double area_mm2 = static_cast<double>(n.faces) * 0.617188 * 0.617188;
     EXPECT_GT(area_mm2, 250.0);
     EXPECT_LT(area_mm2, 600.0);
