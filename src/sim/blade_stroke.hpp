@@ -1,14 +1,15 @@
 #pragma once
-// Blades and scalpels cutting an Is-XFEM simulation along the surface their mid-plane (the tool's
-// x-z plane) sweeps. Each frame adds a flat patch to the stroke's swept surface
-// (isxfem/cut_surface.hpp): the convex hull of the blade's profile where the frame began and where
-// it ended, in the plane halfway between, carried back to rest space by the mean displacement of
-// the material around the blade (within the blade's plane only, once the stroke is going). A
-// stroke is one cut, one crack, while the blade goes on along its own plane: it may turn and tilt
-// as it goes (a curved incision, however far it comes round) by up to 10 degrees a frame, and
-// waver across its plane by up to 1 mm in all (that motion dropped, so the crack does not step
-// sideways); past that a new stroke, a new cut, begins. A tetrahedron the blade crosses whole
-// only over several frames is cut once it has been. The caller says what each frame's patch is for
+// Blades and scalpels cutting an Is-XFEM simulation along the surface their edges sweep. Each frame
+// adds a flat patch to the stroke's swept surface (isxfem/cut_surface.hpp): the convex hull of the
+// blade's profile where the frame began and where it ended, carried back to rest space by the mean
+// displacement of the material around the blade (only within the cut plane, once the stroke is
+// going) and laid into the plane the edge sweeps: the blade's own plane when it moves along it,
+// the plane holding its edge and the way it moves when it is held at a slant. A stroke is one cut,
+// one crack, while the blade goes on along that plane: it may turn and tilt as it goes (a curved
+// incision, however far it comes round) by up to 10 degrees a frame, and waver across the plane by
+// up to 1 mm in all (that motion dropped, so the crack does not step sideways); past that a new
+// stroke, a new cut, begins. A tetrahedron the blade crosses whole only over several frames is cut
+// once it has been. The caller says what each frame's patch is for
 // (cut now, marked for a two-phase cut, or only carrying the stroke on: sim/isxfem_method.cpp, as
 // the tool policy decides).
 
@@ -47,6 +48,7 @@ private:
     std::size_t m_offered = 0;              ///< patches the model has been asked to cut with
     int m_cut = -1;
     Eigen::Vector3d m_last_normal = Eigen::Vector3d::UnitY(); ///< the blade's plane where the last frame ended, world
+    Eigen::Vector3d m_cut_normal = Eigen::Vector3d::UnitY();  ///< of the plane the edge sweeps, world
     Eigen::Vector3d m_last_position_mm = Eigen::Vector3d::Zero(); ///< where the last frame ended, world
     Eigen::Vector3d m_last_rest_mm = Eigen::Vector3d::Zero();     ///< and in rest space
     Eigen::Vector3d m_last_moved_mm = Eigen::Vector3d::Zero();    ///< the material's displacement there

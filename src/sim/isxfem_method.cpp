@@ -98,10 +98,11 @@ CutFigures IsxfemMethod::follow(std::size_t tool, const io::ToolSpec& spec, cons
     if (spec.shape != io::ToolShape::blade && spec.shape != io::ToolShape::scalpel) return {};
     if (!m_strokes[tool]) m_strokes[tool].emplace(spec);
     BladeStroke& stroke = *m_strokes[tool];
-    if (!order.touching) { // let go (or not yet touching): the next touch starts anew
-        stroke.end();
-        return {};
-    }
+    // Not touching, the stroke waits: a blade that stays in its plane goes on with the same crack
+    // when it touches again (a drooping slab swinging away from a blade and back made a second
+    // crack beside the first). It ends when the tool leaves the scene (lift), turns or moves off
+    // its plane.
+    if (!order.touching) return {};
     // Marking, the stroke counts from the first touch (the object is held, so the material around
     // the blade has not moved since); otherwise it goes on through every frame the blade touches,
     // one crack, and cuts what the frames whose pressure held swept.

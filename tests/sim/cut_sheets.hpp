@@ -1,12 +1,19 @@
 #pragma once
-// What one stroke of a separating tool opened in the branched grid, as issue-level checks count
-// it: the sheets (opened faces joined across voxel edges), pairs of parallel opened faces one voxel
-// apart (a second sheet beside the first), and slivers (pieces of fewer than 27 voxels).
+// What one stroke of a separating tool opened, as issue-level checks count it. Branched grid: the
+// sheets (opened faces joined across voxel edges), pairs of parallel opened faces one voxel apart
+// (a second sheet beside the first), and slivers (pieces of fewer than 27 voxels). Is-XFEM: the
+// sheets (each crack's tetrahedra joined across the edges it crosses), tetrahedra cut twice along nearly
+// the same direction (a second crack beside the first), and slivers (closed pieces of the surface
+// enclosing less than 27 voxels' volume).
 
 #include "core/union_find.hpp"
 #include "grid/fine_voxels.hpp"
+#include "isxfem/xfem_model.hpp"
+#include "surface/embedded_surface.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <utility>
 #include <vector>
@@ -19,6 +26,7 @@ struct SheetCount {
     std::size_t parallel_pairs = 0; ///< same axis, same place across it, one voxel apart along it
     std::size_t pieces = 0;
     std::size_t slivers = 0;        ///< pieces of fewer than 27 voxels
+    std::size_t voxels = 0;         ///< alive voxels after the cut (branched grid)
 };
 
 /// `faces`: (voxel, axis) = the face between the voxel and its +axis neighbour.
@@ -57,6 +65,53 @@ inline SheetCount count_sheets(const grid::FineVoxels& voxels, const std::vector
         if (voxels.alive(v)) ++size[voxel_sets.find(v)];
     out.pieces = size.size();
     for (const auto& [r, n] : size) out.slivers += n < 27;
+    out.voxels = voxels.alive_count();
+    return out;
+}
+
+/// The same for an Is-XFEM model and its closed surface (world mm), `voxel_mm3` one voxel's volume.
+inline SheetCount count_cracks(const isxfem::XfemModel& model, const surface::SurfaceMesh& surface, double voxel_mm3)
+{
+    SheetCount out;
+    // Each crack's tetrahedra, joined where two share a face (three nodes).
+    std::map<int, std::vector<std::size_t>> cut_by;
+    for (std::size_t t = 0; t < model.elements().size(); ++t) {
+        const auto& cuts = model.elements()[t].cuts;
+        for (const isxfem::ElementCut& c : cuts) cut_by[c.id].push_back(t);
+        out.faces += cuts.size();
+        if (cuts.size() == 2 && std::abs(model.crack_normal(cuts[0].id, t).dot(model.crack_normal(cuts[1].id, t))) > 0.95)
+            ++out.parallel_pairs;
+    }
+    // Two of a crack's tetrahedra join where they share an edge the crack crosses (its nodes on
+    // the crack's two sides in both): their crack polygons meet on it.
+    for (const auto& [id, tets] : cut_by) {
+        UnionFind sets(tets.size());
+        std::map<std::array<std::uint32_t, 2>, std::size_t> edge_owner;
+        for (std::size_t k = 0; k < tets.size(); ++k) {
+            const isxfem::XfemElement& el = model.elements()[tets[k]];
+            const isxfem::ElementCut& cut = el.cuts[static_cast<std::size_t>(el.cut_index(id))];
+            for (std::size_t a = 0; a < 4; ++a)
+                for (std::size_t b = a + 1; b < 4; ++b) {
+                    if (cut.node_side[a] == cut.node_side[b]) continue;
+                    const std::array<std::uint32_t, 2> edge{std::min(el.node[a], el.node[b]), std::max(el.node[a], el.node[b])};
+                    const auto [it, fresh] = edge_owner.emplace(edge, k);
+                    if (!fresh) sets.unite(static_cast<std::uint32_t>(it->second), static_cast<std::uint32_t>(k));
+                }
+        }
+        for (std::size_t k = 0; k < tets.size(); ++k) out.sheets += sets.find(static_cast<std::uint32_t>(k)) == k;
+    }
+    // Pieces: the closed surface's connected parts, each with the volume it encloses.
+    UnionFind parts(surface.positions.size());
+    for (const Eigen::Vector3i& t : surface.triangles) {
+        parts.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]));
+        parts.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[2]));
+    }
+    std::map<std::uint32_t, double> volume;
+    for (const Eigen::Vector3i& t : surface.triangles)
+        volume[parts.find(static_cast<std::uint32_t>(t[0]))] +=
+            surface.positions[static_cast<std::size_t>(t[0])].dot(surface.positions[static_cast<std::size_t>(t[1])].cross(surface.positions[static_cast<std::size_t>(t[2])])) / 6.0;
+    out.pieces = volume.size();
+    for (const auto& [root, v] : volume) out.slivers += v < 27.0 * voxel_mm3;
     return out;
 }
 
