@@ -122,9 +122,24 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
     const double cell = static_cast<double>(1 << level);
 
-    // Dense numbering of the nodes the alive elements use.
+    // Dense numbering of the nodes the alive elements use. After a change, the nodes of the
+    // previous model that are still used keep their order and come first, new ones after them: a
+    // cut that only adds nodes (opening faces) keeps every old number, so the solver's
+    // preconditioner goes on with its factor and patches the rows the cut changed (a factor
+    // taken anew took about 130 ms on the liver at level 4).
     m_dense_node.assign(lv.node_users.size(), grid::no_index);
     std::size_t alive = 0;
+    if (previous) {
+        std::vector<unsigned char> used(lv.node_users.size(), 0);
+        for (const grid::Element& g : lv.elements)
+            if (g.alive)
+                for (std::uint32_t n : g.nodes) used[n] = 1;
+        for (std::uint32_t n : previous->m_grid_node)
+            if (n < used.size() && used[n] && m_dense_node[n] == grid::no_index) {
+                m_dense_node[n] = static_cast<std::uint32_t>(m_grid_node.size());
+                m_grid_node.push_back(n);
+            }
+    }
     for (std::uint32_t e = 0; e < lv.elements.size(); ++e) {
         if (!lv.elements[e].alive) continue;
         ++alive;

@@ -34,7 +34,8 @@ public:
     /// The same after a change of the grid: elements of `previous` (the model of the same level
     /// before the change) that `changed` does not flag (per grid element id of the level: created
     /// or updated by the change) keep their stiffness and mass instead of having them evaluated
-    /// from their moments again, the bulk of a rebuild after a cut.
+    /// from their moments again, the bulk of a rebuild after a cut. The nodes of `previous` still
+    /// in use keep their order and come first.
     HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed);
 
     [[nodiscard]] int level() const { return m_level; }

@@ -214,6 +214,18 @@ private:
     std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
     std::vector<Vector24d> m_element_force;           ///< per element, rotated elastic forces, N
     mutable std::vector<Vector24d> m_element_product; ///< matrix-free products, per element
+    /// Elements sharing one stiffness matrix (full cells of one material), up to k_batch at a time,
+    /// and each partial element on its own: the matrix-free product multiplies a batch's matrix
+    /// once by all its elements' vectors (a matrix-matrix product instead of k_batch
+    /// matrix-vector ones).
+    static constexpr int k_batch = 16;
+    struct ElementBatch {
+        const Matrix24d* stiffness = nullptr;
+        std::uint32_t first = 0, count = 0; ///< into m_batch_elements
+    };
+    std::vector<ElementBatch> m_batches;
+    std::vector<std::uint32_t> m_batch_elements;
+    void build_batches();
     bool m_matrix_current = false;                    ///< m_matrix holds the system being solved
     Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
     double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K

@@ -162,9 +162,12 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     const io::PreconditionerChoice old_choice = m_choice;
     build(Build::cut, old_model.get(), &report, old_solver.get());
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
-    if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 &&
-        old_model->grid_node() == m_model->grid_node()) {
-        // Every node kept its number: the factor goes on, patched where elements changed.
+    const std::vector<std::uint32_t>& old_nodes = old_model->grid_node();
+    const std::vector<std::uint32_t>& new_nodes = m_model->grid_node();
+    if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 && new_nodes.size() >= old_nodes.size() &&
+        std::equal(old_nodes.begin(), old_nodes.end(), new_nodes.begin())) {
+        // Every node kept its number (new ones come after them): the factor goes on, patched where
+        // elements changed and over the new nodes (fem/rest_cholesky.hpp).
         const std::vector<unsigned char> changed = changed_elements(grid, m_level, report);
         std::vector<std::uint32_t> nodes;
         for (const fem::HexElement& el : m_model->elements())
