@@ -9,13 +9,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <unordered_map>
 
 namespace vox::fem {
 
@@ -48,7 +45,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
     m_element_force.assign(model.elements().size(), Vector24d::Zero());
     m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
-    build_batches();
+    m_element_product.assign(model.elements().size(), Vector24d::Zero());
     if (same_mesh && same_mesh->m_options.matrix_free == m_options.matrix_free && same_connectivity(same_mesh->m_model, model)) {
         // A cut that changed element matrices only (a drill taking a voxel a frame): the
         // incidence and the matrix pattern are those of the previous solver.
@@ -61,51 +58,6 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
         return;
     }
     build_pattern();
-}
-
-void ImplicitSolver::build_batches()
-{
-    // Colours first: each element takes the lowest colour no element sharing a node with it has
-    // yet (eight on a plain grid, a few more where superimposed elements meet), so the elements of
-    // one colour can add into the nodes side by side.
-    const auto& elements = m_model.elements();
-    std::vector<std::uint64_t> node_colours(m_model.node_count(), 0);
-    std::vector<int> colour(elements.size(), 0);
-    int colours = 0;
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-        std::uint64_t taken = 0;
-        for (std::uint32_t n : elements[e].dof_node) taken |= node_colours[n];
-        if (~taken == 0) throw std::logic_error("ImplicitSolver: an element meets more than 63 others at its nodes");
-        colour[e] = std::countr_zero(~taken);
-        for (std::uint32_t n : elements[e].dof_node) node_colours[n] |= std::uint64_t{1} << colour[e];
-        colours = std::max(colours, colour[e] + 1);
-    }
-    // Then, colour by colour in element order (neighbours in space), each shared matrix's open
-    // batch filled up to k_batch.
-    m_batches.clear();
-    m_batch_elements.clear();
-    m_colour_start.assign(1, 0);
-    for (int c = 0; c < colours; ++c) {
-        std::unordered_map<const Matrix24d*, std::size_t> open;
-        std::vector<std::vector<std::uint32_t>> members;
-        std::vector<const Matrix24d*> matrix;
-        for (std::uint32_t e = 0; e < elements.size(); ++e) {
-            if (colour[e] != c) continue;
-            const Matrix24d* k = elements[e].stiffness;
-            auto it = open.find(k);
-            if (it == open.end() || members[it->second].size() == static_cast<std::size_t>(k_batch)) {
-                it = open.insert_or_assign(k, members.size()).first;
-                members.emplace_back();
-                matrix.push_back(k);
-            }
-            members[it->second].push_back(e);
-        }
-        for (std::size_t b = 0; b < members.size(); ++b) {
-            m_batches.push_back({matrix[b], static_cast<std::uint32_t>(m_batch_elements.size()), static_cast<std::uint32_t>(members[b].size())});
-            m_batch_elements.insert(m_batch_elements.end(), members[b].begin(), members[b].end());
-        }
-        m_colour_start.push_back(m_batches.size());
-    }
 }
 
 bool ImplicitSolver::same_connectivity(const HexModel& a, const HexModel& b)
@@ -246,6 +198,7 @@ void ImplicitSolver::update_active()
             }
         if (m_active[e]) continue;
         m_element_force[e].setZero();
+        m_element_product[e].setZero();
         m_element_energy[e] = 0.0;
     }
     m_active_current = true;
@@ -485,74 +438,37 @@ void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) co
     });
 }
 
-namespace {
-
-/// force(:, 0 .. n) = k local(:, 0 .. n), four columns at a time in twelve-row halves: each
-/// column of k is loaded once for four elements and the 12 x 4 sums stay in registers (a
-/// matrix-vector product per element loads the whole matrix for each: it was bound by those loads).
-template <int Batch>
-void stiffness_times(const Matrix24d& k, Eigen::Matrix<double, 24, Batch>& local, Eigen::Matrix<double, 24, Batch>& force, int n)
-{
-    const int columns = (n + 3) / 4 * 4;
-    for (int j = n; j < columns; ++j) local.col(j).setZero();
-    for (int j = 0; j < columns; j += 4)
-        for (int i = 0; i < 24; i += 12) {
-            Eigen::Matrix<double, 12, 4> sum = Eigen::Matrix<double, 12, 4>::Zero();
-            for (int c = 0; c < 24; ++c) sum.noalias() += k.template block<12, 1>(i, c) * local.template block<1, 4>(c, j);
-            force.template block<12, 4>(i, j) = sum;
-        }
-}
-
-} // namespace
-
 void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
     // out = m_scale M p + k_scale sum_e R K R^T p, element by element; held dofs map to themselves
-    // (CG keeps them zero in p). Each element's share (its stiffness and consistent mass terms) is
-    // taken batch by batch and added into its nodes at once, one colour at a time (elements of a
-    // colour share no node). Gathering the shares node by node afterwards read a vector per
-    // element back from memory, a fifth of the product's time on the FEM bench's beam.
+    // (CG keeps them zero in p).
     const auto& elements = m_model.elements();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t e = range.begin(); e != range.end(); ++e) {
+            if (!m_active[e]) continue;
+            const HexElement& el = elements[e];
+            const Eigen::Matrix3d& r = m_element_rotation[e];
+            Vector24d local;
+            for (int c = 0; c < 8; ++c)
+                local.segment<3>(3 * c) = r.transpose() * p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
+            const Vector24d fl = m_stiffness_scale[e] * ((*el.stiffness) * local);
+            for (int c = 0; c < 8; ++c) m_element_product[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
+        }
+    });
+    out.resize(p.size());
     const bool lumped = m_options.lumped_mass;
-    out.setZero(p.size());
-    for (std::size_t colour = 0; colour + 1 < m_colour_start.size(); ++colour) {
-        const tbb::blocked_range<std::size_t> batches(m_colour_start[colour], m_colour_start[colour + 1], 4);
-        tbb::parallel_for(batches, [&](const tbb::blocked_range<std::size_t>& range) {
-            Eigen::Matrix<double, 24, k_batch> local, force;
-            std::array<Eigen::Matrix<double, 8, 3>, k_batch> unrotated;
-            std::array<std::uint32_t, k_batch> which{};
-            for (std::size_t b = range.begin(); b != range.end(); ++b) {
-                const ElementBatch& batch = m_batches[b];
-                int n = 0;
-                for (std::uint32_t i = 0; i < batch.count; ++i) {
-                    const std::uint32_t e = m_batch_elements[batch.first + i];
-                    if (!m_active[e]) continue;
-                    const HexElement& el = elements[e];
-                    const Eigen::Matrix3d& r = m_element_rotation[e];
-                    for (int c = 0; c < 8; ++c) {
-                        const Eigen::Vector3d pc = p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
-                        unrotated[static_cast<std::size_t>(n)].row(c) = pc.transpose();
-                        local.col(n).segment<3>(3 * c) = r.transpose() * pc;
-                    }
-                    which[static_cast<std::size_t>(n++)] = e;
-                }
-                stiffness_times(*batch.stiffness, local, force, n);
-                for (int j = 0; j < n; ++j) {
-                    const std::uint32_t e = which[static_cast<std::size_t>(j)];
-                    const HexElement& el = elements[e];
-                    const Eigen::Matrix3d r = (m_k_scale * m_stiffness_scale[e]) * m_element_rotation[e];
-                    Eigen::Matrix<double, 8, 3> mass = Eigen::Matrix<double, 8, 3>::Zero();
-                    if (!lumped) mass.noalias() = m_m_scale * (el.mass * unrotated[static_cast<std::size_t>(j)]);
-                    for (int c = 0; c < 8; ++c)
-                        out.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += r * force.col(j).segment<3>(3 * c) + mass.row(c).transpose();
-                }
-            }
-        });
-    }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t n = range.begin(); n != range.end(); ++n) {
             const auto i = static_cast<Eigen::Index>(3 * n);
-            out.segment<3>(i) += m_m_scale * (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]) * p.segment<3>(i);
+            Eigen::Vector3d sum = Eigen::Vector3d::Zero(), mass = Eigen::Vector3d::Zero();
+            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
+                sum += m_element_product[e].segment<3>(3 * c);
+                if (!lumped)
+                    for (int d = 0; d < 8; ++d) mass += elements[e].mass(c, d) * p.segment<3>(3 * static_cast<Eigen::Index>(elements[e].dof_node[d]));
+            }
+            mass += (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]) * p.segment<3>(i);
+            out.segment<3>(i) = m_k_scale * sum + m_m_scale * mass;
             if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
                 out.segment<3>(i) += m_contact_scale * (m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m * p.segment<3>(i));
             for (int a = 0; a < 3; ++a)

@@ -213,19 +213,7 @@ private:
     std::vector<std::uint32_t> m_incidence;           ///< 8 element + corner, grouped by node
     std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
     std::vector<Vector24d> m_element_force;           ///< per element, rotated elastic forces, N
-    /// The matrix-free product's batches: elements sharing one stiffness matrix (full cells of one
-    /// material) up to k_batch at a time, each partial element on its own, grouped by colour
-    /// (elements of one colour share no node): a batch's matrix multiplies all its elements'
-    /// vectors at once, and a colour's elements add into their nodes side by side.
-    static constexpr int k_batch = 16;
-    struct ElementBatch {
-        const Matrix24d* stiffness = nullptr;
-        std::uint32_t first = 0, count = 0; ///< into m_batch_elements
-    };
-    std::vector<ElementBatch> m_batches;
-    std::vector<std::uint32_t> m_batch_elements;
-    std::vector<std::size_t> m_colour_start; ///< per colour, its first batch; then the end
-    void build_batches();
+    mutable std::vector<Vector24d> m_element_product; ///< matrix-free products, per element
     bool m_matrix_current = false;                    ///< m_matrix holds the system being solved
     Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
     double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K
