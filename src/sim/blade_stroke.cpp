@@ -35,13 +35,12 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
     // (its own plane when it moves along it). A blade held at a slant to the way it moves, as a
     // hand holds it, otherwise drifted across its own plane and started a new crack beside the
     // last about every millimetre (a staircase of cracks: 2 to 4 cracks through a sagging rod).
-    Eigen::Vector3d cut_normal = going ? m_cut_normal : normal;
-    if (going) {
-        const Eigen::Vector3d swept = to.orientation.toRotationMatrix().col(0).cross(step);
-        // Along its plane: the plane halfway through the frame's turn (a turning blade moves along that).
-        cut_normal = swept.norm() > 0.2 * step.norm() && step.norm() > 1e-9 ? Eigen::Vector3d(swept.normalized() * (swept.dot(normal) < 0.0 ? -1.0 : 1.0))
-                                                                             : Eigen::Vector3d((m_last_normal + normal).normalized());
-    }
+    // Moving along its plane, the plane halfway through the frame's turn (a turning blade moves
+    // along that).
+    const Eigen::Vector3d swept = to.orientation.toRotationMatrix().col(0).cross(step);
+    Eigen::Vector3d cut_normal = !going                                        ? normal
+                                 : swept.norm() > 0.2 * step.norm() && step.norm() > 1e-9 ? Eigen::Vector3d(swept.normalized() * (swept.dot(normal) < 0.0 ? -1.0 : 1.0))
+                                                                               : Eigen::Vector3d((m_last_normal + normal).normalized());
     const double across = step.dot(cut_normal);
     const bool goes_on = going && normal.dot(m_last_normal) >= k_max_frame_turn_cos && std::abs(m_drift_mm + across) <= k_max_drift_mm;
     m_drift_mm = goes_on ? m_drift_mm + across : 0.0;
@@ -51,7 +50,6 @@ isxfem::CutReport BladeStroke::advance(IsxfemSimulation& sim, const io::ToolPose
         m_cut = -1;
         cut_normal = normal;
     }
-    m_cut_normal = cut_normal;
     m_last_normal = normal;
     m_last_position_mm = to.position_mm;
     // The frame's patch: the profile where the frame began (where the blade was, if in the same

@@ -48,7 +48,6 @@ private:
     std::size_t m_offered = 0;              ///< patches the model has been asked to cut with
     int m_cut = -1;
     Eigen::Vector3d m_last_normal = Eigen::Vector3d::UnitY(); ///< the blade's plane where the last frame ended, world
-    Eigen::Vector3d m_cut_normal = Eigen::Vector3d::UnitY();  ///< of the plane the edge sweeps, world
     Eigen::Vector3d m_last_position_mm = Eigen::Vector3d::Zero(); ///< where the last frame ended, world
     Eigen::Vector3d m_last_rest_mm = Eigen::Vector3d::Zero();     ///< and in rest space
     Eigen::Vector3d m_last_moved_mm = Eigen::Vector3d::Zero();    ///< the material's displacement there
