@@ -41,7 +41,16 @@ struct PointContact {
     /// blade's edge head-on), a symmetric positive semidefinite stand-in otherwise (stable, slightly
     /// off in direction for a sphere touching at a slant).
     double stiffness_n_per_mm = 0.0;
+    /// Friction (obstacles: contact/obstacle.hpp) as a stiffness across the normal on the step's
+    /// displacement, N/mm; tools have none.
+    double tangent_stiffness_n_per_mm = 0.0;
     bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
+    /// The whole stiffness, N/mm: along the normal and across it (friction).
+    [[nodiscard]] Eigen::Matrix3d stiffness_matrix_n_per_mm() const
+    {
+        const Eigen::Matrix3d along = normal * normal.transpose();
+        return stiffness_n_per_mm * along + tangent_stiffness_n_per_mm * (Eigen::Matrix3d::Identity() - along);
+    }
 };
 
 struct ContactResult {

@@ -76,6 +76,22 @@ void area_and_normal(const ModelSurface& surface, std::uint32_t v, DeformedPosit
     if (normal.norm() > 0.0) normal *= surface.outward_sign() / normal.norm();
 }
 
+/// Renumbers `out`'s contact points to the vertex slots `inside` they index, and gathers their
+/// forces on the model's nodes.
+void gather_on_nodes(const ModelSurface& surface, const std::vector<std::uint32_t>& inside, SurfaceContact& out)
+{
+    for (contact::PointContact& c : out.contact.points) {
+        const std::uint32_t v = inside[c.point];
+        c.point = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(v);
+        out.keys.push_back(surface.embedded().vertices()[v].key);
+        out.elements.push_back(surface.vertex_element(v));
+    }
+    out.nodes = node_contacts(surface, out);
+    std::sort(out.elements.begin(), out.elements.end());
+    out.elements.erase(std::unique(out.elements.begin(), out.elements.end()), out.elements.end());
+}
+
 } // namespace
 
 SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
@@ -100,16 +116,44 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
     std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
     out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals, from);
-    for (contact::PointContact& c : out.contact.points) {
-        const std::uint32_t v = inside[c.point];
-        c.point = static_cast<std::uint32_t>(out.vertices.size());
-        out.vertices.push_back(v);
-        out.keys.push_back(surface.embedded().vertices()[v].key);
-        out.elements.push_back(surface.vertex_element(v));
+    gather_on_nodes(surface, inside, out);
+    return out;
+}
+
+SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                              const std::vector<Eigen::Vector3d>& node_velocities, const contact::Obstacle& obstacle, double dt_s)
+{
+    SurfaceContact out;
+    const fem::HexModel& model = surface.model();
+    std::vector<std::uint32_t> inside;
+    std::vector<Eigen::Vector3d> inside_mm;
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        for (std::uint32_t n : model.elements()[e].dof_node) box.extend(1e3 * node_positions[n]);
+        if (!obstacle.may_reach(box)) continue;
+        surface.for_each_element_vertex(e, [&](std::uint32_t v) {
+            const Eigen::Vector3d p = surface.vertex_mm(v, node_positions);
+            if (obstacle.signed_distance(p) >= 0.0) return;
+            inside.push_back(v);
+            inside_mm.push_back(p);
+        });
     }
-    out.nodes = node_contacts(surface, out);
-    std::sort(out.elements.begin(), out.elements.end());
-    out.elements.erase(std::unique(out.elements.begin(), out.elements.end()), out.elements.end());
+    if (inside.empty()) return out;
+    DeformedPositions position(surface, node_positions);
+    for (std::size_t i = 0; i < inside.size(); ++i) position.add(inside[i], inside_mm[i]);
+    std::vector<double> areas(inside.size(), 0.0);
+    std::vector<Eigen::Vector3d> velocities(inside.size(), Eigen::Vector3d::Zero());
+    Eigen::Vector3d normal;
+    for (std::size_t i = 0; i < inside.size(); ++i) {
+        const std::uint32_t v = inside[i];
+        area_and_normal(surface, v, position, areas[i], normal);
+        const fem::HexElement& el = model.elements()[surface.vertex_element(v)];
+        for (int corner = 0; corner < 8; ++corner)
+            velocities[i] += 1e3 * grid::hex8_shape(corner, surface.vertex_local(v)) * node_velocities[el.dof_node[corner]];
+    }
+    out.contact = contact::obstacle_contact(obstacle, inside_mm, areas, velocities, dt_s);
+    gather_on_nodes(surface, inside, out);
     return out;
 }
 
@@ -123,7 +167,7 @@ std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const S
         const std::uint32_t v = contact.vertices[c.point];
         if (v >= vertices.size() || vertices[v].users == 0 || vertices[v].key != contact.keys[c.point]) continue;
         const std::uint32_t e = surface.vertex_element(v);
-        const Eigen::Matrix3d k = 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose(); // N/m
+        const Eigen::Matrix3d k = 1e3 * c.stiffness_matrix_n_per_mm(); // N/m
         for (int corner = 0; corner < 8; ++corner) {
             const double w = grid::hex8_shape(corner, surface.vertex_local(v));
             if (w == 0.0) continue;

@@ -4,6 +4,7 @@
 // force shared by the corners of its element with the trilinear weights; the penalty stiffness
 // lumped the same way), ready for the solver's implicit contact.
 
+#include "contact/obstacle.hpp"
 #include "contact/penalty_contact.hpp"
 #include "cut/model_surface.hpp"
 #include "fem/implicit_solver.hpp"
@@ -28,6 +29,14 @@ struct SurfaceContact {
 [[nodiscard]] SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
                                            const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                                            const contact::PlacedShape* from = nullptr);
+
+/// Contact of the surface deformed by `node_positions` (m) and moving at `node_velocities` (m/s)
+/// with a static obstacle over a step of `dt_s` (contact::obstacle_contact): its penalty and
+/// friction gathered on the nodes. Only elements whose deformed corner box may reach into the
+/// obstacle are visited.
+[[nodiscard]] SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                                            const std::vector<Eigen::Vector3d>& node_velocities, const contact::Obstacle& obstacle,
+                                            double dt_s);
 
 /// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
 /// the corners of its element with the trilinear weights, the penalty stiffness lumped the same

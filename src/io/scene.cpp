@@ -43,6 +43,8 @@ constexpr NameTable<ToolShape, 5> tool_shapes{{{"blade", ToolShape::blade},
                                                {"mesh", ToolShape::mesh}}};
 constexpr NameTable<ToolAction, 4> tool_actions{
     {{"push", ToolAction::push}, {"cut", ToolAction::cut}, {"wet", ToolAction::wet}, {"drill", ToolAction::drill}}};
+constexpr NameTable<ObstacleShape, 3> obstacle_shapes{
+    {{"plane", ObstacleShape::plane}, {"box", ObstacleShape::box}, {"mesh", ObstacleShape::mesh}}};
 constexpr NameTable<CutMode, 2> cut_modes{{{"remove", CutMode::remove}, {"separate", CutMode::separate}}};
 
 // ---------------------------------------------------------------------------------------------
@@ -336,6 +338,7 @@ SceneObject read_object(JsonReader r)
                                                            {"leave_out", UnheldPieces::leave_out},
                                                            {"rigid", UnheldPieces::rigid}}};
         o.unheld = choose_enum(*node, names);
+        o.unheld_given = true;
     }
     r.finish("for a " + std::string(kind) + " object");
     return o;
@@ -489,6 +492,39 @@ Load read_load(JsonReader r)
     return l;
 }
 
+Obstacle read_obstacle(JsonReader r)
+{
+    Obstacle o;
+    const JsonNode shape = r.required_node("shape");
+    o.shape = choose_enum(shape, obstacle_shapes);
+    switch (o.shape) {
+    case ObstacleShape::plane: {
+        o.point_mm = finite_vector(r.required_node("point_mm"));
+        const JsonNode normal = r.required_node("normal");
+        o.normal = finite_vector(normal);
+        if (!(o.normal.norm() >= 1e-9)) normal.fail("has no direction (its length is below 1e-9)");
+        o.normal.normalize();
+        break;
+    }
+    case ObstacleShape::box: {
+        const JsonNode box = r.required_node("box_mm");
+        std::tie(o.box_min_mm, o.box_max_mm) = read_box(box);
+        if ((o.box_max_mm - o.box_min_mm).minCoeff() <= 0.0) box.fail("is flat (an obstacle box needs a thickness on every axis)");
+        break;
+    }
+    case ObstacleShape::mesh:
+        o.mesh = existing_file(r.required_node("mesh"));
+        if (const std::optional<JsonNode> node = r.optional_node("position_mm")) o.position_mm = finite_vector(*node);
+        if (const std::optional<JsonNode> node = r.optional_node("orientation_wxyz")) o.orientation = unit_quaternion(*node);
+        o.scale = r.optional("scale", o.scale, half_open_range(0.0, 1e6));
+        break;
+    }
+    o.friction = r.optional("friction", o.friction, closed_range(0.0, 10.0));
+    o.stiffness_n_per_mm = r.optional("stiffness_n_per_mm", o.stiffness_n_per_mm, half_open_range(0.0, 1e4));
+    r.finish("for a " + as<std::string>(shape) + " obstacle");
+    return o;
+}
+
 WetRegion read_wet_region(JsonReader r)
 {
     WetRegion w;
@@ -624,6 +660,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     const std::optional<JsonNode> solver = root.optional_node("solver");
     const std::optional<JsonNode> gravity = root.optional_node("gravity_m_s2");
     const std::optional<JsonNode> constraints = root.optional_node("constraints");
+    const std::optional<JsonNode> obstacles = root.optional_node("obstacles");
     const std::optional<JsonNode> loads = root.optional_node("loads");
     const std::optional<JsonNode> wet_regions = root.optional_node("wet_regions");
     const std::optional<JsonNode> tools = root.optional_node("tools");
@@ -654,6 +691,13 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     // "components": "held" and "unheld_pieces" need the boxes the constraints reach (any object kind).
     for (const Constraint& c : scene.constraints) {
         scene.object.select.pieces.held_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
+    }
+    if (obstacles) {
+        for (const JsonNode& node : obstacles->elements()) {
+            scene.obstacles.push_back(read_obstacle(JsonReader(node)));
+        }
+        // An object given something to rest on is let go onto it unless the file says otherwise.
+        if (!scene.obstacles.empty() && !scene.object.unheld_given) scene.object.unheld = UnheldPieces::fall;
     }
     if (loads) {
         for (const JsonNode& node : loads->elements()) {

@@ -64,8 +64,9 @@ struct SceneObject {
     /// whose measured step fits) or max_error (the coarsest level whose deflection differs from
     /// the next finer level's by at most this fraction); exactly one of the two is given.
     bool auto_levels = false;
-    /// Key "unheld_pieces".
+    /// Key "unheld_pieces"; unset: hold, or fall when the scene has obstacles (they catch it).
     UnheldPieces unheld = UnheldPieces::hold;
+    bool unheld_given = false; ///< the file set "unheld_pieces"
     /// Key "smooth_surface": the surface is smoothed at rest (windowed sinc, volume kept) so that
     /// slice terraces and voxel steps do not show; false keeps the voxel steps. Unset: see
     /// smooths_surface().
@@ -176,6 +177,34 @@ struct Constraint {
     /// two for slide (a roller holds the two axes across its rolling direction; a symmetry plane
     /// x = 0 holds x).
     std::array<bool, 3> held_axes{true, true, true};
+};
+
+enum class ObstacleShape { plane, box, mesh };
+
+/// A static, solid obstacle the object rests on or is pushed against (a table, a support, a
+/// tray); tools pass through it. Contact is the tools' penalty model with Coulomb friction
+/// (contact/obstacle.hpp): a flat face pressed 1 mm into it over 1 cm^2 is pushed back with
+/// stiffness_n_per_mm newtons.
+struct Obstacle {
+    ObstacleShape shape = ObstacleShape::plane;
+    /// plane: a point on it, world mm, and its unit normal (normalised when read); solid on the
+    /// side opposite the normal.
+    Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    /// box: its min and max corners, world mm; solid.
+    Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
+    /// mesh: a closed surface mesh, absolute path (it existed when read), solid inside; placed by
+    /// scaling its vertices by `scale`, turning by `orientation` and moving by `position_mm`.
+    std::filesystem::path mesh;
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+    double scale = 1.0;
+    /// Coulomb friction coefficient, [0, 10]: sliding along the obstacle is resisted by up to
+    /// friction x the normal force.
+    double friction = 0.3;
+    /// Penalty stiffness per cm^2 of contact, N/mm, in (0, 1e4].
+    double stiffness_n_per_mm = 10.0;
 };
 
 /// An external point force: a total force, world frame, shared equally by the nodes whose rest
@@ -320,6 +349,8 @@ struct Scene {
     /// Gravitational acceleration in the world frame, m/s^2.
     Eigen::Vector3d gravity_m_s2{0.0, 0.0, -9.81};
     std::vector<Constraint> constraints;
+    /// Static obstacles; none by default.
+    std::vector<Obstacle> obstacles;
     /// External point forces, constant in time; none by default.
     std::vector<Load> loads;
     /// Initial water content by region; none by default (dry).

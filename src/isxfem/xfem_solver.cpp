@@ -190,6 +190,15 @@ Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>&
     return p;
 }
 
+Eigen::Vector3d XfemSolver::velocity(std::size_t t, const std::array<double, 4>& n, int region) const
+{
+    const XfemElement& el = m_model.elements()[t];
+    const std::array<double, k_max_blocks> w = weights(t, n, region);
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    for (std::size_t a = 0; a < el.block_count(); ++a) v += w[a] * m_v[el.block(a)];
+    return v;
+}
+
 void XfemSolver::set_point_loads(std::vector<PointLoad> loads)
 {
     for (const PointLoad& l : loads)

@@ -104,6 +104,8 @@ public:
     /// World position of the material point with barycentric coordinates `n` in tetrahedron t, in
     /// region `region` when the tetrahedron is cut (one cut: 0 where phi < 0, 1 where phi >= 0).
     [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int region) const;
+    /// Velocity (m/s) of that material point.
+    [[nodiscard]] Eigen::Vector3d velocity(std::size_t t, const std::array<double, 4>& n, int region) const;
     [[nodiscard]] double kinetic_energy() const;
     [[nodiscard]] Eigen::Vector3d momentum() const;
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }

@@ -35,6 +35,7 @@ DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGr
 DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, std::unique_ptr<grid::BranchedGrid> grid, int level)
     : m_scene(scene), m_labels(std::move(labels)), m_level(level), m_grid_levels(grid->max_level()), m_grid(std::move(grid))
 {
+    m_obstacles = make_obstacles(m_scene);
     m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
     if (m_sim->held_piece_count() > 0)
         log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
@@ -272,6 +273,13 @@ void DbgMethod::end_tools()
         if (!m_touched[k]) continue;
         if (!m_fresh[k]) m_touch[k].nodes = cut::node_contacts(m_sim->surface(), m_touch[k]); // onto the rebuilt model's nodes
         cut::merge_node_contacts(nodes, m_touch[k].nodes);
+    }
+    m_obstacle_force.setZero();
+    for (const contact::Obstacle& o : m_obstacles) {
+        const cut::SurfaceContact c =
+            cut::touch_obstacle(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(), o, m_scene.solver.dt_s);
+        m_obstacle_force -= c.contact.force_on_tool_n;
+        cut::merge_node_contacts(nodes, c.nodes);
     }
     m_sim->solver().set_contact(std::move(nodes));
     m_sim->set_tool_reach(std::move(m_tool_reach));

@@ -7,6 +7,7 @@
 
 #include "cut/surface_contact.hpp"
 #include "sim/dbg_simulation.hpp"
+#include "sim/obstacles.hpp"
 #include "sim/method.hpp"
 
 #include <memory>
@@ -60,6 +61,7 @@ public:
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override;
     void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
     [[nodiscard]] std::size_t piece_count() const override;
+    [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
     void add_summary_figures(nlohmann::json& summary) const override;
 
     [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
@@ -103,6 +105,8 @@ private:
     std::vector<CutRecord> m_cuts;
     std::unordered_set<std::uint32_t> m_separated; ///< voxel slots with an opened face
     std::unordered_set<std::uint64_t> m_uncut;     ///< surface vertex keys before any cut
+    std::vector<contact::Obstacle> m_obstacles;
+    Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
     // Per tool, this frame and across frames.
     std::vector<cut::SurfaceContact> m_touch;
     std::vector<Eigen::AlignedBox3d> m_tool_reach; ///< this frame's tools, grown by k_sleep_tool_mm (DbgSimulation::set_tool_reach)

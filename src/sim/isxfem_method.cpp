@@ -48,6 +48,7 @@ IsxfemMethod::IsxfemMethod(const io::Scene& scene, std::shared_ptr<const grid::L
 {
     check_isxfem_scene(scene);
     m_grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *m_labels, std::max(level, 1)));
+    m_obstacles = make_obstacles(m_scene);
     m_sim = std::make_unique<IsxfemSimulation>(m_scene, *m_grid, level);
     if (m_sim->held_piece_count() > 0)
         log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
@@ -152,7 +153,15 @@ void IsxfemMethod::end_tools()
             const unsigned now = static_cast<unsigned>(m_sim->side_of(m_loads[i].tet, m_loads[i].bary));
             m_loads[i].side = static_cast<int>((static_cast<unsigned>(m_loads[i].side) & known) | (now & ~known));
         }
-    m_sim->solver().set_point_loads(m_loads);
+    // The obstacles press on the surface as the frame's cuts left it (their loads know every cut).
+    std::vector<isxfem::PointLoad> loads = m_loads;
+    m_obstacle_force.setZero();
+    for (const contact::Obstacle& o : m_obstacles) {
+        IsxfemSimulation::Touch t = m_sim->touch_obstacle(o, m_scene.solver.dt_s);
+        m_obstacle_force -= t.contact.force_on_tool_n;
+        loads.insert(loads.end(), t.loads.begin(), t.loads.end());
+    }
+    m_sim->solver().set_point_loads(std::move(loads));
     // The run's counts, and what the user is told once.
     const isxfem::CutReport& c = m_frame_cut;
     if (c.crossed_tets > 0 && m_crossed == 0)

@@ -10,6 +10,7 @@
 
 #include "sim/blade_stroke.hpp"
 #include "sim/isxfem_simulation.hpp"
+#include "sim/obstacles.hpp"
 #include "sim/method.hpp"
 
 #include <memory>
@@ -55,6 +56,7 @@ public:
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override { return m_sim->surface_keys(); }
     void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
     [[nodiscard]] std::size_t piece_count() const override;
+    [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
     void add_frame_figures(nlohmann::json& frame) const override;
     void add_summary_figures(nlohmann::json& summary) const override;
 
@@ -76,6 +78,8 @@ private:
     int m_level = 1;
     std::unique_ptr<grid::BranchedGrid> m_grid;
     std::unique_ptr<IsxfemSimulation> m_sim;
+    std::vector<contact::Obstacle> m_obstacles;
+    Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
     // Per tool.
     std::vector<std::optional<BladeStroke>> m_strokes; ///< blades and scalpels that cut
     std::vector<contact::ContactResult> m_contact;

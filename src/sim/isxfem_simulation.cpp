@@ -355,7 +355,25 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
     for (const contact::PointContact& c : out.contact.points) {
         const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
-        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_n_per_mm * c.normal * c.normal.transpose()});
+        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_matrix_n_per_mm()});
+    }
+    return out;
+}
+
+IsxfemSimulation::Touch IsxfemSimulation::touch_obstacle(const contact::Obstacle& obstacle, double dt_s) const
+{
+    const NearSurface s = near_surface(obstacle.bounds(), 0.0);
+    std::vector<Eigen::Vector3d> velocities;
+    velocities.reserve(s.near.size());
+    for (std::uint32_t k : s.near) {
+        const isxfem::SurfacePoint& v = (*s.vertices)[k];
+        velocities.push_back(1e3 * m_solver->velocity(v.tet, v.bary, v.side));
+    }
+    Touch out;
+    out.contact = contact::obstacle_contact(obstacle, s.positions, s.areas, velocities, dt_s);
+    for (const contact::PointContact& c : out.contact.points) {
+        const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
+        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_matrix_n_per_mm()});
     }
     return out;
 }

@@ -7,6 +7,7 @@
 // tetrahedron), closed along the cuts (isxfem/cut_closure.hpp): what tools touch, the haptic
 // loop samples and runs export.
 
+#include "contact/obstacle.hpp"
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
 #include "io/scene.hpp"
@@ -85,6 +86,10 @@ public:
     };
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                               const contact::PlacedShape* from = nullptr, double closed_walls_mm = 0.0) const;
+
+    /// The closed surface pressed against a static obstacle over a step of `dt_s`
+    /// (contact::obstacle_contact), with the forces as point loads.
+    [[nodiscard]] Touch touch_obstacle(const contact::Obstacle& obstacle, double dt_s) const;
 
     /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
     /// with its area and outward normal, and the triangles among them: the snapshot the haptic

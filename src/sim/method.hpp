@@ -115,7 +115,8 @@ public:
     /// A drilling tool removes up to `volume_mm3` (with what earlier frames left over) of the
     /// material it touches at `at`, the voxels nearest its body first.
     virtual CutFigures drill(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at, double volume_mm3) = 0;
-    /// The frame's contact forces go to the solver for the next step.
+    /// The frame's contact forces go to the solver for the next step, with those of the scene's
+    /// obstacles (sim/obstacles.hpp) pressing on the surface as the frame's cuts left it.
     virtual void end_tools() = 0;
 
     /// One time step (or, static scenes, the equilibrium).
@@ -143,6 +144,9 @@ public:
     virtual void add_summary_figures(nlohmann::json& /*summary*/) const {}
     /// Separate pieces of the object now.
     [[nodiscard]] virtual std::size_t piece_count() const = 0;
+    /// The force the scene's obstacles push the object with this frame, N (their friction left
+    /// out: it acts through the step, contact/obstacle.hpp).
+    [[nodiscard]] virtual Eigen::Vector3d obstacle_force_n() const = 0;
 
     /// The same object at another level, from rest: the branched grid keeps its cuts (replayed on
     /// the new level's grid); Is-XFEM starts uncut (its cuts live in the tetrahedra of one level).

@@ -1,0 +1,110 @@
+#include "contact/obstacle.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vox::contact {
+
+Obstacle Obstacle::plane(const Eigen::Vector3d& point_mm, const Eigen::Vector3d& normal)
+{
+    Obstacle o;
+    o.m_origin = point_mm;
+    o.m_normal = normal.normalized();
+    return o;
+}
+
+Obstacle Obstacle::box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
+{
+    Obstacle o;
+    o.m_shape = ToolShape::box(hi - lo);
+    o.m_origin = 0.5 * (lo + hi);
+    o.m_bounds = Eigen::AlignedBox3d(lo, hi);
+    return o;
+}
+
+Obstacle Obstacle::mesh(TriangleMesh world_mesh)
+{
+    if (world_mesh.triangles.empty()) throw InputError("obstacle mesh: it has no triangle");
+    Obstacle o;
+    o.m_bounds.setEmpty();
+    for (const Eigen::Vector3d& p : world_mesh.positions) o.m_bounds.extend(p);
+    o.m_shape = ToolShape::from_mesh(std::move(world_mesh));
+    return o;
+}
+
+double Obstacle::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
+{
+    if (!m_shape) {
+        if (gradient) *gradient = m_normal;
+        return (p - m_origin).dot(m_normal);
+    }
+    return m_shape->signed_distance(m_shape->kind() == ToolShape::Kind::box ? Eigen::Vector3d(p - m_origin) : p, gradient);
+}
+
+bool Obstacle::may_reach(const Eigen::AlignedBox3d& box) const
+{
+    if (box.isEmpty()) return false;
+    if (m_shape) return box.intersects(m_bounds);
+    // The box's corner farthest along -normal is its deepest point.
+    Eigen::Vector3d deepest;
+    for (int a = 0; a < 3; ++a) deepest[a] = m_normal[a] > 0.0 ? box.min()[a] : box.max()[a];
+    return (deepest - m_origin).dot(m_normal) < 0.0;
+}
+
+Eigen::AlignedBox3d Obstacle::bounds() const
+{
+    if (m_shape) return m_bounds;
+    const double far = std::numeric_limits<double>::max();
+    return {Eigen::Vector3d::Constant(-far), Eigen::Vector3d::Constant(far)};
+}
+
+TriangleMesh Obstacle::drawing_mesh(const Eigen::Vector3d& centre_mm, double extent_mm) const
+{
+    if (m_shape) {
+        TriangleMesh m = m_shape->mesh();
+        if (m_shape->kind() == ToolShape::Kind::box)
+            for (Eigen::Vector3d& p : m.positions) p += m_origin;
+        return m;
+    }
+    const Eigen::Vector3d foot = centre_mm - (centre_mm - m_origin).dot(m_normal) * m_normal;
+    const Eigen::Vector3d u = m_normal.unitOrthogonal(), v = m_normal.cross(u);
+    TriangleMesh m;
+    for (const double su : {-1.0, 1.0})
+        for (const double sv : {-1.0, 1.0}) m.positions.push_back(foot + extent_mm * (su * u + sv * v));
+    m.triangles = {{0, 1, 3}, {0, 3, 2}}; // (u x v) = normal: counter-clockwise seen from the free side
+    return m;
+}
+
+ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::Vector3d> points, std::span<const double> areas,
+                               std::span<const Eigen::Vector3d> velocities_mm_s, double dt_s)
+{
+    ContactResult out;
+    Eigen::Vector3d total = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        Eigen::Vector3d g;
+        const double depth = -obstacle.signed_distance(points[i], &g);
+        if (!(depth > 0.0)) continue;
+        const double k = obstacle.stiffness_n_per_mm / 100.0 * areas[i]; // per mm^2 of contact
+        PointContact c;
+        c.point = static_cast<std::uint32_t>(i);
+        c.depth_mm = depth;
+        c.normal = g;
+        c.stiffness_n_per_mm = k;
+        c.force_n = k * depth * g;
+        const Eigen::Vector3d& v = velocities_mm_s[i];
+        const double slide = (v - v.dot(g) * g).norm();
+        c.tangent_stiffness_n_per_mm = obstacle.friction * k * depth / std::max(slide, k_stick_speed_mm_s) / dt_s;
+        total += c.force_n;
+        out.area_mm2 += areas[i];
+        out.points.push_back(c);
+    }
+    out.force_on_tool_n = -total;
+    out.load_area_mm2 = out.area_mm2;
+    if (out.area_mm2 > 0.0) out.pressure_pa = total.norm() / out.area_mm2 * 1e6;
+    return out;
+}
+
+} // namespace vox::contact

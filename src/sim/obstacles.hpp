@@ -1,0 +1,29 @@
+#pragma once
+// The scene's obstacles (io::Obstacle) as contact shapes, and what `check` says of them. Both
+// methods press their surface against them every frame (contact/obstacle.hpp); pictures and the
+// viewer draw them.
+
+#include "contact/obstacle.hpp"
+#include "io/scene.hpp"
+#include "surface/embedded_surface.hpp"
+
+#include <string>
+#include <vector>
+
+namespace vox::sim {
+
+/// The scene's obstacles, meshes read, scaled, turned and placed. Throws the scene's InputError
+/// naming obstacles[i].mesh for a mesh that cannot be read, has no triangle or is not closed and
+/// consistently oriented (its inside would not be defined).
+[[nodiscard]] std::vector<contact::Obstacle> make_obstacles(const io::Scene& scene);
+
+/// The triangles to draw for every obstacle, world mm: planes as squares around `bounds` (the
+/// object's box) reaching well beyond it.
+[[nodiscard]] contact::TriangleMesh obstacles_mesh(const std::vector<contact::Obstacle>& obstacles, const Eigen::AlignedBox3d& bounds);
+
+/// One line per obstacle the surface (world mm) starts inside: how many of its vertices and how
+/// deep the deepest; empty when none does.
+[[nodiscard]] std::vector<std::string> obstacle_overlaps(const io::Scene& scene, const std::vector<contact::Obstacle>& obstacles,
+                                                         const surface::SurfaceMesh& surface);
+
+} // namespace vox::sim
