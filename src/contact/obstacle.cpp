@@ -79,9 +79,11 @@ TriangleMesh Obstacle::drawing_mesh(const Eigen::Vector3d& centre_mm, double ext
 }
 
 ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::Vector3d> points, std::span<const double> areas,
-                               std::span<const Eigen::Vector3d> velocities_mm_s, double dt_s)
+                               std::span<const Eigen::Vector3d> velocities_mm_s, double dt_s, std::span<const std::uint64_t> keys,
+                               FrictionAnchors& anchors)
 {
     ContactResult out;
+    FrictionAnchors held;
     Eigen::Vector3d total = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < points.size(); ++i) {
         Eigen::Vector3d g;
@@ -94,13 +96,32 @@ ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::
         c.normal = g;
         c.stiffness_n_per_mm = k;
         c.force_n = k * depth * g;
-        const Eigen::Vector3d& v = velocities_mm_s[i];
-        const double slide = (v - v.dot(g) * g).norm();
-        c.tangent_stiffness_n_per_mm = obstacle.friction * k * depth / std::max(slide, k_stick_speed_mm_s) / dt_s;
+        // Friction: the spring to the anchor, across the normal, slipping beyond mu |f_n|.
+        const auto found = anchors.find(keys[i]);
+        Eigen::Vector3d anchor = found == anchors.end() ? points[i] : found->second;
+        const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - g * g.transpose();
+        const Eigen::Vector3d stretch = across * (points[i] - anchor);
+        const double limit = obstacle.friction * k * depth; // mu |f_n|
+        // The spring reaches the limit over the larger of k_stick_give_mm and the step's expected
+        // slide: within one step it cannot pull much beyond mu |f_n|.
+        const double slide = (across * velocities_mm_s[i]).norm() * dt_s;
+        const double spring = std::min(k, limit / std::max(k_stick_give_mm, slide));
+        const double pull = spring * stretch.norm();
+        if (pull <= limit) {
+            c.force_n -= spring * stretch;
+            c.friction_stiffness_n_per_mm = spring * across;
+        } else { // slips: the anchor follows at the distance where the spring pulls with mu |f_n|
+            const Eigen::Vector3d way = stretch / stretch.norm();
+            anchor = points[i] - (limit / spring) * way;
+            c.force_n -= limit * way;
+            c.friction_stiffness_n_per_mm = spring * (across - way * way.transpose());
+        }
+        held.emplace(keys[i], anchor);
         total += c.force_n;
         out.area_mm2 += areas[i];
         out.points.push_back(c);
     }
+    anchors = std::move(held);
     out.force_on_tool_n = -total;
     out.load_area_mm2 = out.area_mm2;
     if (out.area_mm2 > 0.0) out.pressure_pa = total.norm() / out.area_mm2 * 1e6;

@@ -8,14 +8,18 @@
 // stiffness_n_per_mm. Unlike a tool's, the push follows the obstacle's normal, not the object's:
 // a table pushes up under the rounded edge of an organ, not sideways.
 //
-// Friction is Coulomb's, regularised and lagged (as incremental potential contact lags it): a
-// point sliding at tangential speed |v_t| is resisted by a viscous force -c v_t with
-// c = mu |f_n| / max(|v_t|, k_stick_speed_mm_s), both f_n and |v_t| taken at the frame's start.
-// Sliding, the force is mu |f_n| against the motion; nearly at rest, it is a stiff damper that
-// holds the point (it creeps at most at k_stick_speed_mm_s under a tangential load equal to the
-// friction limit). The solver takes the damper implicitly, as a tangential stiffness c / dt on
-// the step's displacement (displacement over the step = dt v at its end), so it is stable
-// however large c is.
+// Friction is Coulomb's, as a stick-slip spring (the penalty friction of haptic rendering): a
+// point that comes into contact is tied to an anchor where it touched by a spring across the
+// normal. While the spring pulls with at most mu |f_n| the point sticks; beyond, it slips: the
+// anchor is dragged behind it at the distance where the spring pulls with exactly mu |f_n|. A
+// sticking point gives at most k_stick_give_mm before it slips, and under a smaller load does
+// not move at all: no creep. The solver takes the spring implicitly (stick: its stiffness across
+// the normal; slip: across the normal and the slip, the derivative of a force of fixed size), so
+// a point that stops sliding cannot be thrown back: it lands on its spring. One linear solve a
+// step cannot switch between stick and slip within the step, so the spring is made soft enough
+// that the step's expected slide (the point's speed at the step's start times dt) stretches it
+// to mu |f_n| at most: the step neither holds a sliding point much beyond Coulomb's force nor
+// lets it go much before.
 
 #include "contact/penalty_contact.hpp"
 #include "contact/tool_shape.hpp"
@@ -23,13 +27,19 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <optional>
+#include <unordered_map>
 #include <span>
 
 namespace vox::contact {
 
-/// Below this tangential speed friction holds a point (mm/s); see the header.
-inline constexpr double k_stick_speed_mm_s = 1.0;
+/// Where each surface point touching an obstacle is anchored (world mm), by the point's identity
+/// (a method's key of a material point, the same from frame to frame): friction's memory.
+using FrictionAnchors = std::unordered_map<std::uint64_t, Eigen::Vector3d>;
+
+/// How far a sticking point gives before it slips, mm (see the header).
+inline constexpr double k_stick_give_mm = 0.01;
 
 class Obstacle {
 public:
@@ -63,11 +73,14 @@ private:
     Eigen::AlignedBox3d m_bounds;                      ///< box and mesh
 };
 
-/// Contact of surface points (world mm, each carrying `areas[i]` mm^2 and moving at
-/// `velocities_mm_s[i]`) with `obstacle` over a step of `dt_s`: the normal penalty and the
-/// friction of the header, each point's stiffness along its normal and its friction's
-/// tangential stiffness. Points outside are skipped. force_on_tool_n is the force on the obstacle.
+/// Contact of surface points (world mm, each carrying `areas[i]` mm^2, moving at
+/// `velocities_mm_s[i]`, identified by `keys[i]`) with `obstacle` for a step of `dt_s`: the
+/// normal penalty and the friction of the header, each point's force and
+/// stiffness. `anchors` holds the anchors of the last call and receives this call's (points no
+/// longer touching let go). Points outside are skipped. force_on_tool_n is the force on the
+/// obstacle, friction included.
 [[nodiscard]] ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::Vector3d> points,
-                                             std::span<const double> areas, std::span<const Eigen::Vector3d> velocities_mm_s, double dt_s);
+                                             std::span<const double> areas, std::span<const Eigen::Vector3d> velocities_mm_s,
+                                             double dt_s, std::span<const std::uint64_t> keys, FrictionAnchors& anchors);
 
 } // namespace vox::contact

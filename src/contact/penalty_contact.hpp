@@ -41,15 +41,14 @@ struct PointContact {
     /// blade's edge head-on), a symmetric positive semidefinite stand-in otherwise (stable, slightly
     /// off in direction for a sphere touching at a slant).
     double stiffness_n_per_mm = 0.0;
-    /// Friction (obstacles: contact/obstacle.hpp) as a stiffness across the normal on the step's
-    /// displacement, N/mm; tools have none.
-    double tangent_stiffness_n_per_mm = 0.0;
+    /// Friction's stiffness across the normal, N/mm (obstacles: contact/obstacle.hpp; tools have
+    /// none): symmetric, positive semidefinite.
+    Eigen::Matrix3d friction_stiffness_n_per_mm = Eigen::Matrix3d::Zero();
     bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
     /// The whole stiffness, N/mm: along the normal and across it (friction).
     [[nodiscard]] Eigen::Matrix3d stiffness_matrix_n_per_mm() const
     {
-        const Eigen::Matrix3d along = normal * normal.transpose();
-        return stiffness_n_per_mm * along + tangent_stiffness_n_per_mm * (Eigen::Matrix3d::Identity() - along);
+        return stiffness_n_per_mm * normal * normal.transpose() + friction_stiffness_n_per_mm;
     }
 };
 

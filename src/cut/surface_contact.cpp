@@ -121,7 +121,8 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
 }
 
 SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                              const std::vector<Eigen::Vector3d>& node_velocities, const contact::Obstacle& obstacle, double dt_s)
+                              const std::vector<Eigen::Vector3d>& node_velocities, double dt_s, const contact::Obstacle& obstacle,
+                              contact::FrictionAnchors& anchors)
 {
     SurfaceContact out;
     const fem::HexModel& model = surface.model();
@@ -143,16 +144,18 @@ SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eig
     DeformedPositions position(surface, node_positions);
     for (std::size_t i = 0; i < inside.size(); ++i) position.add(inside[i], inside_mm[i]);
     std::vector<double> areas(inside.size(), 0.0);
+    std::vector<std::uint64_t> keys(inside.size());
     std::vector<Eigen::Vector3d> velocities(inside.size(), Eigen::Vector3d::Zero());
     Eigen::Vector3d normal;
     for (std::size_t i = 0; i < inside.size(); ++i) {
         const std::uint32_t v = inside[i];
         area_and_normal(surface, v, position, areas[i], normal);
+        keys[i] = surface.embedded().vertices()[v].key;
         const fem::HexElement& el = model.elements()[surface.vertex_element(v)];
         for (int corner = 0; corner < 8; ++corner)
             velocities[i] += 1e3 * grid::hex8_shape(corner, surface.vertex_local(v)) * node_velocities[el.dof_node[corner]];
     }
-    out.contact = contact::obstacle_contact(obstacle, inside_mm, areas, velocities, dt_s);
+    out.contact = contact::obstacle_contact(obstacle, inside_mm, areas, velocities, dt_s, keys, anchors);
     gather_on_nodes(surface, inside, out);
     return out;
 }

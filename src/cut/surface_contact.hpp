@@ -31,12 +31,12 @@ struct SurfaceContact {
                                            const contact::PlacedShape* from = nullptr);
 
 /// Contact of the surface deformed by `node_positions` (m) and moving at `node_velocities` (m/s)
-/// with a static obstacle over a step of `dt_s` (contact::obstacle_contact): its penalty and
-/// friction gathered on the nodes. Only elements whose deformed corner box may reach into the
-/// obstacle are visited.
+/// with a static obstacle for a step of `dt_s` (contact::obstacle_contact; `anchors` its
+/// friction's, by surface vertex key): its penalty and friction gathered on the nodes. Only
+/// elements whose deformed corner box may reach into the obstacle are visited.
 [[nodiscard]] SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                            const std::vector<Eigen::Vector3d>& node_velocities, const contact::Obstacle& obstacle,
-                                            double dt_s);
+                                            const std::vector<Eigen::Vector3d>& node_velocities, double dt_s,
+                                            const contact::Obstacle& obstacle, contact::FrictionAnchors& anchors);
 
 /// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
 /// the corners of its element with the trilinear weights, the penalty stiffness lumped the same

@@ -36,6 +36,7 @@ DbgMethod::DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGr
     : m_scene(scene), m_labels(std::move(labels)), m_level(level), m_grid_levels(grid->max_level()), m_grid(std::move(grid))
 {
     m_obstacles = make_obstacles(m_scene);
+    m_anchors.resize(m_obstacles.size());
     m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
     if (m_sim->held_piece_count() > 0)
         log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
@@ -275,9 +276,9 @@ void DbgMethod::end_tools()
         cut::merge_node_contacts(nodes, m_touch[k].nodes);
     }
     m_obstacle_force.setZero();
-    for (const contact::Obstacle& o : m_obstacles) {
-        const cut::SurfaceContact c =
-            cut::touch_obstacle(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(), o, m_scene.solver.dt_s);
+    for (std::size_t k = 0; k < m_obstacles.size(); ++k) {
+        const cut::SurfaceContact c = cut::touch_obstacle(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(),
+                                                          m_scene.solver.dt_s, m_obstacles[k], m_anchors[k]);
         m_obstacle_force -= c.contact.force_on_tool_n;
         cut::merge_node_contacts(nodes, c.nodes);
     }

@@ -106,6 +106,7 @@ private:
     std::unordered_set<std::uint32_t> m_separated; ///< voxel slots with an opened face
     std::unordered_set<std::uint64_t> m_uncut;     ///< surface vertex keys before any cut
     std::vector<contact::Obstacle> m_obstacles;
+    std::vector<contact::FrictionAnchors> m_anchors; ///< per obstacle
     Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
     // Per tool, this frame and across frames.
     std::vector<cut::SurfaceContact> m_touch;

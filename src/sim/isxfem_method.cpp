@@ -49,6 +49,7 @@ IsxfemMethod::IsxfemMethod(const io::Scene& scene, std::shared_ptr<const grid::L
     check_isxfem_scene(scene);
     m_grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *m_labels, std::max(level, 1)));
     m_obstacles = make_obstacles(m_scene);
+    m_anchors.resize(m_obstacles.size());
     m_sim = std::make_unique<IsxfemSimulation>(m_scene, *m_grid, level);
     if (m_sim->held_piece_count() > 0)
         log::info("{}: {} piece(s) held by no constraint stay where they are (object.unheld_pieces \"hold\"; "
@@ -156,8 +157,8 @@ void IsxfemMethod::end_tools()
     // The obstacles press on the surface as the frame's cuts left it (their loads know every cut).
     std::vector<isxfem::PointLoad> loads = m_loads;
     m_obstacle_force.setZero();
-    for (const contact::Obstacle& o : m_obstacles) {
-        IsxfemSimulation::Touch t = m_sim->touch_obstacle(o, m_scene.solver.dt_s);
+    for (std::size_t k = 0; k < m_obstacles.size(); ++k) {
+        IsxfemSimulation::Touch t = m_sim->touch_obstacle(m_obstacles[k], m_scene.solver.dt_s, m_anchors[k]);
         m_obstacle_force -= t.contact.force_on_tool_n;
         loads.insert(loads.end(), t.loads.begin(), t.loads.end());
     }

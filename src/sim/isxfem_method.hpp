@@ -79,6 +79,7 @@ private:
     std::unique_ptr<grid::BranchedGrid> m_grid;
     std::unique_ptr<IsxfemSimulation> m_sim;
     std::vector<contact::Obstacle> m_obstacles;
+    std::vector<contact::FrictionAnchors> m_anchors; ///< per obstacle
     Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
     // Per tool.
     std::vector<std::optional<BladeStroke>> m_strokes; ///< blades and scalpels that cut

@@ -360,17 +360,24 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     return out;
 }
 
-IsxfemSimulation::Touch IsxfemSimulation::touch_obstacle(const contact::Obstacle& obstacle, double dt_s) const
+IsxfemSimulation::Touch IsxfemSimulation::touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors) const
 {
     const NearSurface s = near_surface(obstacle.bounds(), 0.0);
+    // A material point is its rest position (to 1 nm) and side: the same point after a cut.
+    std::vector<std::uint64_t> keys;
     std::vector<Eigen::Vector3d> velocities;
+    keys.reserve(s.near.size());
     velocities.reserve(s.near.size());
     for (std::uint32_t k : s.near) {
         const isxfem::SurfacePoint& v = (*s.vertices)[k];
         velocities.push_back(1e3 * m_solver->velocity(v.tet, v.bary, v.side));
+        std::uint64_t key = static_cast<std::uint64_t>(v.side);
+        for (int a = 0; a < 3; ++a)
+            key = key * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(std::llround(v.rest_m[a] * 1e9));
+        keys.push_back(key);
     }
     Touch out;
-    out.contact = contact::obstacle_contact(obstacle, s.positions, s.areas, velocities, dt_s);
+    out.contact = contact::obstacle_contact(obstacle, s.positions, s.areas, velocities, dt_s, keys, anchors);
     for (const contact::PointContact& c : out.contact.points) {
         const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
         out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_matrix_n_per_mm()});

@@ -87,9 +87,10 @@ public:
     [[nodiscard]] Touch touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                               const contact::PlacedShape* from = nullptr, double closed_walls_mm = 0.0) const;
 
-    /// The closed surface pressed against a static obstacle over a step of `dt_s`
-    /// (contact::obstacle_contact), with the forces as point loads.
-    [[nodiscard]] Touch touch_obstacle(const contact::Obstacle& obstacle, double dt_s) const;
+    /// The closed surface pressed against a static obstacle for a step of `dt_s`
+    /// (contact::obstacle_contact; `anchors` its friction's, by material point: rest position and
+    /// side), with the forces as point loads.
+    [[nodiscard]] Touch touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors) const;
 
     /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
     /// with its area and outward normal, and the triangles among them: the snapshot the haptic
