@@ -7,6 +7,7 @@
 #include "io/scene.hpp"
 #include "io/piece_selection.hpp"
 #include "io/scene_object.hpp"
+#include "sim/obstacles.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -93,6 +94,7 @@ void add_check_command(CLI::App& app)
                             static_cast<unsigned long long>(n), m.youngs_modulus_pa, m.poisson_ratio, m.density_kg_m3);
         }
         list_pieces(scene, labels, *path);
+        for (const std::string& line : sim::obstacle_overlaps(scene, sim::make_obstacles(scene), labels)) log::warn("{}", line);
         if (scene.object.auto_levels) {
             if (scene.object.step_budget_ms)
                 std::printf("level: auto, the finest whose whole frames (tools, cuts, step) fit %g ms\n", *scene.object.step_budget_ms);
@@ -105,8 +107,8 @@ void add_check_command(CLI::App& app)
         std::printf("solver: %s, dt %g s, CG tolerance %g, at most %d iterations\n",
                     scene.solver.type == io::SolverType::dbg ? "dbg" : "isxfem", scene.solver.dt_s,
                     scene.solver.cg_tolerance, scene.solver.cg_max_iterations);
-        std::printf("constraints: %zu, tools: %zu, script: %zu key frames", scene.constraints.size(), scene.tools.size(),
-                    scene.script.size());
+        std::printf("constraints: %zu, obstacles: %zu, tools: %zu, script: %zu key frames", scene.constraints.size(),
+                    scene.obstacles.size(), scene.tools.size(), scene.script.size());
         if (!scene.script.empty()) std::printf(" over %g s", scene.script.back().t_s - scene.script.front().t_s);
         std::printf("\noutput: %s\n", scene.output.dir.string().c_str());
     });

@@ -16,6 +16,7 @@ struct DrawMesh {
     std::vector<std::uint32_t> indices;     ///< triangles (three per), or line segments (two per)
     float alpha = 1.0f;                     ///< below 1: blended over the opaque meshes
     bool lines = false;                     ///< indices are segments, drawn unlit
+    bool frames_camera = true;              ///< a picture's camera is framed on it (not on a table reaching far beyond the object)
 };
 
 /// Area-weighted vertex normals of a triangle mesh (into mesh.normals).

@@ -61,6 +61,7 @@ public:
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override;
     void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
     [[nodiscard]] std::size_t piece_count() const override;
+    [[nodiscard]] const std::vector<contact::Obstacle>& obstacles() const override { return m_obstacles; }
     [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
     void add_summary_figures(nlohmann::json& summary) const override;
 

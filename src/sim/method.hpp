@@ -11,6 +11,7 @@
 // swept geometry carried to its rest space) and *how* (voxels removed or faces opened,
 // tetrahedra enriched).
 
+#include "contact/obstacle.hpp"
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
@@ -144,8 +145,9 @@ public:
     virtual void add_summary_figures(nlohmann::json& /*summary*/) const {}
     /// Separate pieces of the object now.
     [[nodiscard]] virtual std::size_t piece_count() const = 0;
-    /// The force the scene's obstacles push the object with this frame, N (their friction left
-    /// out: it acts through the step, contact/obstacle.hpp).
+    /// The scene's obstacles (sim/obstacles.hpp), and the force they push the object with this
+    /// frame, N, friction included.
+    [[nodiscard]] virtual const std::vector<contact::Obstacle>& obstacles() const = 0;
     [[nodiscard]] virtual Eigen::Vector3d obstacle_force_n() const = 0;
 
     /// The same object at another level, from rest: the branched grid keeps its cuts (replayed on

@@ -66,25 +66,26 @@ contact::TriangleMesh obstacles_mesh(const std::vector<contact::Obstacle>& obsta
 }
 
 std::vector<std::string> obstacle_overlaps(const io::Scene& scene, const std::vector<contact::Obstacle>& obstacles,
-                                           const surface::SurfaceMesh& surface)
+                                           const grid::LabelGrid& labels)
 {
     std::vector<std::string> out;
+    const double half = 0.5 * labels.voxel_size().minCoeff();
     for (std::size_t i = 0; i < obstacles.size(); ++i) {
         std::size_t inside = 0;
         double deepest = 0.0;
-        for (const Eigen::Vector3d& p : surface.positions) {
-            const double d = obstacles[i].signed_distance(p);
+        labels.for_each_active([&](const grid::Coord& ijk, std::int32_t) {
+            const double d = obstacles[i].signed_distance(labels.index_to_world(ijk.cast<double>())) - half;
             if (d < 0.0) {
                 ++inside;
                 deepest = std::max(deepest, -d);
             }
-        }
+        });
         if (inside == 0) continue;
-        char text[256];
+        char text[320];
         std::snprintf(text, sizeof text,
-                      "%s: obstacles[%zu]: the object starts inside it (%zu of %zu surface vertices, up to %.3g mm deep); "
-                      "the first frames push it out",
-                      scene.source.c_str(), i, inside, surface.positions.size(), deepest);
+                      "%s: obstacles[%zu]: the object starts inside it (%zu of %llu voxels, up to %.3g mm deep); the first frames "
+                      "push it out, fast where it is deep",
+                      scene.source.c_str(), i, inside, static_cast<unsigned long long>(labels.active_voxel_count()), deepest);
         out.emplace_back(text);
     }
     return out;

@@ -5,7 +5,7 @@
 
 #include "contact/obstacle.hpp"
 #include "io/scene.hpp"
-#include "surface/embedded_surface.hpp"
+#include "grid/label_grid.hpp"
 
 #include <string>
 #include <vector>
@@ -21,9 +21,9 @@ namespace vox::sim {
 /// object's box) reaching well beyond it.
 [[nodiscard]] contact::TriangleMesh obstacles_mesh(const std::vector<contact::Obstacle>& obstacles, const Eigen::AlignedBox3d& bounds);
 
-/// One line per obstacle the surface (world mm) starts inside: how many of its vertices and how
-/// deep the deepest; empty when none does.
+/// One line per obstacle the object starts inside: its voxels whose surface (half a voxel beyond
+/// their centre) reaches into the obstacle, how many and how deep the deepest; empty when none does.
 [[nodiscard]] std::vector<std::string> obstacle_overlaps(const io::Scene& scene, const std::vector<contact::Obstacle>& obstacles,
-                                                         const surface::SurfaceMesh& surface);
+                                                         const grid::LabelGrid& labels);
 
 } // namespace vox::sim

@@ -1,6 +1,7 @@
 #include "view/scene_pictures.hpp"
 
 #include "core/error.hpp"
+#include "sim/obstacles.hpp"
 
 #include <sstream>
 
@@ -62,6 +63,24 @@ void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::
     if (margin_mm > 0.05) drawing(margin_mm, {0.35f, 0.55f, 0.85f}, 0.25f);
 }
 
+void add_obstacle_drawings(const std::vector<contact::Obstacle>& obstacles, const render::DrawMesh& object, std::vector<render::DrawMesh>& out)
+{
+    if (obstacles.empty()) return;
+    Eigen::AlignedBox3d around;
+    around.setEmpty();
+    for (const std::uint32_t i : object.indices) around.extend(object.positions[i].cast<double>());
+    const contact::TriangleMesh m = sim::obstacles_mesh(obstacles, around);
+    render::DrawMesh d;
+    for (const Eigen::Vector3d& p : m.positions) d.positions.push_back(p.cast<float>());
+    d.colors.assign(d.positions.size(), Eigen::Vector3f(0.62f, 0.66f, 0.70f)); // brushed steel, as an instrument table
+    for (const Eigen::Vector3i& t : m.triangles)
+        for (int c = 0; c < 3; ++c) d.indices.push_back(static_cast<std::uint32_t>(t[c]));
+    render::compute_normals(d);
+    d.alpha = 0.45f; // the object shows through from any side
+    d.frames_camera = false;
+    out.push_back(std::move(d));
+}
+
 ScenePictures::ScenePictures(const PictureOptions& options) : m_options(options) {}
 
 void ScenePictures::write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes)
@@ -69,7 +88,8 @@ void ScenePictures::write(const std::filesystem::path& path, const std::vector<r
     if (!m_camera) {
         std::vector<Eigen::Vector3f> used; // the vertices in use (a surface keeps free slots)
         for (const render::DrawMesh& m : meshes)
-            for (const std::uint32_t i : m.indices) used.push_back(m.positions[i]);
+            if (m.frames_camera)
+                for (const std::uint32_t i : m.indices) used.push_back(m.positions[i]);
         m_camera = render::fit_camera(m_options.camera, used, static_cast<double>(m_options.width) / m_options.height);
     }
     render::write_png(path, m_renderer.render(meshes, *m_camera, m_options.width, m_options.height));
@@ -79,6 +99,7 @@ void ScenePictures::write(const std::filesystem::path& path, const sim::Method& 
 {
     std::vector<render::DrawMesh> meshes{surface_picture(method, m_options.smooth)};
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
+    add_obstacle_drawings(method.obstacles(), meshes.front(), meshes);
     write(path, meshes);
 }
 

@@ -47,6 +47,10 @@ struct PictureOptions {
 /// `margin_mm`) translucent when the margin is visible.
 void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);
 
+/// The scene's obstacles, translucent, planes as squares reaching well beyond `object` (the
+/// object's drawing); the camera is not framed on them.
+void add_obstacle_drawings(const std::vector<contact::Obstacle>& obstacles, const render::DrawMesh& object, std::vector<render::DrawMesh>& out);
+
 class ScenePictures {
 public:
     /// Makes the offscreen context (throws render::NoOpenGL when there is none).

@@ -194,6 +194,7 @@ void ViewSimulation::make_picture()
         r.smooth = m_options.smooth;
     }
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) add_tool_drawings(m_tools.placed(k), m_scene.tools[k].push_margin_mm, r.meshes);
+    add_obstacle_drawings(m_method->obstacles(), r.meshes.front(), r.meshes);
     if (q.show_cage.load() && dbg) r.meshes.push_back(element_cage(dbg->simulation()));
     r.t_s = m_loop.frames() * m_scene.solver.dt_s;
     r.elements = m_method->element_count();
