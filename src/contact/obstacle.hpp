@@ -12,8 +12,9 @@
 // point that comes into contact is tied to an anchor where it touched by a spring across the
 // normal. While the spring pulls with at most mu |f_n| the point sticks; beyond, it slips: the
 // anchor is dragged behind it at the distance where the spring pulls with exactly mu |f_n|. A
-// sticking point gives at most k_stick_give_mm before it slips, and under a smaller load does
-// not move at all: no creep. The solver takes the spring implicitly (stick: its stiffness across
+// sticking point gives k_stick_give_mm before it slips (more only when pressed in deeper than
+// k_stick_give_mm / mu: the spring is never stiffer than the normal penalty), and under a smaller
+// load does not move at all: no creep. The solver takes the spring implicitly (stick: its stiffness across
 // the normal; slip: across the normal and the slip, the derivative of a force of fixed size), so
 // a point that stops sliding cannot be thrown back: it lands on its spring. One linear solve a
 // step cannot switch between stick and slip within the step, so the spring is made soft enough

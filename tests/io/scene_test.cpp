@@ -166,7 +166,8 @@ TEST(SceneExamples, TheFormatPageShowsTheExampleScenesAsTheyAre)
     const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     for (const char* name : {"liver.json", "beam.json", "elephant.json", "cylinder.json"}) {
         SCOPED_TRACE(name);
-        const std::size_t heading = page.find("`" + std::string(name) + "`\n");
+        const std::string title = std::string("`").append(name).append("`\n");
+        const std::size_t heading = page.find(title);
         ASSERT_NE(heading, std::string::npos);
         const std::size_t begin = page.find("```json\n", heading);
         ASSERT_NE(begin, std::string::npos);
@@ -452,6 +453,58 @@ TEST(SceneParse, BadLoads)
     doc["loads"] = json::array(
         {{{"box_mm", {{0, 0, -std::numeric_limits<double>::infinity()}, {1, 1, 1}}}, {"force_n", {0, 0, 1}}}});
     EXPECT_EQ(scene_error(doc), "s.json: loads[0].box_mm[0][2]: must be a finite number");
+}
+
+TEST(SceneParse, Obstacles)
+{
+    json doc = minimal_scene();
+    const fs::path mesh = write_temp("obstacle.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+    doc["obstacles"] = json::array({
+        {{"shape", "plane"}, {"point_mm", {0, 0, -5}}, {"normal", {0, 0, 2}}},
+        {{"shape", "box"}, {"box_mm", {{-10, -10, -20}, {10, 30, -0.5}}}, {"friction", 0.8}, {"stiffness_n_per_mm", 50}},
+        {{"shape", "mesh"}, {"mesh", mesh.string()}, {"position_mm", {1, 2, 3}}, {"orientation_wxyz", {0, 0, 0, 2}}, {"scale", 10}},
+    });
+    const Scene s = parse_scene(doc, "/tmp", "obstacles.json");
+    ASSERT_EQ(s.obstacles.size(), 3u);
+    EXPECT_EQ(s.obstacles[0].shape, ObstacleShape::plane);
+    EXPECT_EQ(s.obstacles[0].point_mm, Eigen::Vector3d(0, 0, -5));
+    EXPECT_EQ(s.obstacles[0].normal, Eigen::Vector3d(0, 0, 1)); // normalised
+    EXPECT_EQ(s.obstacles[0].friction, 0.3);                     // the documented defaults
+    EXPECT_EQ(s.obstacles[0].stiffness_n_per_mm, 10.0);
+    EXPECT_EQ(s.obstacles[1].shape, ObstacleShape::box);
+    EXPECT_EQ(s.obstacles[1].box_max_mm, Eigen::Vector3d(10, 30, -0.5));
+    EXPECT_EQ(s.obstacles[1].friction, 0.8);
+    EXPECT_EQ(s.obstacles[1].stiffness_n_per_mm, 50.0);
+    EXPECT_EQ(s.obstacles[2].shape, ObstacleShape::mesh);
+    EXPECT_EQ(s.obstacles[2].mesh, mesh);
+    EXPECT_EQ(s.obstacles[2].position_mm, Eigen::Vector3d(1, 2, 3));
+    EXPECT_EQ(s.obstacles[2].orientation.coeffs(), Eigen::Quaterniond(0, 0, 0, 1).coeffs());
+    EXPECT_EQ(s.obstacles[2].scale, 10.0);
+    // Something to rest on: the object falls onto it, unless the file says what its pieces do.
+    EXPECT_EQ(s.object.unheld, UnheldPieces::fall);
+    doc["object"]["unheld_pieces"] = "hold";
+    EXPECT_EQ(parse_scene(doc, "/tmp", "obstacles.json").object.unheld, UnheldPieces::hold);
+    EXPECT_EQ(parse_scene(minimal_scene(), "/tmp", "none.json").object.unheld, UnheldPieces::hold);
+}
+
+TEST(SceneParse, BadObstaclesNameTheKeyPath)
+{
+    json doc = minimal_scene();
+    const auto with = [&](const char* obstacle) {
+        doc["obstacles"] = json::array({json::parse(obstacle)});
+        return scene_error(doc);
+    };
+    EXPECT_EQ(with(R"({"shape": "cone"})"), "s.json: obstacles[0].shape: expected one of \"plane\", \"box\", \"mesh\", got \"cone\"");
+    EXPECT_EQ(with(R"({"shape": "plane", "point_mm": [0, 0, 0]})"), "s.json: obstacles[0].normal: required key is missing");
+    EXPECT_EQ(with(R"({"shape": "plane", "point_mm": [0, 0, 0], "normal": [0, 0, 0]})"),
+              "s.json: obstacles[0].normal: has no direction (its length is below 1e-9)");
+    EXPECT_EQ(with(R"({"shape": "box", "box_mm": [[0, 0, 0], [1, 0, 1]]})"),
+              "s.json: obstacles[0].box_mm: is flat (an obstacle box needs a thickness on every axis)");
+    EXPECT_EQ(with(R"({"shape": "box", "box_mm": [[0, 0, 0], [1, 1, 1]], "friction": -0.1})").rfind("s.json: obstacles[0].friction: ", 0), 0u);
+    EXPECT_EQ(with(R"({"shape": "box", "box_mm": [[0, 0, 0], [1, 1, 1]], "stiffness_n_per_mm": 0})").rfind("s.json: obstacles[0].stiffness_n_per_mm: ", 0), 0u);
+    EXPECT_EQ(with(R"({"shape": "mesh", "mesh": "no_such_table.stl"})").rfind("s.json: obstacles[0].mesh: ", 0), 0u);
+    EXPECT_EQ(with(R"({"shape": "box", "box_mm": [[0, 0, 0], [1, 1, 1]], "normal": [0, 0, 1]})")
+                  .rfind("s.json: obstacles[0].normal: unknown key", 0), 0u);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -770,7 +823,7 @@ void PrintTo(const BadScene& b, std::ostream* os) { *os << b.name; }
 
 const BadScene bad_scenes[] = {
     BadScene{"unknown_key", "toolz",
-             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, loads, wet_regions, tools, script, "
+             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, obstacles, loads, wet_regions, tools, script, "
              "output)"},
     BadScene{"unknown_phantom_key", "object.phantom.radius_mm",
              "unknown key for a beam phantom (known keys: shape, voxel_mm, size_mm)"},
