@@ -45,6 +45,13 @@ public:
         : m_surface(surface), m_nodes(node_positions)
     {
     }
+    /// Knowing already the positions `known_mm` of vertex slots `known`.
+    DeformedPositions(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                      const std::vector<std::uint32_t>& known, const std::vector<Eigen::Vector3d>& known_mm)
+        : DeformedPositions(surface, node_positions)
+    {
+        for (std::size_t i = 0; i < known.size(); ++i) add(known[i], known_mm[i]);
+    }
     void add(std::uint32_t v, const Eigen::Vector3d& p) { m_known.emplace(v, p); }
     const Eigen::Vector3d& operator()(std::uint32_t v)
     {
@@ -110,8 +117,7 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
         inside_mm.push_back(p);
     });
     if (inside.empty()) return out;
-    DeformedPositions position(surface, node_positions);
-    for (std::size_t i = 0; i < inside.size(); ++i) position.add(inside[i], inside_mm[i]);
+    DeformedPositions position(surface, node_positions, inside, inside_mm);
     std::vector<double> areas(inside.size(), 0.0);
     std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
@@ -141,8 +147,7 @@ SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eig
         });
     }
     if (inside.empty()) return out;
-    DeformedPositions position(surface, node_positions);
-    for (std::size_t i = 0; i < inside.size(); ++i) position.add(inside[i], inside_mm[i]);
+    DeformedPositions position(surface, node_positions, inside, inside_mm);
     std::vector<double> areas(inside.size(), 0.0);
     std::vector<std::uint64_t> keys(inside.size());
     std::vector<Eigen::Vector3d> velocities(inside.size(), Eigen::Vector3d::Zero());

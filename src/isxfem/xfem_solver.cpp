@@ -181,22 +181,14 @@ std::array<double, k_max_blocks> XfemSolver::weights(std::size_t t, const std::a
     return w;
 }
 
-Eigen::Vector3d XfemSolver::position(std::size_t t, const std::array<double, 4>& n, int region) const
+Eigen::Vector3d XfemSolver::interpolate(std::size_t t, const std::array<double, 4>& n, int region,
+                                        const std::vector<Eigen::Vector3d>& blocks) const
 {
     const XfemElement& el = m_model.elements()[t];
     const std::array<double, k_max_blocks> w = weights(t, n, region);
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (std::size_t a = 0; a < el.block_count(); ++a) p += w[a] * m_x[el.block(a)];
-    return p;
-}
-
-Eigen::Vector3d XfemSolver::velocity(std::size_t t, const std::array<double, 4>& n, int region) const
-{
-    const XfemElement& el = m_model.elements()[t];
-    const std::array<double, k_max_blocks> w = weights(t, n, region);
-    Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    for (std::size_t a = 0; a < el.block_count(); ++a) v += w[a] * m_v[el.block(a)];
-    return v;
+    Eigen::Vector3d out = Eigen::Vector3d::Zero();
+    for (std::size_t a = 0; a < el.block_count(); ++a) out += w[a] * blocks[el.block(a)];
+    return out;
 }
 
 void XfemSolver::set_point_loads(std::vector<PointLoad> loads)

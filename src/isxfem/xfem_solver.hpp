@@ -103,9 +103,15 @@ public:
     [[nodiscard]] std::array<double, k_max_blocks> weights(std::size_t t, const std::array<double, 4>& n, int region) const;
     /// World position of the material point with barycentric coordinates `n` in tetrahedron t, in
     /// region `region` when the tetrahedron is cut (one cut: 0 where phi < 0, 1 where phi >= 0).
-    [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int region) const;
+    [[nodiscard]] Eigen::Vector3d position(std::size_t t, const std::array<double, 4>& n, int region) const
+    {
+        return interpolate(t, n, region, m_x);
+    }
     /// Velocity (m/s) of that material point.
-    [[nodiscard]] Eigen::Vector3d velocity(std::size_t t, const std::array<double, 4>& n, int region) const;
+    [[nodiscard]] Eigen::Vector3d velocity(std::size_t t, const std::array<double, 4>& n, int region) const
+    {
+        return interpolate(t, n, region, m_v);
+    }
     [[nodiscard]] double kinetic_energy() const;
     [[nodiscard]] Eigen::Vector3d momentum() const;
     [[nodiscard]] std::size_t dof_count() const { return 3 * m_x.size(); }
@@ -113,6 +119,9 @@ public:
     [[nodiscard]] std::size_t regularised_blocks() const { return m_regularised.size(); }
 
 private:
+    /// The per-block vectors `blocks` (positions or velocities) at a material point, as position().
+    [[nodiscard]] Eigen::Vector3d interpolate(std::size_t t, const std::array<double, 4>& n, int region,
+                                              const std::vector<Eigen::Vector3d>& blocks) const;
     int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
 
     const XfemModel& m_model;

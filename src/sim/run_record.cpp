@@ -95,6 +95,10 @@ void RunRecord::add(const FrameStats& f, const Method& method)
         frame["level_change"] = change;
         m_document["level_changes"].push_back(change);
     }
+    if (!method.obstacles().empty()) {
+        const Eigen::Vector3d force = method.obstacle_force_n();
+        frame["obstacle_force_n"] = {force.x(), force.y(), force.z()};
+    }
     method.add_frame_figures(frame);
     m_document["frames"].push_back(std::move(frame));
 }

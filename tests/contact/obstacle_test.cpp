@@ -77,7 +77,9 @@ TEST(Obstacle, BroadPhaseNeverMissesABoxReachingIn)
                 for (int y = 0; y < 5; ++y)
                     for (int z = 0; z < 5; ++z)
                         inside |= o.signed_distance(b.min() + (b.max() - b.min()).cwiseProduct(Vector3d(x, y, z) / 4.0)) < 0.0;
-            if (inside) EXPECT_TRUE(o.may_reach(b));
+            if (inside) {
+                EXPECT_TRUE(o.may_reach(b));
+            }
         }
 }
 

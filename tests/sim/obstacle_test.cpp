@@ -144,7 +144,7 @@ TEST_P(Obstacles, ClosedMeshHoldsTheObjectAsTheBoxItIsShapedAs)
 }
 
 INSTANTIATE_TEST_SUITE_P(BothMethods, Obstacles, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const auto& info) { return info.param == io::SolverType::dbg ? "dbg" : "isxfem"; });
+                         [](const auto& test) { return test.param == io::SolverType::dbg ? "dbg" : "isxfem"; });
 
 } // namespace
 } // namespace vox::sim
