@@ -21,6 +21,7 @@
 namespace vox::app {
 
 using view::PictureOptions;
+using view::add_obstacle_drawings;
 using view::ScenePictures;
 using view::add_tool_drawings;
 using view::parse_size;
@@ -71,6 +72,7 @@ void add_render_command(CLI::App& app)
                 const io::ToolPose pose = io::tool_pose(scene, k, 0.0);
                 if (pose.placed) add_tool_drawings({&tools.shape(k), pose.position_mm, pose.orientation}, scene.tools[k].push_margin_mm, meshes);
             }
+            add_obstacle_drawings(opened.method->obstacles(), meshes.front(), meshes);
         } else if (io::is_mesh_path(args->input)) {
             const io::TriangleMesh m = io::read_mesh(args->input);
             meshes.push_back(surface_drawing({m.vertices, m.triangles, {}}, options.smooth));

@@ -8,6 +8,7 @@
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 
 #include <cmath>
@@ -122,6 +123,55 @@ TEST(Render, TheCutCylinderShowsTwoSilhouettes)
     };
     EXPECT_EQ(pieces(read_png(dir.path("before.png"))), 1);
     EXPECT_EQ(pieces(read_png(dir.root() / "run" / "final.png")), 2);
+}
+
+TEST(Render, TheRodCutOnItsSupportsFallsInTwoHalvesOntoTheTable)
+{
+    // The rod across two supports on a table: one piece at rest, drawn with the obstacles (grey,
+    // neither background nor object); cut through, two halves that have come down onto the table
+    // and stopped there.
+    ScratchDir dir;
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/rod_on_supports_cut.json");
+    auto r = run_voxsculpt("render " + scene + " --camera front --size 480x360 --out " + quote(dir.path("before.png")));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_voxsculpt("run " + scene + " --render-every 300 --camera front --size 480x360 --out " + quote(dir.path("run")));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto pieces = [](const Picture& p) {
+        int n = 0;
+        for (int size : components(p, object)) n += size >= 100;
+        return n;
+    };
+    // The steel below the rod (the blade is above it): the supports and the table.
+    auto steel_below = [](const Picture& p) {
+        int bottom = 0, n = 0;
+        for (int y = 0; y < p.height; ++y)
+            for (int x = 0; x < p.width; ++x)
+                if (object(p.at(x, y))) bottom = y;
+        for (int y = bottom + 1; y < p.height; ++y)
+            for (int x = 0; x < p.width; ++x) n += foreground(p.at(x, y));
+        return static_cast<double>(n) / (p.width * p.height);
+    };
+    const Picture before = read_png(dir.path("before.png")), after = read_png(dir.root() / "run" / "final.png");
+    EXPECT_EQ(pieces(before), 1);
+    EXPECT_EQ(pieces(after), 2);
+    EXPECT_GT(steel_below(before), 0.01);
+    std::ifstream in(dir.root() / "run" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["summary"]["pieces"], 2);
+    EXPECT_LT(stats["summary"]["final_kinetic_energy_j"].get<double>(), 1e-9);
+    // Carried by the table and supports: the obstacles push with the rod's weight (10 g).
+    const nlohmann::json& force = stats["frames"].back()["obstacle_force_n"];
+    EXPECT_NEAR(force[2].get<double>(), 0.01 * 9.81, 1e-3);
+    double lowest = 1e300;
+    std::ifstream obj(dir.root() / "run" / "final.obj");
+    for (std::string line; std::getline(obj, line);)
+        if (line.rfind("v ", 0) == 0) {
+            double x = 0, y = 0, z = 0;
+            std::istringstream(line.substr(2)) >> x >> y >> z;
+            lowest = std::min(lowest, z);
+        }
+    EXPECT_GT(lowest, -31.0); // on the table (z = -30), not through it
+    EXPECT_LT(lowest, -25.0); // the cut ends came down onto it
 }
 
 TEST(Render, AnIsxfemRunDrawsTheFlapItCutOut)
