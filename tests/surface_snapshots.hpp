@@ -28,6 +28,8 @@ inline contact::SurfacePoints flat_wall(int n = 41, bool triangles = false)
             }
         const std::span<const Eigen::Vector3d> p(s.positions_mm.data(), s.count);
         s.triangle_tree.rebuild(p, p, s.triangles);
+    s.edges = contact::surface_edges(s.triangles);
+        s.edges = contact::surface_edges(s.triangles);
     }
     s.t_s = 0.0;
     return s;
@@ -46,6 +48,7 @@ inline contact::SurfacePoints coarse_square()
     s.triangles = {{0, 1, 2}, {0, 2, 3}};
     const std::span<const Eigen::Vector3d> p(s.positions_mm.data(), s.count);
     s.triangle_tree.rebuild(p, p, s.triangles);
+    s.edges = contact::surface_edges(s.triangles);
     s.t_s = 0.0;
     return s;
 }

@@ -1,8 +1,10 @@
 #include "contact/penalty_contact.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
 
 namespace vox::contact {
 namespace {
@@ -36,6 +38,62 @@ bool point_penalty(const PlacedShape& tool, const PlacedShape* from, const Conta
     return true;
 }
 
+/// An edge of the object's surface against the pushing shape (the Is-XFEM sculpting paper's
+/// edge-edge penalty, its equation 19): both ends outside, at both poses, but the edge between
+/// them reaching in, as where a thin blade's edge lies across a face between two vertices. The
+/// deepest point p = w_a a + w_b b along the edge (the distance along a segment is convex for a
+/// convex shape: golden-section search), its depth there (integrated over the move as a point's),
+/// and the area it stands for: a third of its ends' mean area (a vertex has about three edges of
+/// its own) times the share of its length inside.
+struct EdgePenalty {
+    double w_a = 0.0, depth = 0.0, stiffness = 0.0, area = 0.0, distance = 0.0;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(), force = Eigen::Vector3d::Zero(), at = Eigen::Vector3d::Zero();
+};
+
+bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const ContactParameters& parameters, const Eigen::Vector3d& a,
+                  const Eigen::Vector3d& b, double d_a, double d_b, double area_a, double area_b, const Eigen::Vector3d& n_a,
+                  const Eigen::Vector3d& n_b, EdgePenalty& out) noexcept
+{
+    const double margin = parameters.margin_mm, length = (b - a).norm();
+    if (!(d_a >= margin && d_b >= margin) || 0.5 * (d_a + d_b - length) >= margin) return false; // 1-Lipschitz: cannot reach in
+    if (from && (from->signed_distance(a) < margin || from->signed_distance(b) < margin)) return false; // a point contact has it
+    auto distance = [&](double t) { return tool.signed_distance(a + t * (b - a)); };
+    constexpr double golden = 0.6180339887498949;
+    double lo = 0.0, hi = 1.0, t1 = hi - golden * (hi - lo), t2 = lo + golden * (hi - lo), f1 = distance(t1), f2 = distance(t2);
+    for (int k = 0; k < 40 && hi - lo > 1e-6; ++k) {
+        if (f1 < f2) {
+            hi = t2, t2 = t1, f2 = f1, t1 = hi - golden * (hi - lo), f1 = distance(t1);
+        } else {
+            lo = t1, t1 = t2, f1 = f2, t2 = lo + golden * (hi - lo), f2 = distance(t2);
+        }
+    }
+    const double t = 0.5 * (lo + hi);
+    out.at = a + t * (b - a);
+    out.distance = tool.signed_distance(out.at, &out.normal);
+    out.depth = margin - out.distance;
+    double inside = out.depth > 0.0 ? 1.0 : 0.0;
+    if (from) out.depth = mean_penetration(margin - from->signed_distance(out.at), out.depth, inside);
+    if (!(out.depth > 0.0)) return false;
+    // The share of the edge inside, at the pose it is deeper in: bisection for where it leaves on each side.
+    const PlacedShape& deeper = out.distance < margin || !from ? tool : *from;
+    auto leaves = [&](double in, double outside) {
+        for (int k = 0; k < 30; ++k) {
+            const double mid = 0.5 * (in + outside);
+            (deeper.signed_distance(a + mid * (b - a)) < margin ? in : outside) = mid;
+        }
+        return 0.5 * (in + outside);
+    };
+    const double share = deeper.signed_distance(out.at) < margin ? leaves(t, 1.0) - leaves(t, 0.0) : 0.0;
+    out.w_a = 1.0 - t;
+    out.area = std::max(share, 1e-3) * (area_a + area_b) / 6.0;
+    const Eigen::Vector3d outward = out.w_a * n_a + t * n_b;
+    if (outward.squaredNorm() > 0.0) out.normal = -outward.normalized(); // along the object's normal, as a point's
+    const double k = parameters.stiffness_n_per_mm / 100.0 * out.area;
+    out.force = k * out.depth * out.normal;
+    out.stiffness = k * inside;
+    return true;
+}
+
 /// Whether a point force carries the load: within 60 degrees of the net force on the object (all
 /// of them when the forces cancel, a squeeze with no net push).
 bool carries_load(const Eigen::Vector3d& force, const Eigen::Vector3d& net) noexcept
@@ -62,32 +120,62 @@ double mean_penetration(double d0, double d1, double& inside) noexcept
 
 ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
                               std::span<const Eigen::Vector3d> points, std::span<const double> areas,
-                              std::span<const Eigen::Vector3d> normals, const PlacedShape* from)
+                              std::span<const Eigen::Vector3d> normals, const PlacedShape* from,
+                              std::span<const Eigen::Vector3i> triangles)
 {
     ContactResult out;
     Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     if (from) reach.extend(from->world_bounds(parameters.margin_mm));
     PointPenalty pp;
+    std::vector<double> distance(triangles.empty() ? 0 : points.size(), std::numeric_limits<double>::quiet_NaN()); // NaN: not measured
     for (std::size_t i = 0; i < points.size(); ++i) {
-        if (!point_penalty(tool, from, parameters, reach, points[i], areas[i], normals[i], pp)) continue;
+        const bool inside = point_penalty(tool, from, parameters, reach, points[i], areas[i], normals[i], pp);
+        if (!distance.empty() && pp.measured) distance[i] = pp.distance;
+        if (!inside) continue;
         PointContact c;
         c.point = static_cast<std::uint32_t>(i);
         c.depth_mm = pp.depth;
         c.normal = pp.normal;
         c.stiffness_n_per_mm = pp.stiffness;
         c.force_n = pp.force;
+        c.area_mm2 = areas[i];
         c.inside_inner = pp.distance < 0.0;
         out.force_on_tool_n -= c.force_n;
         out.torque_on_tool_n_mm -= (points[i] - tool.position).cross(c.force_n);
         out.area_mm2 += areas[i];
         out.points.push_back(c);
     }
+    // Edges reaching in between their ends, their force shared by their ends as the point on them is.
+    EdgePenalty ep;
+    for (const Eigen::Vector2i& edge : surface_edges(triangles)) {
+        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
+        if (!reach.intersects(Eigen::AlignedBox3d(points[a].cwiseMin(points[b]), points[a].cwiseMax(points[b])))) continue;
+        for (const std::size_t end : {a, b})
+            if (std::isnan(distance[end])) distance[end] = tool.signed_distance(points[end]);
+        if (!edge_penalty(tool, from, parameters, points[a], points[b], distance[a], distance[b], areas[a], areas[b], normals[a],
+                          normals[b], ep))
+            continue;
+        for (const auto& [end, w] : {std::pair{a, ep.w_a}, std::pair{b, 1.0 - ep.w_a}}) {
+            PointContact c;
+            c.point = static_cast<std::uint32_t>(end);
+            c.depth_mm = ep.depth;
+            c.normal = ep.normal;
+            c.stiffness_n_per_mm = w * ep.stiffness;
+            c.force_n = w * ep.force;
+            c.area_mm2 = w * ep.area;
+            c.inside_inner = ep.distance < 0.0;
+            out.points.push_back(c);
+        }
+        out.force_on_tool_n -= ep.force;
+        out.torque_on_tool_n_mm -= (ep.at - tool.position).cross(ep.force);
+        out.area_mm2 += ep.area;
+    }
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     for (const PointContact& c : out.points) {
         if (!carries_load(c.force_n, net)) continue;
         magnitude += c.force_n.norm();
-        out.load_area_mm2 += areas[c.point];
+        out.load_area_mm2 += c.area_mm2;
     }
     // N / mm^2 = 1e6 Pa.
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
@@ -112,6 +200,33 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         out.area_mm2 += points.areas_mm2[i];
         out.inner_reaches_surface = out.inner_reaches_surface || pp.distance < 0.0;
     }
+    // The edges, as penalty_contact takes them (their ends' distances from the pass above when
+    // kept, else measured again).
+    EdgePenalty ep;
+    // An end outside the pushing shape's box is measured here (and kept for the continuous check).
+    auto measured = [&](std::size_t i) {
+        if (keep && distance[i] < INFINITY) return distance[i];
+        const double d = tool.signed_distance(points.positions_mm[i]);
+        if (keep) distance[i] = d;
+        return d;
+    };
+    auto near = [&](std::size_t a, std::size_t b) {
+        const Eigen::Vector3d &p = points.positions_mm[a], &q = points.positions_mm[b];
+        return reach.intersects(Eigen::AlignedBox3d(p.cwiseMin(q), p.cwiseMax(q)));
+    };
+    for (const Eigen::Vector2i& edge : points.edges) {
+        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
+        if (b >= points.count || !near(a, b)) continue;
+        const double d_a = measured(a), d_b = measured(b);
+        if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
+                          points.areas_mm2[b], points.normals[a], points.normals[b], ep))
+            continue;
+        out.force_on_tool_n -= ep.force;
+        out.torque_on_tool_n_mm -= (ep.at - tool.position).cross(ep.force);
+        out.stiffness_n_per_mm += ep.stiffness * ep.normal * ep.normal.transpose();
+        out.area_mm2 += ep.area;
+        out.inner_reaches_surface = out.inner_reaches_surface || ep.distance < 0.0;
+    }
     if (!with_pressure || out.area_mm2 == 0.0) return out;
     // A second pass for the load-carrying part: nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
@@ -121,6 +236,17 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         if (!carries_load(pp.force, net)) continue;
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
+    }
+    for (const Eigen::Vector2i& edge : points.edges) {
+        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
+        if (b >= points.count || !near(a, b)) continue;
+        const double d_a = measured(a), d_b = measured(b);
+        if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
+                          points.areas_mm2[b], points.normals[a], points.normals[b], ep) ||
+            !carries_load(ep.force, net))
+            continue;
+        magnitude += ep.force.norm();
+        out.load_area_mm2 += ep.area;
     }
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;

@@ -45,6 +45,7 @@ struct PointContact {
     /// none): symmetric, positive semidefinite.
     Eigen::Matrix3d friction_stiffness_n_per_mm = Eigen::Matrix3d::Zero();
     bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
+    double area_mm2 = 0.0;                  ///< the surface area this contact stands for
     /// The whole stiffness, N/mm: along the normal and across it (friction).
     [[nodiscard]] Eigen::Matrix3d stiffness_matrix_n_per_mm() const
     {
@@ -80,7 +81,8 @@ struct ContactTotals {
     bool inner_reaches_surface = false;
 };
 
-/// The same model as penalty_contact over the first `points.count` points; never allocates,
+/// The same model as penalty_contact over the first `points.count` points and their triangles
+/// (edges included); never allocates,
 /// locks or throws (the haptic loop calls it). The pressure (and load area) take a second pass
 /// over the points and are computed only `with_pressure` (the force and stiffness do not need it).
 /// `distance`, when given (at least points.count long), receives each point's signed distance to
@@ -100,9 +102,18 @@ struct ContactTotals {
 /// two steps pushes for the part of the step it was in contact, not as if it had been there all
 /// along; the force rises with the time in contact instead of jumping. A point inside at either
 /// pose counts. The stiffness is scaled by the share of the step spent inside.
+///
+/// With `triangles` (the surface's triangles among the points), edges are pressed too (the
+/// Is-XFEM sculpting paper's edge-edge penalty, its equation 19): an edge whose two ends are
+/// outside the pushing shape at both poses but whose middle reaches in, as where a thin blade's
+/// edge lies across a face between two vertices, is pushed at its deepest point with the same
+/// penalty over the area it stands for (a third of its ends' mean area times the share of its
+/// length inside); its force and stiffness go to its two ends as the point's position does (two
+/// PointContacts, one per end), its reaction and torque to the tool at the point.
 [[nodiscard]] ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& parameters,
                                             std::span<const Eigen::Vector3d> points, std::span<const double> areas,
-                                            std::span<const Eigen::Vector3d> normals, const PlacedShape* from = nullptr);
+                                            std::span<const Eigen::Vector3d> normals, const PlacedShape* from = nullptr,
+                                            std::span<const Eigen::Vector3i> triangles = {});
 
 /// The mean over a step of a penetration depth going linearly from d0 to d1 (negative: outside),
 /// counting only the part inside; `inside` receives the share of the step spent inside.

@@ -106,23 +106,44 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
                              const contact::PlacedShape* from)
 {
     SurfaceContact out;
-    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    if (from) reach.extend(from->world_bounds(parameters.margin_mm));
-    // Candidate points: the vertices near the tool, kept when inside the outer shape (at either pose).
-    std::vector<std::uint32_t> inside;
-    std::vector<Eigen::Vector3d> inside_mm;
+    // Candidate points: the vertices near the tool, kept when inside the outer shape (at either
+    // pose) or near enough for an edge of theirs to reach in (no edge is longer than two voxels).
+    const double edge_reach = parameters.margin_mm + 2.0e3 * surface.grid().voxels().voxel_size_m().maxCoeff();
+    Eigen::AlignedBox3d reach = tool.world_bounds(edge_reach);
+    if (from) reach.extend(from->world_bounds(edge_reach));
+    std::vector<std::uint32_t> near;
+    std::vector<Eigen::Vector3d> near_mm;
+    bool touching = false;
     vertices_in(surface, node_positions, reach, [&](std::uint32_t v, const Eigen::Vector3d& p) {
-        if (tool.signed_distance(p) >= parameters.margin_mm && !(from && from->signed_distance(p) < parameters.margin_mm)) return;
-        inside.push_back(v);
-        inside_mm.push_back(p);
+        const double d = std::min(tool.signed_distance(p), from ? from->signed_distance(p) : INFINITY);
+        if (d >= edge_reach) return;
+        touching = touching || d < edge_reach - parameters.margin_mm; // an edge may reach in
+        near.push_back(v);
+        near_mm.push_back(p);
     });
-    if (inside.empty()) return out;
-    DeformedPositions position(surface, node_positions, inside, inside_mm);
-    std::vector<double> areas(inside.size(), 0.0);
-    std::vector<Eigen::Vector3d> normals(inside.size(), Eigen::Vector3d::Zero());
-    for (std::size_t i = 0; i < inside.size(); ++i) area_and_normal(surface, inside[i], position, areas[i], normals[i]);
-    out.contact = contact::penalty_contact(tool, parameters, inside_mm, areas, normals, from);
-    gather_on_nodes(surface, inside, out);
+    if (!touching) return out;
+    DeformedPositions position(surface, node_positions, near, near_mm);
+    std::vector<double> areas(near.size(), 0.0);
+    std::vector<Eigen::Vector3d> normals(near.size(), Eigen::Vector3d::Zero());
+    for (std::size_t i = 0; i < near.size(); ++i) area_and_normal(surface, near[i], position, areas[i], normals[i]);
+    // The triangles among them, for the edges.
+    std::unordered_map<std::uint32_t, int> index;
+    for (std::size_t i = 0; i < near.size(); ++i) index.emplace(near[i], static_cast<int>(i));
+    std::vector<Eigen::Vector3i> triangles;
+    const auto& all = surface.embedded().triangles();
+    for (std::size_t i = 0; i < near.size(); ++i)
+        for (std::uint32_t t : surface.vertex_triangles(near[i])) {
+            Eigen::Vector3i corners;
+            bool among = true;
+            for (int c = 0; c < 3 && among; ++c) {
+                const auto found = index.find(all[t][static_cast<std::size_t>(c)]);
+                among = found != index.end();
+                if (among) corners[c] = found->second;
+            }
+            if (among && corners.minCoeff() == static_cast<int>(i)) triangles.push_back(corners); // each once
+        }
+    out.contact = contact::penalty_contact(tool, parameters, near_mm, areas, normals, from, triangles);
+    gather_on_nodes(surface, near, out);
     return out;
 }
 
@@ -227,6 +248,7 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
         }
     const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
     out.triangle_tree.rebuild(positions, positions, out.triangles);
+    out.edges = contact::surface_edges(out.triangles);
 }
 
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b)

@@ -347,12 +347,14 @@ IsxfemSimulation::NearSurface IsxfemSimulation::near_surface(const Eigen::Aligne
 IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                                                 const contact::PlacedShape* from, double closed_walls_mm) const
 {
-    // Only the surface within the tool's reach (at both poses) is measured.
-    Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
-    if (from && from->shape) reach.extend(from->world_bounds(parameters.margin_mm));
+    // Only the surface within the tool's reach (at both poses) is measured, and as far beyond as
+    // an edge may reach into it (no edge is longer than two voxels).
+    const double edge_reach = parameters.margin_mm + 2.0e3 * m_grid.voxels().voxel_size_m().maxCoeff();
+    Eigen::AlignedBox3d reach = tool.world_bounds(edge_reach);
+    if (from && from->shape) reach.extend(from->world_bounds(edge_reach));
     const NearSurface s = near_surface(reach, closed_walls_mm);
     Touch out;
-    out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr);
+    out.contact = contact::penalty_contact(tool, parameters, s.positions, s.areas, s.normals, from && from->shape ? from : nullptr, s.triangles);
     for (const contact::PointContact& c : out.contact.points) {
         const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
         out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_matrix_n_per_mm()});
@@ -398,6 +400,7 @@ void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::S
         if (t.maxCoeff() < static_cast<int>(out.count)) out.triangles.push_back(t);
     const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
     out.triangle_tree.rebuild(positions, positions, out.triangles);
+    out.edges = contact::surface_edges(out.triangles);
 }
 
 } // namespace vox::sim

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <span>
@@ -343,4 +344,107 @@ TEST(ContinuousPenalty, TheImpulseOfAnApproachIsExactWhereverTheStepsFall)
     }
     EXPECT_LT(worst_continuous, 1e-9);
     EXPECT_GT(least_discrete, 0.1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Edges (the Is-XFEM paper's edge-edge penalty, equation 19).
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+/// A flat 10 x 10 mm patch on z = 0 of 2 mm squares, each split along its diagonal: vertices at
+/// x, y in {-4, -2, 0, 2, 4}, 4 mm^2 each, outward normal +z.
+struct CoarsePatch {
+    std::vector<Vector3d> points, normals;
+    std::vector<double> areas;
+    std::vector<Eigen::Vector3i> triangles;
+    CoarsePatch()
+    {
+        for (int i = 0; i < 5; ++i)
+            for (int j = 0; j < 5; ++j) {
+                points.emplace_back(-4.0 + 2 * i, -4.0 + 2 * j, 0.0);
+                normals.emplace_back(0, 0, 1);
+                areas.push_back(4.0);
+            }
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j) {
+                const int a = 5 * i + j, b = 5 * (i + 1) + j, c = b + 1, d = a + 1;
+                triangles.emplace_back(a, b, c);
+                triangles.emplace_back(a, c, d);
+            }
+    }
+};
+
+/// A blade 0.2 mm thick across x, 20 mm long along y, its edge `depth` below z = 0, centred on x.
+PlacedShape thin_blade(const ToolShape& shape, double x, double depth) { return {&shape, Vector3d(x, 0, 5.0 - depth), Eigen::Quaterniond::Identity()}; }
+
+} // namespace
+
+TEST(EdgePenalty, ABladeEdgeBetweenTwoRowsOfVerticesPressesTheEdgesItCrosses)
+{
+    // The blade lies between the vertex columns x = 0 and x = 2: no vertex is inside it, but the
+    // 5 rows' horizontal edges and the 4 squares' diagonals from x = 0 to x = 2 cross it (9
+    // edges). Each is inside over 0.2 mm of its 2 mm run across (share 0.1), 0.05 mm deep: it
+    // stands for 0.1 x (4 + 4) / 6 mm^2 and is pushed with k d a.
+    const ToolShape blade = ToolShape::box({0.2, 20, 10});
+    const CoarsePatch patch;
+    const ContactParameters parameters{0.0, 5.0};
+    const PlacedShape at = thin_blade(blade, 1.0, 0.05);
+    const ContactResult without = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals);
+    EXPECT_TRUE(without.points.empty()); // the blade falls between the vertices
+    const ContactResult with = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, nullptr, patch.triangles);
+    const double area = 0.1 * 8.0 / 6.0, force = 5.0 / 100.0 * area * 0.05;
+    EXPECT_EQ(with.points.size(), 2u * 9u);
+    EXPECT_NEAR(-with.force_on_tool_n.z(), -9.0 * force, 1e-9); // pushed into the object, along -normal
+    EXPECT_NEAR(with.force_on_tool_n.head<2>().norm(), 0.0, 1e-12);
+    EXPECT_NEAR(with.area_mm2, 9.0 * area, 1e-6);
+    EXPECT_NEAR(with.pressure_pa, 1e6 * force / area, 1e-3 * 1e6 * force / area); // k d: the same as a point's
+    EXPECT_TRUE(with.inner_reaches_surface());
+    // Each edge's force goes to its ends by where the point on it is: about the middle (the
+    // depth is the same over the middle 0.1 mm of the blade's thickness), about half each.
+    for (const PointContact& c : with.points) EXPECT_NEAR(c.force_n.z(), -0.5 * force, 0.03 * force);
+    // The haptic loop's totals are the same contact.
+    SurfacePoints cloud(patch.points.size());
+    cloud.count = patch.points.size();
+    std::copy(patch.points.begin(), patch.points.end(), cloud.positions_mm.begin());
+    std::copy(patch.normals.begin(), patch.normals.end(), cloud.normals.begin());
+    std::copy(patch.areas.begin(), patch.areas.end(), cloud.areas_mm2.begin());
+    cloud.triangles = patch.triangles;
+    cloud.edges = surface_edges(patch.triangles);
+    const ContactTotals totals = penalty_totals(at, parameters, cloud);
+    EXPECT_NEAR((totals.force_on_tool_n - with.force_on_tool_n).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((totals.torque_on_tool_n_mm - with.torque_on_tool_n_mm).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(totals.pressure_pa, with.pressure_pa, 1e-9);
+    EXPECT_NEAR(totals.stiffness_n_per_mm(2, 2), 9.0 * 5.0 / 100.0 * area, 1e-9);
+}
+
+TEST(EdgePenalty, AnEdgeWithAnEndInsideIsLeftToThePointContact)
+{
+    // Centred on the column x = 0 the blade holds five vertices: they carry the contact, and the
+    // edges from them are not pressed a second time.
+    const ToolShape blade = ToolShape::box({0.2, 20, 10});
+    const CoarsePatch patch;
+    const ContactParameters parameters{0.0, 5.0};
+    const PlacedShape at = thin_blade(blade, 0.0, 0.05);
+    const ContactResult points_only = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals);
+    const ContactResult with = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, nullptr, patch.triangles);
+    EXPECT_EQ(points_only.points.size(), 5u);
+    EXPECT_EQ(with.points.size(), 5u);
+    EXPECT_NEAR((with.force_on_tool_n - points_only.force_on_tool_n).norm(), 0.0, 1e-15);
+}
+
+TEST(EdgePenalty, AnEdgeTheBladeCrossedWithinTheStepPushesForThePartOfTheStepItWasIn)
+{
+    // Continuous, as a point: the blade comes down from 0.05 mm above to 0.05 mm below the patch
+    // over the step, so each crossed edge is inside half of it, at a mean depth of 0.0125 mm.
+    const ToolShape blade = ToolShape::box({0.2, 20, 10});
+    const CoarsePatch patch;
+    const ContactParameters parameters{0.0, 5.0};
+    const PlacedShape from = thin_blade(blade, 1.0, -0.05), at = thin_blade(blade, 1.0, 0.05);
+    const ContactResult c = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, &from, patch.triangles);
+    const double area = 0.1 * 8.0 / 6.0;
+    EXPECT_NEAR(-c.force_on_tool_n.z(), -9.0 * 5.0 / 100.0 * area * 0.0125, 1e-9);
+    // An edge's two ends share its stiffness, scaled by the half of the step it was inside.
+    ASSERT_GE(c.points.size(), 2u);
+    EXPECT_NEAR(c.points[0].stiffness_n_per_mm + c.points[1].stiffness_n_per_mm, 0.5 * 5.0 / 100.0 * area, 1e-9);
 }
