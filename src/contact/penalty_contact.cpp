@@ -1,6 +1,7 @@
 #include "contact/penalty_contact.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -58,9 +59,30 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     if (!(d_a >= margin && d_b >= margin) || 0.5 * (d_a + d_b - length) >= margin) return false; // 1-Lipschitz: cannot reach in
     if (from && (from->signed_distance(a) < margin || from->signed_distance(b) < margin)) return false; // a point contact has it
     auto distance = [&](double t) { return tool.signed_distance(a + t * (b - a)); };
+    // Whether any point of it is inside, at either pose: halving the edge while the distance's
+    // Lipschitz bound leaves room (most edges near the tool are out after a sample or two).
+    auto reaches_in = [&](const PlacedShape& shape, double f0, double f1) {
+        struct Span {
+            double t0, t1, f0, f1;
+        };
+        std::array<Span, 24> stack{};
+        int top = 0;
+        stack[top++] = {0.0, 1.0, f0, f1};
+        while (top > 0) {
+            const Span s = stack[--top];
+            if (0.5 * (s.f0 + s.f1 - (s.t1 - s.t0) * length) >= margin) continue;
+            const double mid = 0.5 * (s.t0 + s.t1), fm = shape.signed_distance(a + mid * (b - a));
+            if (fm < margin) return true;
+            if (top + 2 > static_cast<int>(stack.size()) || (s.t1 - s.t0) * length < 1e-4) continue; // finer than 0.1 um: out
+            stack[top++] = {s.t0, mid, s.f0, fm};
+            stack[top++] = {mid, s.t1, fm, s.f1};
+        }
+        return false;
+    };
+    if (!reaches_in(tool, d_a, d_b) && !(from && reaches_in(*from, from->signed_distance(a), from->signed_distance(b)))) return false;
     constexpr double golden = 0.6180339887498949;
     double lo = 0.0, hi = 1.0, t1 = hi - golden * (hi - lo), t2 = lo + golden * (hi - lo), f1 = distance(t1), f2 = distance(t2);
-    for (int k = 0; k < 40 && hi - lo > 1e-6; ++k) {
+    for (int k = 0; k < 30 && (hi - lo) * length > 1e-4; ++k) {
         if (f1 < f2) {
             hi = t2, t2 = t1, f2 = f1, t1 = hi - golden * (hi - lo), f1 = distance(t1);
         } else {
@@ -77,7 +99,7 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     // The share of the edge inside, at the pose it is deeper in: bisection for where it leaves on each side.
     const PlacedShape& deeper = out.distance < margin || !from ? tool : *from;
     auto leaves = [&](double in, double outside) {
-        for (int k = 0; k < 30; ++k) {
+        for (int k = 0; k < 30 && std::abs(outside - in) * length > 1e-4; ++k) {
             const double mid = 0.5 * (in + outside);
             (deeper.signed_distance(a + mid * (b - a)) < margin ? in : outside) = mid;
         }
@@ -210,13 +232,19 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         if (keep) distance[i] = d;
         return d;
     };
-    auto near = [&](std::size_t a, std::size_t b) {
+    // Cheap tests first (the loop visits every edge of the snapshot each tick): with both ends
+    // measured, an end inside (its point contact has it) or the Lipschitz bound; else the box.
+    auto may_reach_in = [&](std::size_t a, std::size_t b) {
         const Eigen::Vector3d &p = points.positions_mm[a], &q = points.positions_mm[b];
+        if (keep && distance[a] < INFINITY && distance[b] < INFINITY) {
+            const double margin = parameters.margin_mm, room = distance[a] + distance[b] - 2.0 * margin;
+            return distance[a] >= margin && distance[b] >= margin && room * room < (q - p).squaredNorm();
+        }
         return reach.intersects(Eigen::AlignedBox3d(p.cwiseMin(q), p.cwiseMax(q)));
     };
     for (const Eigen::Vector2i& edge : points.edges) {
         const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-        if (b >= points.count || !near(a, b)) continue;
+        if (b >= points.count || !may_reach_in(a, b)) continue;
         const double d_a = measured(a), d_b = measured(b);
         if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                           points.areas_mm2[b], points.normals[a], points.normals[b], ep))
@@ -239,7 +267,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     }
     for (const Eigen::Vector2i& edge : points.edges) {
         const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-        if (b >= points.count || !near(a, b)) continue;
+        if (b >= points.count || !may_reach_in(a, b)) continue;
         const double d_a = measured(a), d_b = measured(b);
         if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                           points.areas_mm2[b], points.normals[a], points.normals[b], ep) ||
