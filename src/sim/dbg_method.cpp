@@ -93,7 +93,13 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
         rest_section = cut::section_polygon(*at.shape, 0.0, at);
         carry_to_rest(tool, spec, from, at, order, rest_section);
     }
-    std::vector<Eigen::Vector3d> previous = std::exchange(m_previous_section[tool], rest_section);
+    // Within a stroke that has cut, a frame that cuts nothing (its pressure fell under the
+    // threshold as the object gave way) keeps the last cut's section, so the next cut goes on from
+    // where that one ended: one continuous sheet (a curved stroke dragging a soft plate towards its
+    // held rim paused for a few frames and opened its next cut 6 mm further on, a second sheet).
+    std::vector<Eigen::Vector3d> previous = m_previous_section[tool];
+    const bool paused = spec.cut_mode == io::CutMode::separate && !spec.two_phase && !order.cut && m_stroke[tool].has_cut;
+    if (!paused) m_previous_section[tool] = rest_section;
     // Two-phase: the whole path marked since the first touch is cut at once.
     if (spec.two_phase) {
         if (!order.touching) {
@@ -114,6 +120,7 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
                                                                          at.orientation * Eigen::Vector3d::UnitY()));
     }
     if (removed.empty() && faces.empty()) return {};
+    if (spec.cut_mode == io::CutMode::separate) m_stroke[tool].has_cut = true;
     return apply(std::move(removed), std::move(faces));
 }
 

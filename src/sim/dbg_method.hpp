@@ -115,8 +115,8 @@ private:
     std::vector<bool> m_touched;  ///< placed (and touched) this frame
     std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
     std::vector<double> m_drill_budget; ///< per tool: volume a drill may still remove, below one voxel's, mm^3
-    /// A separating tool's cutting section at the previous frame, in rest space: a frame's cut
-    /// opens what the section swept since.
+    /// A separating tool's cutting section at the previous frame (within a stroke that has cut,
+    /// at its last cut), in rest space: a frame's cut opens what the section swept since.
     std::vector<std::vector<Eigen::Vector3d>> m_previous_section;
     /// Two-phase tools: the section where the marking began (rest space).
     std::vector<std::vector<Eigen::Vector3d>> m_marked_from;
@@ -130,6 +130,7 @@ private:
         double across_mm = 0.0;
         Eigen::Vector3d cut_normal = Eigen::Vector3d::Zero(); ///< of the plane the edge sweeps
         double untouched_s = 0.0;                              ///< since the blade last touched
+        bool has_cut = false;                                  ///< some frame of it opened faces
     };
     std::vector<StrokeCarry> m_stroke;
     static constexpr double k_stroke_turn_cos = 0.98480775301220802; // cos 10 degrees
