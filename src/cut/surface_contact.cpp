@@ -83,6 +83,26 @@ void area_and_normal(const ModelSurface& surface, std::uint32_t v, DeformedPosit
     if (normal.norm() > 0.0) normal *= surface.outward_sign() / normal.norm();
 }
 
+/// The triangles whose three corners are among the points `point_of` numbers (vertex slot ->
+/// point), in those numbers, each once (from its lowest-numbered corner).
+std::vector<Eigen::Vector3i> triangles_among(const ModelSurface& surface, const std::unordered_map<std::uint32_t, int>& point_of)
+{
+    std::vector<Eigen::Vector3i> out;
+    const auto& triangles = surface.embedded().triangles();
+    for (const auto& [v, point] : point_of)
+        for (std::uint32_t t : surface.vertex_triangles(v)) {
+            Eigen::Vector3i corners;
+            bool all = true;
+            for (int c = 0; c < 3 && all; ++c) {
+                const auto found = point_of.find(triangles[t][static_cast<std::size_t>(c)]);
+                all = found != point_of.end();
+                if (all) corners[c] = found->second;
+            }
+            if (all && corners.minCoeff() == point) out.push_back(corners);
+        }
+    return out;
+}
+
 /// Renumbers `out`'s contact points to the vertex slots `inside` they index, and gathers their
 /// forces on the model's nodes.
 void gather_on_nodes(const ModelSurface& surface, const std::vector<std::uint32_t>& inside, SurfaceContact& out)
@@ -129,20 +149,7 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
     // The triangles among them, for the edges.
     std::unordered_map<std::uint32_t, int> index;
     for (std::size_t i = 0; i < near.size(); ++i) index.emplace(near[i], static_cast<int>(i));
-    std::vector<Eigen::Vector3i> triangles;
-    const auto& all = surface.embedded().triangles();
-    for (std::size_t i = 0; i < near.size(); ++i)
-        for (std::uint32_t t : surface.vertex_triangles(near[i])) {
-            Eigen::Vector3i corners;
-            bool among = true;
-            for (int c = 0; c < 3 && among; ++c) {
-                const auto found = index.find(all[t][static_cast<std::size_t>(c)]);
-                among = found != index.end();
-                if (among) corners[c] = found->second;
-            }
-            if (among && corners.minCoeff() == static_cast<int>(i)) triangles.push_back(corners); // each once
-        }
-    out.contact = contact::penalty_contact(tool, parameters, near_mm, areas, normals, from, triangles);
+    out.contact = contact::penalty_contact(tool, parameters, near_mm, areas, normals, from, triangles_among(surface, index));
     gather_on_nodes(surface, near, out);
     return out;
 }
@@ -232,20 +239,8 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
         area_and_normal(surface, v, position, out.areas_mm2[out.count], out.normals[out.count]);
         ++out.count;
     }
-    // The triangles among the points, each once (from its lowest-numbered corner), and their tree.
-    out.triangles.clear();
-    const auto& triangles = surface.embedded().triangles();
-    for (const auto& [v, point] : point_of)
-        for (std::uint32_t t : surface.vertex_triangles(v)) {
-            Eigen::Vector3i corners;
-            bool all = true;
-            for (int c = 0; c < 3 && all; ++c) {
-                const auto found = point_of.find(triangles[t][static_cast<std::size_t>(c)]);
-                all = found != point_of.end();
-                if (all) corners[c] = found->second;
-            }
-            if (all && corners.minCoeff() == point) out.triangles.push_back(corners);
-        }
+    // The triangles among the points, their tree and edges.
+    out.triangles = triangles_among(surface, point_of);
     const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
     out.triangle_tree.rebuild(positions, positions, out.triangles);
     out.edges = contact::surface_edges(out.triangles);

@@ -75,6 +75,29 @@ std::vector<int> components(const Picture& p, Inside inside)
     return sizes;
 }
 
+/// Pieces of the object in a picture: its components of at least 100 pixels (specks of
+/// antialiasing aside).
+int pieces(const Picture& p)
+{
+    int n = 0;
+    for (int size : components(p, object)) n += size >= 100;
+    return n;
+}
+
+/// A bundled scene drawn at rest to DIR/before.png, then run with `run_options` into DIR/run,
+/// both from the front at 480 x 360; false (and the command's error reported) when either fails.
+bool render_before_and_run(const ScratchDir& dir, const std::string& scene_name, const std::string& run_options)
+{
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/" + scene_name);
+    const std::string view = " --camera front --size 480x360 --out ";
+    for (const std::string& command : {"render " + scene + view + quote(dir.path("before.png")), "run " + scene + " " + run_options + view + quote(dir.path("run"))}) {
+        const auto r = run_voxsculpt(command);
+        EXPECT_EQ(r.exit_code, 0) << command << ": " << r.err;
+        if (r.exit_code != 0) return false;
+    }
+    return true;
+}
+
 } // namespace
 
 TEST(Render, TheSpherePhantomCoversTheShareOfTheFrameADiskDoes)
@@ -110,17 +133,8 @@ TEST(Render, TheCutCylinderShowsTwoSilhouettes)
     // The hanging cylinder cut through, 0.12 s later: the lower piece has dropped away from the
     // upper one. Before the cut (the scene at rest) there is one.
     ScratchDir dir;
-    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/cylinder_cut.json");
-    auto r = run_voxsculpt("render " + scene + " --camera front --size 480x360 --out " + quote(dir.path("before.png")));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    r = run_voxsculpt("run " + scene + " --frames 24 --render-every 24 --camera front --size 480x360 --out " + quote(dir.path("run")));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_TRUE(render_before_and_run(dir, "cylinder_cut.json", "--frames 24 --render-every 24"));
     ASSERT_TRUE(fs::exists(dir.root() / "run" / "frame_00024.png"));
-    auto pieces = [](const Picture& p) {
-        int n = 0;
-        for (int size : components(p, object)) n += size >= 100; // specks of antialiasing aside
-        return n;
-    };
     EXPECT_EQ(pieces(read_png(dir.path("before.png"))), 1);
     EXPECT_EQ(pieces(read_png(dir.root() / "run" / "final.png")), 2);
 }
@@ -131,16 +145,7 @@ TEST(Render, TheRodCutOnItsSupportsFallsInTwoHalvesOntoTheTable)
     // neither background nor object); cut through, two halves that have come down onto the table
     // and stopped there.
     ScratchDir dir;
-    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/rod_on_supports_cut.json");
-    auto r = run_voxsculpt("render " + scene + " --camera front --size 480x360 --out " + quote(dir.path("before.png")));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    r = run_voxsculpt("run " + scene + " --render-every 300 --camera front --size 480x360 --out " + quote(dir.path("run")));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    auto pieces = [](const Picture& p) {
-        int n = 0;
-        for (int size : components(p, object)) n += size >= 100;
-        return n;
-    };
+    ASSERT_TRUE(render_before_and_run(dir, "rod_on_supports_cut.json", "--render-every 300"));
     // The steel below the rod (the blade is above it): the supports and the table.
     auto steel_below = [](const Picture& p) {
         int bottom = 0, n = 0;

@@ -375,24 +375,32 @@ struct CoarsePatch {
     }
 };
 
-/// A blade 0.2 mm thick across x, 20 mm long along y, its edge `depth` below z = 0, centred on x.
-PlacedShape thin_blade(const ToolShape& shape, double x, double depth) { return {&shape, Vector3d(x, 0, 5.0 - depth), Eigen::Quaterniond::Identity()}; }
+/// A blade 0.2 mm thick across x, 20 mm long along y, over the coarse patch, pressed with
+/// 5 N/mm per cm^2 and no margin.
+struct EdgePenalty : ::testing::Test {
+    const ToolShape blade = ToolShape::box({0.2, 20, 10});
+    const CoarsePatch patch;
+    const ContactParameters parameters{0.0, 5.0};
+    /// Centred on x, its edge `depth` below z = 0.
+    [[nodiscard]] PlacedShape at(double x, double depth) const { return {&blade, Vector3d(x, 0, 5.0 - depth), Eigen::Quaterniond::Identity()}; }
+    [[nodiscard]] ContactResult touch(const PlacedShape& tool, bool edges, const PlacedShape* from = nullptr) const
+    {
+        return penalty_contact(tool, parameters, patch.points, patch.areas, patch.normals, from,
+                               edges ? std::span<const Eigen::Vector3i>(patch.triangles) : std::span<const Eigen::Vector3i>());
+    }
+};
 
 } // namespace
 
-TEST(EdgePenalty, ABladeEdgeBetweenTwoRowsOfVerticesPressesTheEdgesItCrosses)
+TEST_F(EdgePenalty, ABladeEdgeBetweenTwoRowsOfVerticesPressesTheEdgesItCrosses)
 {
     // The blade lies between the vertex columns x = 0 and x = 2: no vertex is inside it, but the
     // 5 rows' horizontal edges and the 4 squares' diagonals from x = 0 to x = 2 cross it (9
     // edges). Each is inside over 0.2 mm of its 2 mm run across (share 0.1), 0.05 mm deep: it
     // stands for 0.1 x (4 + 4) / 6 mm^2 and is pushed with k d a.
-    const ToolShape blade = ToolShape::box({0.2, 20, 10});
-    const CoarsePatch patch;
-    const ContactParameters parameters{0.0, 5.0};
-    const PlacedShape at = thin_blade(blade, 1.0, 0.05);
-    const ContactResult without = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals);
-    EXPECT_TRUE(without.points.empty()); // the blade falls between the vertices
-    const ContactResult with = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, nullptr, patch.triangles);
+    const PlacedShape between = at(1.0, 0.05);
+    EXPECT_TRUE(touch(between, false).points.empty()); // the blade falls between the vertices
+    const ContactResult with = touch(between, true);
     const double area = 0.1 * 8.0 / 6.0, force = 5.0 / 100.0 * area * 0.05;
     EXPECT_EQ(with.points.size(), 2u * 9u);
     EXPECT_NEAR(-with.force_on_tool_n.z(), -9.0 * force, 1e-4 * 9.0 * force); // pushed into the object, along -normal (the share to 0.1 um)
@@ -411,37 +419,30 @@ TEST(EdgePenalty, ABladeEdgeBetweenTwoRowsOfVerticesPressesTheEdgesItCrosses)
     std::copy(patch.areas.begin(), patch.areas.end(), cloud.areas_mm2.begin());
     cloud.triangles = patch.triangles;
     cloud.edges = surface_edges(patch.triangles);
-    const ContactTotals totals = penalty_totals(at, parameters, cloud);
+    const ContactTotals totals = penalty_totals(between, parameters, cloud);
     EXPECT_NEAR((totals.force_on_tool_n - with.force_on_tool_n).norm(), 0.0, 1e-12);
     EXPECT_NEAR((totals.torque_on_tool_n_mm - with.torque_on_tool_n_mm).norm(), 0.0, 1e-12);
     EXPECT_NEAR(totals.pressure_pa, with.pressure_pa, 1e-9);
     EXPECT_NEAR(totals.stiffness_n_per_mm(2, 2), 9.0 * 5.0 / 100.0 * area, 1e-4 * 9.0 * 5.0 / 100.0 * area);
 }
 
-TEST(EdgePenalty, AnEdgeWithAnEndInsideIsLeftToThePointContact)
+TEST_F(EdgePenalty, AnEdgeWithAnEndInsideIsLeftToThePointContact)
 {
     // Centred on the column x = 0 the blade holds five vertices: they carry the contact, and the
     // edges from them are not pressed a second time.
-    const ToolShape blade = ToolShape::box({0.2, 20, 10});
-    const CoarsePatch patch;
-    const ContactParameters parameters{0.0, 5.0};
-    const PlacedShape at = thin_blade(blade, 0.0, 0.05);
-    const ContactResult points_only = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals);
-    const ContactResult with = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, nullptr, patch.triangles);
+    const ContactResult points_only = touch(at(0.0, 0.05), false);
+    const ContactResult with = touch(at(0.0, 0.05), true);
     EXPECT_EQ(points_only.points.size(), 5u);
     EXPECT_EQ(with.points.size(), 5u);
     EXPECT_NEAR((with.force_on_tool_n - points_only.force_on_tool_n).norm(), 0.0, 1e-15);
 }
 
-TEST(EdgePenalty, AnEdgeTheBladeCrossedWithinTheStepPushesForThePartOfTheStepItWasIn)
+TEST_F(EdgePenalty, AnEdgeTheBladeCrossedWithinTheStepPushesForThePartOfTheStepItWasIn)
 {
     // Continuous, as a point: the blade comes down from 0.05 mm above to 0.05 mm below the patch
     // over the step, so each crossed edge is inside half of it, at a mean depth of 0.0125 mm.
-    const ToolShape blade = ToolShape::box({0.2, 20, 10});
-    const CoarsePatch patch;
-    const ContactParameters parameters{0.0, 5.0};
-    const PlacedShape from = thin_blade(blade, 1.0, -0.05), at = thin_blade(blade, 1.0, 0.05);
-    const ContactResult c = penalty_contact(at, parameters, patch.points, patch.areas, patch.normals, &from, patch.triangles);
+    const PlacedShape from = at(1.0, -0.05);
+    const ContactResult c = touch(at(1.0, 0.05), true, &from);
     const double area = 0.1 * 8.0 / 6.0;
     EXPECT_NEAR(-c.force_on_tool_n.z(), -9.0 * 5.0 / 100.0 * area * 0.0125, 1e-4 * 9.0 * 5.0 / 100.0 * area * 0.0125);
     // An edge's two ends share its stiffness, scaled by the half of the step it was inside.
