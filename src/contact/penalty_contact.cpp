@@ -56,9 +56,13 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
                   const Eigen::Vector3d& n_b, EdgePenalty& out) noexcept
 {
     const double margin = parameters.margin_mm, length = (b - a).norm();
-    if (!(d_a >= margin && d_b >= margin) || 0.5 * (d_a + d_b - length) >= margin) return false; // 1-Lipschitz: cannot reach in
-    if (from && (from->signed_distance(a) < margin || from->signed_distance(b) < margin)) return false; // a point contact has it
-    auto distance = [&](double t) { return tool.signed_distance(a + t * (b - a)); };
+    if (!(d_a >= margin && d_b >= margin)) return false; // a point contact has it
+    // 1-Lipschitz: the edge cannot reach in at a pose where its ends are this far out.
+    auto out_of_reach = [&](double f0, double f1) { return 0.5 * (f0 + f1 - length) >= margin; };
+    const double from_a = from ? from->signed_distance(a) : INFINITY, from_b = from ? from->signed_distance(b) : INFINITY;
+    if (from_a < margin || from_b < margin) return false; // a point contact has it, at the step's start
+    if (out_of_reach(d_a, d_b) && out_of_reach(from_a, from_b)) return false;
+
     // Whether any point of it is inside, at either pose: halving the edge while the distance's
     // Lipschitz bound leaves room (most edges near the tool are out after a sample or two).
     auto reaches_in = [&](const PlacedShape& shape, double f0, double f1) {
@@ -70,7 +74,7 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
         stack[top++] = {0.0, 1.0, f0, f1};
         while (top > 0) {
             const Span s = stack[--top];
-            if (0.5 * (s.f0 + s.f1 - (s.t1 - s.t0) * length) >= margin) continue;
+            if (0.5 * (s.f0 + s.f1 - (s.t1 - s.t0) * length) >= margin) continue; // out_of_reach for this span
             const double mid = 0.5 * (s.t0 + s.t1), fm = shape.signed_distance(a + mid * (b - a));
             if (fm < margin) return true;
             if (top + 2 > static_cast<int>(stack.size()) || (s.t1 - s.t0) * length < 1e-4) continue; // finer than 0.1 um: out
@@ -79,7 +83,11 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
         }
         return false;
     };
-    if (!reaches_in(tool, d_a, d_b) && !(from && reaches_in(*from, from->signed_distance(a), from->signed_distance(b)))) return false;
+    // The deepest point is looked for at the pose the edge reaches in at (the end's, if both).
+    const bool in_now = reaches_in(tool, d_a, d_b);
+    if (!in_now && !(from && reaches_in(*from, from_a, from_b))) return false;
+    const PlacedShape& search = in_now ? tool : *from;
+    auto distance = [&](double t) { return search.signed_distance(a + t * (b - a)); };
     constexpr double golden = 0.6180339887498949;
     double lo = 0.0, hi = 1.0, t1 = hi - golden * (hi - lo), t2 = lo + golden * (hi - lo), f1 = distance(t1), f2 = distance(t2);
     for (int k = 0; k < 30 && (hi - lo) * length > 1e-4; ++k) {
@@ -96,16 +104,15 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     double inside = out.depth > 0.0 ? 1.0 : 0.0;
     if (from) out.depth = mean_penetration(margin - from->signed_distance(out.at), out.depth, inside);
     if (!(out.depth > 0.0)) return false;
-    // The share of the edge inside, at the pose it is deeper in: bisection for where it leaves on each side.
-    const PlacedShape& deeper = out.distance < margin || !from ? tool : *from;
+    // The share of the edge inside, at that pose: bisection for where it leaves on each side.
     auto leaves = [&](double in, double outside) {
         for (int k = 0; k < 30 && std::abs(outside - in) * length > 1e-4; ++k) {
             const double mid = 0.5 * (in + outside);
-            (deeper.signed_distance(a + mid * (b - a)) < margin ? in : outside) = mid;
+            (search.signed_distance(a + mid * (b - a)) < margin ? in : outside) = mid;
         }
         return 0.5 * (in + outside);
     };
-    const double share = deeper.signed_distance(out.at) < margin ? leaves(t, 1.0) - leaves(t, 0.0) : 0.0;
+    const double share = search.signed_distance(out.at) < margin ? leaves(t, 1.0) - leaves(t, 0.0) : 0.0;
     out.w_a = 1.0 - t;
     out.area = std::max(share, 1e-3) * (area_a + area_b) / 6.0;
     const Eigen::Vector3d outward = out.w_a * n_a + t * n_b;

@@ -449,3 +449,13 @@ TEST_F(EdgePenalty, AnEdgeTheBladeCrossedWithinTheStepPushesForThePartOfTheStepI
     ASSERT_GE(c.points.size(), 2u);
     EXPECT_NEAR(c.points[0].stiffness_n_per_mm + c.points[1].stiffness_n_per_mm, 0.5 * 5.0 / 100.0 * area, 1e-4 * area);
 }
+
+TEST_F(EdgePenalty, AnEdgeLeftWithinTheStepPushesForThePartOfTheStepItWasIn)
+{
+    // Lifted fast: 0.05 mm in at the step's start, 5 mm clear at its end, so each crossed edge is
+    // inside 0.05 / 5.05 of the step, at a mean depth of half 0.05 mm over that share.
+    const PlacedShape from = at(1.0, 0.05);
+    const ContactResult c = touch(at(1.0, -5.0), true, &from);
+    const double area = 0.1 * 8.0 / 6.0, share = 0.05 / 5.05, expected = 9.0 * 5.0 / 100.0 * area * 0.5 * 0.05 * share;
+    EXPECT_NEAR(-c.force_on_tool_n.z(), -expected, 1e-3 * expected);
+}
