@@ -249,19 +249,24 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         }
         return reach.intersects(Eigen::AlignedBox3d(p.cwiseMin(q), p.cwiseMax(q)));
     };
-    for (const Eigen::Vector2i& edge : points.edges) {
-        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-        if (b >= points.count || !may_reach_in(a, b)) continue;
-        const double d_a = measured(a), d_b = measured(b);
-        if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
-                          points.areas_mm2[b], points.normals[a], points.normals[b], ep))
-            continue;
-        out.force_on_tool_n -= ep.force;
-        out.torque_on_tool_n_mm -= (ep.at - tool.position).cross(ep.force);
-        out.stiffness_n_per_mm += ep.stiffness * ep.normal * ep.normal.transpose();
-        out.area_mm2 += ep.area;
-        out.inner_reaches_surface = out.inner_reaches_surface || ep.distance < 0.0;
-    }
+    // Calls visit(ep) for each edge pressed (both passes).
+    auto for_each_pressed_edge = [&](auto&& visit) {
+        for (const Eigen::Vector2i& edge : points.edges) {
+            const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
+            if (b >= points.count || !may_reach_in(a, b)) continue;
+            const double d_a = measured(a), d_b = measured(b);
+            if (edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
+                             points.areas_mm2[b], points.normals[a], points.normals[b], ep))
+                visit(ep);
+        }
+    };
+    for_each_pressed_edge([&](const EdgePenalty& e) {
+        out.force_on_tool_n -= e.force;
+        out.torque_on_tool_n_mm -= (e.at - tool.position).cross(e.force);
+        out.stiffness_n_per_mm += e.stiffness * e.normal * e.normal.transpose();
+        out.area_mm2 += e.area;
+        out.inner_reaches_surface = out.inner_reaches_surface || e.distance < 0.0;
+    });
     if (!with_pressure || out.area_mm2 == 0.0) return out;
     // A second pass for the load-carrying part: nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
@@ -272,17 +277,11 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
     }
-    for (const Eigen::Vector2i& edge : points.edges) {
-        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-        if (b >= points.count || !may_reach_in(a, b)) continue;
-        const double d_a = measured(a), d_b = measured(b);
-        if (!edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
-                          points.areas_mm2[b], points.normals[a], points.normals[b], ep) ||
-            !carries_load(ep.force, net))
-            continue;
-        magnitude += ep.force.norm();
-        out.load_area_mm2 += ep.area;
-    }
+    for_each_pressed_edge([&](const EdgePenalty& e) {
+        if (!carries_load(e.force, net)) return;
+        magnitude += e.force.norm();
+        out.load_area_mm2 += e.area;
+    });
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;
 }

@@ -134,10 +134,13 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
     std::vector<std::uint32_t> near;
     std::vector<Eigen::Vector3d> near_mm;
     bool touching = false;
+    // Something may touch only where a vertex is within the margin, or within half the longest
+    // edge beyond it (an edge whose ends are both farther cannot reach in).
+    const double may_touch = 0.5 * (parameters.margin_mm + edge_reach);
     vertices_in(surface, node_positions, reach, [&](std::uint32_t v, const Eigen::Vector3d& p) {
         const double d = std::min(tool.signed_distance(p), from ? from->signed_distance(p) : INFINITY);
         if (d >= edge_reach) return;
-        touching = touching || d < edge_reach - parameters.margin_mm; // an edge may reach in
+        touching = touching || d < may_touch;
         near.push_back(v);
         near_mm.push_back(p);
     });
