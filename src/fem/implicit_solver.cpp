@@ -349,6 +349,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
             }
         }
     });
+    if (output != Output::forces) m_pairs.add_diagonal(m_contact_scale, m_diagonal); // not in the matrix: multiply() adds them
     m_update_plastic = false;
     double energy = 0.0;
     for (double e : m_element_energy) energy += e;
@@ -401,6 +402,7 @@ Eigen::VectorXd ImplicitSolver::external_force() const
         const NodeContact& k = m_contact[c];
         f.segment<3>(static_cast<Eigen::Index>(3 * k.node)) += k.force_n - k.stiffness_n_per_m * (m_x[k.node] - m_contact_x0[c]);
     }
+    m_pairs.add_forces(m_x, f);
     return f;
 }
 
@@ -421,10 +423,14 @@ void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 
 void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
-    if (!m_matrix_current) {
-        multiply_element_wise(p, out);
-        return;
-    }
+    if (!m_matrix_current) multiply_element_wise(p, out);
+    else multiply_matrix(p, out);
+    // Pair contacts couple nodes the matrix's pattern may not join (two pieces): added here.
+    m_pairs.add_product(p, m_contact_scale, m_fixed, out);
+}
+
+void ImplicitSolver::multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
     const int* outer = m_matrix.outerIndexPtr();
     const int* inner = m_matrix.innerIndexPtr();
     const double* values = m_matrix.valuePtr();
@@ -489,7 +495,7 @@ void ImplicitSolver::update_node_rotations()
         if (sum[n].squaredNorm() > 0.0) m_node_rotation[n].coeffs() = sum[n].normalized();
 }
 
-int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
+int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system)
 {
     const Eigen::Index n = rhs.size();
     Eigen::VectorXd inv_d(n), inv_sqrt_d(n);
@@ -498,7 +504,7 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
         inv_d[i] = d > 0.0 ? 1.0 / d : 1.0;
         inv_sqrt_d[i] = std::sqrt(inv_d[i]);
     }
-    if (m_preconditioner) {
+    if (m_preconditioner && !same_system) {
         update_node_rotations();
         m_preconditioner->update(m_matrix_current ? &m_matrix : nullptr, m_fixed, m_node_rotation);
         if (m_preconditioner->failed()) { // e.g. a factor of a singular K: nothing holds the object
@@ -516,7 +522,7 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
     const CgResult cg = conjugate_gradient([this](const Eigen::VectorXd& p, Eigen::VectorXd& out) { multiply(p, out); }, precondition, rhs,
                                            inv_sqrt_d, m_options.cg_tolerance, m_options.cg_max_iterations, x);
     residual = cg.residual;
-    if (m_preconditioner) m_preconditioner->report_iterations(cg.iterations);
+    if (m_preconditioner && !same_system) m_preconditioner->report_iterations(cg.iterations);
     return cg.iterations;
 }
 
@@ -539,7 +545,7 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     const auto n = static_cast<Eigen::Index>(3 * m_x.size());
     Eigen::Map<Eigen::VectorXd> v(m_v.front().data(), n);
     Eigen::Map<Eigen::VectorXd> x(m_x.front().data(), n);
-    const Eigen::VectorXd f_ext = external_force();
+    Eigen::VectorXd f_ext = external_force();
     if (dt != m_last_dt && m_preconditioner) m_preconditioner->invalidate(); // its matrix depends on dt
     m_last_dt = dt;
     m_step_dt = dt;
@@ -558,6 +564,20 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
         if (m_fixed[static_cast<std::size_t>(i)]) next[i] = 0.0;
     double residual = 0.0;
     s.cg_iterations += solve(rhs, next, residual);
+    if (!m_pairs.empty()) {
+        // A pair contact is linear in the solve and would pull two sides that part during the
+        // step back together (a piece rocking on another sticks to it by one edge): those let go
+        // and the step is solved again without them (the solve starts from the first answer).
+        std::vector<Eigen::Vector3d> end(m_x.size());
+        for (std::size_t i = 0; i < m_x.size(); ++i) end[i] = m_x[i] + dt * next.segment<3>(3 * static_cast<Eigen::Index>(i));
+        if (m_pairs.release_pulling(end) > 0) {
+            f_ext = external_force();
+            mass_times(m_v, rhs);
+            rhs += dt * (f_ext - m_internal);
+            apply_constraints(rhs);
+            s.cg_iterations += solve(rhs, next, residual, true);
+        }
+    }
     s.residual = std::max(s.residual, residual);
     s.converged = s.converged && residual <= m_options.cg_tolerance;
     s.solve_ms += ms_since(t);
@@ -569,6 +589,7 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     double contact_correction = 0.0;
     for (const NodeContact& c : m_contact)
         contact_correction += m_v[c.node].dot(c.stiffness_n_per_m * m_v[c.node]);
+    contact_correction += m_pairs.stiffness_product(m_v);
     return dt * f_ext.dot(v) - 0.5 * dt * dt * contact_correction;
 }
 
@@ -589,6 +610,7 @@ double ImplicitSolver::incremental_potential(double dt, const std::vector<Eigen:
         const Eigen::Vector3d d = m_x[k.node] - m_contact_x0[c];
         u += -k.force_n.dot(d) + 0.5 * d.dot(k.stiffness_n_per_m * d);
     }
+    u += m_pairs.potential(m_x);
     return 0.5 * (1.0 + dt * m_options.rayleigh_mass_per_s) * v.dot(mv) - v.dot(m_v0) + psi + u;
 }
 
@@ -647,6 +669,8 @@ double ImplicitSolver::newton_step(double dt, StepStats& s, double& energy_befor
             next = incremental_potential(dt, x0, m_v0);
             converged = true;
         }
+        for (std::size_t i = 0; i < m_x.size(); ++i) m_x[i] = x0[i] + dt * m_v[i];
+        if (m_pairs.release_pulling(m_x) > 0) next = incremental_potential(dt, x0, m_v0); // a contact only pushes
         phi = next;
     }
     s.converged = s.converged && converged;
@@ -654,6 +678,7 @@ double ImplicitSolver::newton_step(double dt, StepStats& s, double& energy_befor
     m_element_pass_current = false;
     double contact_correction = 0.0;
     for (const NodeContact& c : m_contact) contact_correction += m_v[c.node].dot(c.stiffness_n_per_m * m_v[c.node]);
+    contact_correction += m_pairs.stiffness_product(m_v);
     return dt * f_start.dot(v) - 0.5 * dt * dt * contact_correction;
 }
 
@@ -769,7 +794,7 @@ StepStats ImplicitSolver::step()
         for (int it = 0; it < m_options.newton_max_iterations; ++it) {
             auto t = std::chrono::steady_clock::now();
             assemble(0.0, 1.0, system_output());
-            if (!m_contact.empty()) f_ext = external_force(); // contact forces follow the nodes
+            if (!m_contact.empty() || !m_pairs.empty()) f_ext = external_force(); // contact forces follow the nodes
             Eigen::VectorXd rhs = f_ext - m_internal;
             apply_constraints(rhs);
             s.assembly_ms += ms_since(t);
@@ -785,6 +810,7 @@ StepStats ImplicitSolver::step()
             s.solve_ms += ms_since(t);
             x += dx;
             m_element_pass_current = false;
+            m_pairs.release_pulling(m_x); // a contact only pushes
             ++s.newton_iterations;
         }
     }

@@ -7,6 +7,7 @@
 // iterations until the force residual meets the tolerance, so further frames change nothing.
 
 #include "fem/hex_model.hpp"
+#include "fem/pair_contact.hpp"
 #include "fem/preconditioner.hpp"
 
 #include <Eigen/Sparse>
@@ -101,6 +102,14 @@ public:
     /// stays stable at any dt (an explicit penalty force on a light node explodes).
     void set_contact(std::vector<NodeContact> contact);
     [[nodiscard]] const std::vector<NodeContact>& contact() const { return m_contact; }
+    /// Contacts between material points the elements do not join (pieces, the walls of a cut;
+    /// fem/pair_contact.hpp) for the following steps, replacing the previous ones; blocks are
+    /// nodes. Taken implicitly, as set_contact's. Throws std::invalid_argument for a node out of range.
+    void set_pair_contact(std::vector<PairContact> pairs) { m_pairs.set(std::move(pairs), m_x); }
+    [[nodiscard]] const std::vector<PairContact>& pair_contact() const { return m_pairs.pairs(); }
+    /// The pair contacts' total force magnitude at the current positions (after a step: what it
+    /// applied at its end), N.
+    [[nodiscard]] double pair_contact_force_n() const { return m_pairs.total_force(m_x); }
 
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
@@ -168,12 +177,14 @@ private:
     Eigen::VectorXd external_force() const;
     void apply_constraints(Eigen::VectorXd& rhs);
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    void multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void update_node_rotations();
     /// Flags the elements with a degree of freedom free to move (m_active); the others are
     /// skipped by every element loop.
     void update_active();
-    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
+    /// `same_system`: the matrix and preconditioner of the previous solve, another right-hand side.
+    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system = false);
     [[nodiscard]] double kinetic_energy() const;
     /// One linearised implicit Euler step of `dt`; returns the external forces' work over it and
     /// sets `energy_before` to the kinetic plus elastic energy at its start.
@@ -205,6 +216,7 @@ private:
     std::vector<Eigen::Vector3d> m_contact_x0;  ///< per contact: the node's position when it was set
     std::vector<std::int32_t> m_contact_of_node; ///< per node: index in m_contact, or -1
     double m_contact_scale = 0.0;                ///< factor of the contact stiffness in the system matrix
+    PairContacts m_pairs;
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     SystemMatrix m_matrix;
     std::vector<std::uint16_t> m_rank;          ///< per element and corner pair (c, d): d's node among c's node's neighbours

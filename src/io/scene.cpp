@@ -525,6 +525,21 @@ Obstacle read_obstacle(JsonReader r)
     return o;
 }
 
+PieceContactSettings read_piece_contact(const JsonNode& node)
+{
+    PieceContactSettings p;
+    if (node.value().is_boolean()) {
+        p.enabled = node.value().get<bool>();
+        return p;
+    }
+    if (!node.value().is_object()) node.fail("must be true, false or an object with \"stiffness_n_per_mm\"");
+    p.enabled = true;
+    JsonReader r(node);
+    p.stiffness_n_per_mm = r.optional("stiffness_n_per_mm", p.stiffness_n_per_mm, half_open_range(0.0, 1e4));
+    r.finish();
+    return p;
+}
+
 WetRegion read_wet_region(JsonReader r)
 {
     WetRegion w;
@@ -661,6 +676,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
     const std::optional<JsonNode> gravity = root.optional_node("gravity_m_s2");
     const std::optional<JsonNode> constraints = root.optional_node("constraints");
     const std::optional<JsonNode> obstacles = root.optional_node("obstacles");
+    const std::optional<JsonNode> piece_contact = root.optional_node("piece_contact");
     const std::optional<JsonNode> loads = root.optional_node("loads");
     const std::optional<JsonNode> wet_regions = root.optional_node("wet_regions");
     const std::optional<JsonNode> tools = root.optional_node("tools");
@@ -699,6 +715,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
         // An object given something to rest on is let go onto it unless the file says otherwise.
         if (!scene.obstacles.empty() && !scene.object.unheld_given) scene.object.unheld = UnheldPieces::fall;
     }
+    if (piece_contact) scene.piece_contact = read_piece_contact(*piece_contact);
     if (loads) {
         for (const JsonNode& node : loads->elements()) {
             scene.loads.push_back(read_load(JsonReader(node)));

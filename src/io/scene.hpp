@@ -207,6 +207,16 @@ struct Obstacle {
     double stiffness_n_per_mm = 10.0;
 };
 
+/// Key "piece_contact": contact of the object with itself (pieces cut free on the rest, the walls
+/// of a cut pressed together, folds): the tools' penalty model, vertex against face
+/// (contact/piece_contact.hpp), frictionless. Off unless the scene turns it on (`true`, or an
+/// object setting its stiffness): with a blade in a slit it is not yet stable (docs/fem.md).
+struct PieceContactSettings {
+    bool enabled = false;
+    /// Penalty stiffness per cm^2 of contact, N/mm, in (0, 1e4].
+    double stiffness_n_per_mm = 10.0;
+};
+
 /// An external point force: a total force, world frame, shared equally by the nodes whose rest
 /// position lies in an axis-aligned box, boundary included. A box that catches no node is an
 /// error found when the grid exists.
@@ -351,6 +361,7 @@ struct Scene {
     std::vector<Constraint> constraints;
     /// Static obstacles; none by default.
     std::vector<Obstacle> obstacles;
+    PieceContactSettings piece_contact;
     /// External point forces, constant in time; none by default.
     std::vector<Load> loads;
     /// Initial water content by region; none by default (dry).

@@ -92,12 +92,14 @@ void XfemSolver::model_changed()
     m_preconditioner_failed = false;
 }
 
-int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual)
+int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system)
 {
+    const double contact_scale = m_options.dt_s * m_options.dt_s;
     Eigen::VectorXd inv_d = m_operator.diagonal();
+    m_pairs.add_diagonal(contact_scale, inv_d);
     for (Eigen::Index i = 0; i < inv_d.size(); ++i)
         inv_d[i] = m_fixed[static_cast<std::size_t>(i)] || !(inv_d[i] > 0.0) ? 1.0 : 1.0 / inv_d[i];
-    const bool factor = m_preconditioner && !m_preconditioner_failed;
+    const bool factor = m_preconditioner && !m_preconditioner_failed && !same_system;
     if (factor) {
         m_operator.block_rotations(m_block_rotation);
         m_preconditioner->update(&m_operator.matrix(), m_fixed, m_block_rotation);
@@ -112,11 +114,16 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
         else
             out = res.cwiseProduct(inv_d);
     };
-    const fem::CgResult cg = fem::conjugate_gradient([this](const Eigen::VectorXd& p, Eigen::VectorXd& out) { m_operator.multiply(p, out); },
+    // Pair contacts couple blocks the matrix's pattern may not join (two pieces): added to its product.
+    const auto multiply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& out) {
+        m_operator.multiply(p, out);
+        m_pairs.add_product(p, contact_scale, m_fixed, out);
+    };
+    const fem::CgResult cg = fem::conjugate_gradient(multiply,
                                                      precondition, rhs, inv_d.cwiseSqrt(), m_options.cg_tolerance,
                                                      m_options.cg_max_iterations, x);
     residual = cg.residual;
-    if (m_preconditioner && !m_preconditioner_failed) m_preconditioner->report_iterations(cg.iterations);
+    if (m_preconditioner && !m_preconditioner_failed && !same_system) m_preconditioner->report_iterations(cg.iterations);
     return cg.iterations;
 }
 
@@ -150,11 +157,29 @@ XfemStepStats XfemSolver::step()
     for (std::uint32_t b : m_regularised) rhs.segment<3>(3 * static_cast<Eigen::Index>(b)) += shift * v.segment<3>(3 * static_cast<Eigen::Index>(b));
     Eigen::VectorXd next = v;
     if (m_previous_v.size() == n) next += v - m_previous_v; // CG starts from the velocity extrapolated (one iteration fewer at the median)
+    Eigen::VectorXd contact = Eigen::VectorXd::Zero(n);
+    m_pairs.add_forces(m_x, contact);
+    rhs += dt * contact;
     for (Eigen::Index i = 0; i < n; ++i)
         if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = next[i] = 0.0;
     s.assembly_ms = ms_since(start);
     const auto t = std::chrono::steady_clock::now();
     s.cg_iterations = solve(rhs, next, s.residual);
+    if (!m_pairs.empty()) {
+        // A pair contact that would pull two parting sides together at the step's end lets go,
+        // and the step is solved again without it (from the first answer).
+        std::vector<Eigen::Vector3d> end(m_x.size());
+        for (std::size_t b = 0; b < m_x.size(); ++b) end[b] = m_x[b] + dt * next.segment<3>(3 * static_cast<Eigen::Index>(b));
+        if (m_pairs.release_pulling(end) > 0) {
+            rhs -= dt * contact;
+            contact.setZero();
+            m_pairs.add_forces(m_x, contact);
+            rhs += dt * contact;
+            for (Eigen::Index i = 0; i < n; ++i)
+                if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = 0.0;
+            s.cg_iterations += solve(rhs, next, s.residual, true);
+        }
+    }
     s.converged = s.residual <= m_options.cg_tolerance;
     s.solve_ms = ms_since(t);
     m_previous_v = v;

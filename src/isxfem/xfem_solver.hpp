@@ -16,6 +16,7 @@
 #include "isxfem/xfem_model.hpp"
 #include "isxfem/xfem_operator.hpp"
 
+#include "fem/pair_contact.hpp"
 #include "fem/preconditioner.hpp"
 
 #include <Eigen/Geometry>
@@ -96,6 +97,13 @@ public:
     /// Forces at material points for the following steps (replacing the last ones), taken
     /// implicitly with their stiffness. Throws std::out_of_range for a tetrahedron that is not there.
     void set_point_loads(std::vector<PointLoad> loads);
+    /// Contacts between material points the elements do not join (pieces, a crack's walls;
+    /// fem/pair_contact.hpp) for the following steps, on dof blocks, replacing the previous ones:
+    /// taken implicitly; those that would pull at the step's end are let go and the step solved
+    /// again. Throws std::invalid_argument for a block out of range.
+    void set_pair_contact(std::vector<fem::PairContact> pairs) { m_pairs.set(std::move(pairs), m_x); }
+    /// Their total force magnitude at the current state (after a step: what it applied at its end), N.
+    [[nodiscard]] double pair_contact_force_n() const { return m_pairs.total_force(m_x); }
     /// The weights of the dof blocks of tetrahedron t (its nodes, then per cut their enriched
     /// blocks: psi_jc N_c) at the point with barycentric coordinates `n` in region `region`
     /// (XfemElement::region_at): the point moves by sum_a w_a x_a, and a force f there acts on
@@ -122,7 +130,8 @@ private:
     /// The per-block vectors `blocks` (positions or velocities) at a material point, as position().
     [[nodiscard]] Eigen::Vector3d interpolate(std::size_t t, const std::array<double, 4>& n, int region,
                                               const std::vector<Eigen::Vector3d>& blocks) const;
-    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual);
+    /// `same_system`: the matrix and preconditioner of the previous solve, another right-hand side.
+    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system = false);
 
     const XfemModel& m_model;
     XfemOptions m_options;
@@ -137,6 +146,7 @@ private:
     std::vector<fem::JumpBlock> m_jumps; ///< every enriched block with its node
     std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
     std::vector<PointLoad> m_loads;
+    fem::PairContacts m_pairs;
     Eigen::VectorXd m_previous_v;
 };
 

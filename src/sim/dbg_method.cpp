@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/stopwatch.hpp"
+#include "cut/piece_contact.hpp"
 #include "cut/pieces.hpp"
 #include "cut/voxel_cut.hpp"
 
@@ -290,6 +291,20 @@ void DbgMethod::end_tools()
         cut::merge_node_contacts(nodes, c.nodes);
     }
     m_sim->solver().set_contact(std::move(nodes));
+    m_piece_contact = {};
+    if (m_scene.piece_contact.enabled) {
+        Stopwatch clock;
+        const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
+        cut::PieceContact c = cut::touch_pieces(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(),
+                                                m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
+        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), c.force_n(), 0.0};
+        // A piece pressed by one that moves wakes as a tool's reach would wake it.
+        for (const contact::FaceContact& f : c.faces)
+            m_tool_reach.emplace_back(c.patch.start_mm[f.vertex] - Eigen::Vector3d::Constant(voxel_mm),
+                                      c.patch.start_mm[f.vertex] + Eigen::Vector3d::Constant(voxel_mm));
+        m_sim->solver().set_pair_contact(std::move(c.pairs));
+        m_piece_contact.ms = clock.lap();
+    }
     m_sim->set_tool_reach(std::move(m_tool_reach));
     m_tool_reach.clear();
 }
@@ -297,6 +312,7 @@ void DbgMethod::end_tools()
 StepFigures DbgMethod::step()
 {
     const fem::StepStats s = m_sim->step();
+    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force_n();
     StepFigures out;
     out.step_ms = s.step_ms;
     out.assembly_ms = s.assembly_ms;

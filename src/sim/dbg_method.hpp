@@ -63,6 +63,7 @@ public:
     [[nodiscard]] std::size_t piece_count() const override;
     [[nodiscard]] const std::vector<contact::Obstacle>& obstacles() const override { return m_obstacles; }
     [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
+    [[nodiscard]] PieceContactFigures piece_contact() const override { return m_piece_contact; }
     void add_summary_figures(nlohmann::json& summary) const override;
 
     [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
@@ -109,6 +110,7 @@ private:
     std::vector<contact::Obstacle> m_obstacles;
     std::vector<contact::FrictionAnchors> m_anchors; ///< per obstacle
     Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
+    PieceContactFigures m_piece_contact;                        ///< this frame
     // Per tool, this frame and across frames.
     std::vector<cut::SurfaceContact> m_touch;
     std::vector<Eigen::AlignedBox3d> m_tool_reach; ///< this frame's tools, grown by k_sleep_tool_mm (DbgSimulation::set_tool_reach)

@@ -163,6 +163,15 @@ void IsxfemMethod::end_tools()
         loads.insert(loads.end(), t.loads.begin(), t.loads.end());
     }
     m_sim->solver().set_point_loads(std::move(loads));
+    m_piece_contact = {};
+    if (m_scene.piece_contact.enabled) {
+        Stopwatch clock;
+        const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
+        IsxfemSimulation::PieceTouch t = m_sim->touch_pieces(m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
+        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0};
+        m_sim->solver().set_pair_contact(std::move(t.pairs));
+        m_piece_contact.ms = clock.lap();
+    }
     // The run's counts, and what the user is told once.
     const isxfem::CutReport& c = m_frame_cut;
     if (c.crossed_tets > 0 && m_crossed == 0)
@@ -185,6 +194,7 @@ void IsxfemMethod::end_tools()
 StepFigures IsxfemMethod::step()
 {
     const isxfem::XfemStepStats s = m_sim->solver().step();
+    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force_n();
     StepFigures out;
     out.step_ms = s.step_ms;
     out.assembly_ms = s.assembly_ms;

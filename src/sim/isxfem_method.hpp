@@ -58,6 +58,7 @@ public:
     [[nodiscard]] std::size_t piece_count() const override;
     [[nodiscard]] const std::vector<contact::Obstacle>& obstacles() const override { return m_obstacles; }
     [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
+    [[nodiscard]] PieceContactFigures piece_contact() const override { return m_piece_contact; }
     void add_frame_figures(nlohmann::json& frame) const override;
     void add_summary_figures(nlohmann::json& summary) const override;
 
@@ -82,6 +83,7 @@ private:
     std::vector<contact::Obstacle> m_obstacles;
     std::vector<contact::FrictionAnchors> m_anchors; ///< per obstacle
     Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
+    PieceContactFigures m_piece_contact;                        ///< this frame
     // Per tool.
     std::vector<std::optional<BladeStroke>> m_strokes; ///< blades and scalpels that cut
     std::vector<contact::ContactResult> m_contact;

@@ -387,6 +387,50 @@ IsxfemSimulation::Touch IsxfemSimulation::touch_obstacle(const contact::Obstacle
     return out;
 }
 
+IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const
+{
+    // The whole closed surface: no broad phase by elements here (a crack's two walls lie in the
+    // same tetrahedra), the contact's grid of triangles is the only one.
+    refresh_closed_surface();
+    const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
+    contact::SurfacePatch patch;
+    patch.triangles = m_closed_triangles;
+    patch.presses.assign(vertices.size(), 1);
+    patch.start_mm.reserve(vertices.size());
+    for (const isxfem::SurfacePoint& v : vertices) {
+        const Eigen::Vector3d x = 1e3 * m_solver->position(v.tet, v.bary, v.side);
+        patch.start_mm.push_back(x);
+        patch.end_mm.push_back(x + 1e3 * dt_s * m_solver->velocity(v.tet, v.bary, v.side));
+        patch.rest_mm.push_back(1e3 * v.rest_m);
+    }
+    PieceTouch out;
+    out.vertices = vertices.size();
+    out.faces = contact::face_contacts(patch, parameters);
+    // Each point moves with its tetrahedron's blocks (Is-XFEM's weights on its side of the cuts).
+    auto add = [&](const isxfem::SurfacePoint& v, double weight, std::vector<fem::BlockWeight>& terms) {
+        const isxfem::XfemElement& el = m_model->elements()[v.tet];
+        const auto w = m_solver->weights(v.tet, v.bary, v.side);
+        for (std::size_t a = 0; a < el.block_count(); ++a) {
+            if (w[a] == 0.0) continue;
+            const std::uint32_t block = el.block(a);
+            auto it = std::find_if(terms.begin(), terms.end(), [&](const fem::BlockWeight& t) { return t.block == block; });
+            if (it == terms.end()) terms.push_back({block, weight * w[a]});
+            else it->weight += weight * w[a];
+        }
+    };
+    for (const contact::FaceContact& f : out.faces) {
+        fem::PairContact pair;
+        add(vertices[f.vertex], 1.0, pair.terms);
+        for (int c = 0; c < 3; ++c)
+            add(vertices[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
+        pair.normal = f.normal;
+        pair.force_n = f.force_n;
+        pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
+        out.pairs.push_back(std::move(pair));
+    }
+    return out;
+}
+
 void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::SurfacePoints& out, double closed_walls_mm) const
 {
     const NearSurface s = near_surface(box, closed_walls_mm);

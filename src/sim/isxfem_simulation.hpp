@@ -9,7 +9,9 @@
 
 #include "contact/obstacle.hpp"
 #include "contact/penalty_contact.hpp"
+#include "contact/piece_contact.hpp"
 #include "contact/surface_points.hpp"
+#include "fem/pair_contact.hpp"
 #include "io/scene.hpp"
 #include "isxfem/cut_closure.hpp"
 #include "isxfem/grid_tets.hpp"
@@ -91,6 +93,16 @@ public:
     /// (contact::obstacle_contact; `anchors` its friction's, by material point: rest position and
     /// side), with the forces as point loads.
     [[nodiscard]] Touch touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors) const;
+
+    /// The closed surface pressed against itself over a step of `dt_s` (contact/piece_contact.hpp:
+    /// pieces on pieces, the walls of a crack), every vertex pressing, and each contact as a pair
+    /// contact on the dof blocks of its two material points (fem/pair_contact.hpp).
+    struct PieceTouch {
+        std::vector<contact::FaceContact> faces;
+        std::vector<fem::PairContact> pairs;
+        std::size_t vertices = 0; ///< surface vertices tested
+    };
+    [[nodiscard]] PieceTouch touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const;
 
     /// Fills `out` with the points of the deformed, closed surface within `box` (world mm), each
     /// with its area and outward normal, and the triangles among them: the snapshot the haptic

@@ -12,6 +12,7 @@
 // tetrahedra enriched).
 
 #include "contact/obstacle.hpp"
+#include "sim/piece_contact.hpp"
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
@@ -149,6 +150,8 @@ public:
     /// frame, N, friction included.
     [[nodiscard]] virtual const std::vector<contact::Obstacle>& obstacles() const = 0;
     [[nodiscard]] virtual Eigen::Vector3d obstacle_force_n() const = 0;
+    /// The object's contact with itself this frame (the scene's "piece_contact").
+    [[nodiscard]] virtual PieceContactFigures piece_contact() const = 0;
 
     /// The same object at another level, from rest: the branched grid keeps its cuts (replayed on
     /// the new level's grid); Is-XFEM starts uncut (its cuts live in the tetrahedra of one level).

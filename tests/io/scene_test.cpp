@@ -507,6 +507,27 @@ TEST(SceneParse, BadObstaclesNameTheKeyPath)
                   .rfind("s.json: obstacles[0].normal: unknown key", 0), 0u);
 }
 
+TEST(SceneParse, PieceContactIsOffUnlessTurnedOnAndTakesAStiffness)
+{
+    json doc = minimal_scene();
+    EXPECT_FALSE(parse_scene(doc, "/tmp", "p.json").piece_contact.enabled);
+    doc["piece_contact"] = true;
+    EXPECT_TRUE(parse_scene(doc, "/tmp", "p.json").piece_contact.enabled);
+    EXPECT_EQ(parse_scene(doc, "/tmp", "p.json").piece_contact.stiffness_n_per_mm, 10.0);
+    doc["piece_contact"] = {{"stiffness_n_per_mm", 25}};
+    const Scene s = parse_scene(doc, "/tmp", "p.json");
+    EXPECT_TRUE(s.piece_contact.enabled);
+    EXPECT_EQ(s.piece_contact.stiffness_n_per_mm, 25.0);
+    doc["piece_contact"] = false;
+    EXPECT_FALSE(parse_scene(doc, "/tmp", "p.json").piece_contact.enabled);
+    doc["piece_contact"] = {{"stiffness_n_per_mm", 0}};
+    EXPECT_EQ(scene_error(doc).rfind("s.json: piece_contact.stiffness_n_per_mm: ", 0), 0u);
+    doc["piece_contact"] = {{"friction", 0.3}};
+    EXPECT_EQ(scene_error(doc).rfind("s.json: piece_contact.friction: unknown key", 0), 0u);
+    doc["piece_contact"] = "yes";
+    EXPECT_EQ(scene_error(doc), "s.json: piece_contact: must be true, false or an object with \"stiffness_n_per_mm\"");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tools: contact and cutting keys; script: orientation.
 // ---------------------------------------------------------------------------------------------
@@ -823,7 +844,7 @@ void PrintTo(const BadScene& b, std::ostream* os) { *os << b.name; }
 
 const BadScene bad_scenes[] = {
     BadScene{"unknown_key", "toolz",
-             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, obstacles, loads, wet_regions, tools, script, "
+             "unknown key (known keys: object, materials, solver, gravity_m_s2, constraints, obstacles, piece_contact, loads, wet_regions, tools, script, "
              "output)"},
     BadScene{"unknown_phantom_key", "object.phantom.radius_mm",
              "unknown key for a beam phantom (known keys: shape, voxel_mm, size_mm)"},

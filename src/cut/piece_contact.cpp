@@ -1,0 +1,161 @@
+#include "cut/piece_contact.hpp"
+
+#include "grid/hex8.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace vox::cut {
+
+namespace {
+
+/// Elements holding surface vertices whose swept, deformed boxes come within `gap_mm` of another
+/// such element's without sharing a node with it (the broad phase of the header); sets `pairs`.
+std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& start_m,
+                                                const std::vector<Eigen::Vector3d>& end_m, double gap_mm, std::size_t& pairs)
+{
+    const fem::HexModel& model = surface.model();
+    const auto& elements = model.elements();
+    std::vector<std::uint32_t> candidates;
+    std::vector<Eigen::AlignedBox3d> boxes;
+    for (std::uint32_t e = 0; e < elements.size(); ++e) {
+        bool has_vertex = false;
+        surface.for_each_element_vertex(e, [&](std::uint32_t) { has_vertex = true; });
+        if (!has_vertex) continue;
+        Eigen::AlignedBox3d box;
+        box.setEmpty();
+        for (std::uint32_t n : elements[e].dof_node) {
+            box.extend(1e3 * start_m[n]);
+            box.extend(1e3 * end_m[n]);
+        }
+        candidates.push_back(e);
+        boxes.emplace_back(box.min().array() - 0.5 * gap_mm, box.max().array() + 0.5 * gap_mm);
+    }
+    // A uniform grid of the elements' edge: each box meets a few cells.
+    const double cell = 1e3 * surface.grid().voxels().voxel_size_m().maxCoeff() * std::ldexp(1.0, model.level());
+    auto cells = [&](const Eigen::AlignedBox3d& b, auto&& f) {
+        const Eigen::Array3i lo = (b.min().array() / cell).floor().cast<int>(), hi = (b.max().array() / cell).floor().cast<int>();
+        for (int z = lo.z(); z <= hi.z(); ++z)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int x = lo.x(); x <= hi.x(); ++x)
+                    f((static_cast<std::uint64_t>(x & 0x1FFFFF)) | (static_cast<std::uint64_t>(y & 0x1FFFFF) << 21) |
+                      (static_cast<std::uint64_t>(z & 0x1FFFFF) << 42));
+    };
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
+    for (std::uint32_t i = 0; i < candidates.size(); ++i) cells(boxes[i], [&](std::uint64_t key) { entries.emplace_back(key, i); });
+    std::sort(entries.begin(), entries.end());
+    std::vector<unsigned char> kept(candidates.size(), 0);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> found;
+    for (std::size_t a = 0; a < entries.size();) {
+        std::size_t b = a;
+        while (b < entries.size() && entries[b].first == entries[a].first) ++b;
+        for (std::size_t i = a; i < b; ++i)
+            for (std::size_t j = i + 1; j < b; ++j) {
+                const std::uint32_t p = std::min(entries[i].second, entries[j].second), q = std::max(entries[i].second, entries[j].second);
+                if (!boxes[p].intersects(boxes[q])) continue;
+                const auto& np = elements[candidates[p]].dof_node;
+                const auto& nq = elements[candidates[q]].dof_node;
+                const bool joined = std::any_of(np.begin(), np.end(), [&](std::uint32_t n) { return std::find(nq.begin(), nq.end(), n) != nq.end(); });
+                if (joined) continue;
+                found.emplace_back(p, q);
+            }
+        a = b;
+    }
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    pairs = found.size();
+    for (const auto& [p, q] : found) kept[p] = kept[q] = 1;
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t i = 0; i < candidates.size(); ++i)
+        if (kept[i]) out.push_back(candidates[i]);
+    return out;
+}
+
+/// Adds weight times vertex slot v's trilinear weights on its element's nodes to `terms`.
+void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weight, std::vector<fem::BlockWeight>& terms)
+{
+    const fem::HexElement& el = surface.model().elements()[surface.vertex_element(v)];
+    const Eigen::Vector3d local = surface.vertex_local(v);
+    for (int corner = 0; corner < 8; ++corner) {
+        const double w = weight * grid::hex8_shape(corner, local);
+        if (w == 0.0) continue;
+        const std::uint32_t node = el.dof_node[static_cast<std::size_t>(corner)];
+        auto it = std::find_if(terms.begin(), terms.end(), [&](const fem::BlockWeight& t) { return t.block == node; });
+        if (it == terms.end()) terms.push_back({node, w});
+        else it->weight += w;
+    }
+}
+
+} // namespace
+
+double PieceContact::force_n() const
+{
+    double sum = 0.0;
+    for (const contact::FaceContact& f : faces) sum += f.force_n;
+    return sum;
+}
+
+PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                          const std::vector<Eigen::Vector3d>& node_velocities, double dt_s, const contact::PieceContactParameters& parameters)
+{
+    PieceContact out;
+    std::vector<Eigen::Vector3d> end(node_positions.size());
+    for (std::size_t n = 0; n < end.size(); ++n) end[n] = node_positions[n] + dt_s * node_velocities[n];
+    const std::vector<std::uint32_t> near = elements_near_others(surface, node_positions, end, parameters.approach_mm, out.element_pairs);
+    if (near.empty()) return out;
+    // The patch: the near elements' vertices and the corners of their triangles, each once.
+    std::unordered_map<std::uint32_t, std::uint32_t> index;
+    const auto& triangles = surface.embedded().triangles();
+    contact::SurfacePatch& patch = out.patch;
+    auto add = [&](std::uint32_t v, bool presses) {
+        const auto [it, added] = index.emplace(v, static_cast<std::uint32_t>(out.slots.size()));
+        if (added) {
+            out.slots.push_back(v);
+            patch.presses.push_back(0);
+        }
+        if (presses) patch.presses[it->second] = 1;
+    };
+    for (std::uint32_t e : near)
+        surface.for_each_element_vertex(e, [&](std::uint32_t v) {
+            add(v, true);
+            for (std::uint32_t t : surface.vertex_triangles(v))
+                for (std::uint32_t c : triangles[t]) add(c, false);
+        });
+    patch.outward_sign = surface.outward_sign();
+    for (std::uint32_t v : out.slots) {
+        patch.start_mm.push_back(surface.vertex_mm(v, node_positions));
+        patch.end_mm.push_back(surface.vertex_mm(v, end));
+        patch.rest_mm.push_back(surface.vertex_rest_mm(v));
+    }
+    // Triangles among the patch's vertices, each once; the near elements' own vertices press.
+    for (std::uint32_t i = 0; i < out.slots.size(); ++i)
+        for (std::uint32_t t : surface.vertex_triangles(out.slots[i])) {
+            Eigen::Vector3i corners;
+            bool all = true;
+            for (int c = 0; c < 3 && all; ++c) {
+                const auto found = index.find(triangles[t][static_cast<std::size_t>(c)]);
+                all = found != index.end();
+                if (all) corners[c] = static_cast<int>(found->second);
+            }
+            if (all && static_cast<std::uint32_t>(corners.minCoeff()) == i) patch.triangles.push_back(corners);
+        }
+    out.faces = contact::face_contacts(patch, parameters);
+    // On the nodes: the vertex's element's weights, minus the pressed point's (its triangle's
+    // corners' weights times their elements').
+    for (const contact::FaceContact& f : out.faces) {
+        fem::PairContact pair;
+        add_vertex_terms(surface, out.slots[f.vertex], 1.0, pair.terms);
+        for (int c = 0; c < 3; ++c)
+            add_vertex_terms(surface, out.slots[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
+        pair.normal = f.normal;
+        pair.force_n = f.force_n;
+        pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
+        out.pairs.push_back(std::move(pair));
+    }
+    return out;
+}
+
+} // namespace vox::cut

@@ -1,0 +1,37 @@
+#pragma once
+// The scene's "piece_contact" key as the contact model's parameters, and what a frame's contact of
+// the object with itself measured (stats.json: frames' piece_contact).
+
+#include "contact/piece_contact.hpp"
+#include "io/scene.hpp"
+
+#include <cstddef>
+
+namespace vox::sim {
+
+struct PieceContactFigures {
+    bool enabled = false;            ///< the scene's "piece_contact" is on
+    std::size_t contacts = 0;        ///< vertices pressing a face this frame
+    std::size_t tested_vertices = 0; ///< surface vertices the broad phase passed on
+    double force_n = 0.0;            ///< sum of the contacts' force magnitudes at the step's end
+    double ms = 0.0;                 ///< time to find them and gather them on the model
+};
+
+/// The contact parameters for a scene whose voxels are `voxel_mm` long. Deeper than two voxels
+/// is not a contact: a step under gravity alone moves g dt^2 (a voxel of 1 mm at dt 0.01 s), and
+/// a vertex caught there must still be pushed back. Elements are tested when they come within
+/// 0.9 voxel of each other (so never two of a whole object: at level 0 the nearest elements that
+/// share no node are a voxel apart); apart by less than 2 % of a voxel is touching. Behind the
+/// rest surface by more than half a voxel is through material.
+[[nodiscard]] inline contact::PieceContactParameters piece_contact_parameters(const io::Scene& scene, double voxel_mm)
+{
+    contact::PieceContactParameters p;
+    p.stiffness_n_per_mm = scene.piece_contact.stiffness_n_per_mm;
+    p.max_depth_mm = 2.0 * voxel_mm;
+    p.approach_mm = 0.9 * voxel_mm;
+    p.skin_mm = 0.02 * voxel_mm;
+    p.rest_tolerance_mm = 0.5 * voxel_mm;
+    return p;
+}
+
+} // namespace vox::sim
