@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 namespace vox::contact {
@@ -43,14 +44,20 @@ public:
             for_cells(box.min(), box.max(), [&](std::uint64_t key) { m_entries.emplace_back(key, i); });
         }
         std::sort(m_entries.begin(), m_entries.end());
+        m_cells.reserve(m_entries.size());
+        for (std::uint32_t a = 0, b = 0; a < m_entries.size(); a = b) {
+            while (b < m_entries.size() && m_entries[b].first == m_entries[a].first) ++b;
+            m_cells.emplace(m_entries[a].first, std::pair<std::uint32_t, std::uint32_t>(a, b));
+        }
     }
     /// Calls f(triangle) for every triangle listed in a cell `box` meets (a triangle may come more
     /// than once).
     template <class F> void near(const Eigen::AlignedBox3d& box, F&& f) const
     {
         for_cells(box.min(), box.max(), [&](std::uint64_t key) {
-            auto it = std::lower_bound(m_entries.begin(), m_entries.end(), std::pair<std::uint64_t, std::uint32_t>(key, 0));
-            for (; it != m_entries.end() && it->first == key; ++it) f(it->second);
+            const auto found = m_cells.find(key);
+            if (found == m_cells.end()) return;
+            for (std::uint32_t i = found->second.first; i < found->second.second; ++i) f(m_entries[i].second);
         });
     }
 
@@ -70,6 +77,7 @@ private:
     }
     double m_cell = 1.0;
     std::vector<std::pair<std::uint64_t, std::uint32_t>> m_entries;
+    std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> m_cells; ///< key -> its range of m_entries
 };
 
 /// Outward unit normal of triangle t with corners in `x` (zero when degenerate).
@@ -99,7 +107,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
     constexpr double on_triangle = 0.02; // weights this far below zero still press the triangle (its edges)
     const double k_per_mm2 = parameters.stiffness_n_per_mm / 100.0;
     const std::size_t triangle_count = patch.triangles.size();
-    std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count);
+    std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count), rest_normal(triangle_count);
     std::vector<double> area(triangle_count);
     std::vector<Eigen::Vector3d> vertex_normal(n, Eigen::Vector3d::Zero());
     std::vector<std::uint32_t> first(n + 1, 0), around(3 * triangle_count); // each vertex's triangles
@@ -109,6 +117,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
         area[t] = 0.5 * (patch.start_mm[static_cast<std::size_t>(tri[1])] - a).cross(patch.start_mm[static_cast<std::size_t>(tri[2])] - a).norm();
         start_normal[t] = triangle_normal(patch, patch.start_mm, tri);
         end_normal[t] = triangle_normal(patch, patch.end_mm, tri);
+        rest_normal[t] = triangle_normal(patch, patch.rest_mm, tri);
         for (int c = 0; c < 3; ++c) {
             vertex_normal[static_cast<std::size_t>(tri[c])] += area[t] * start_normal[t];
             ++first[static_cast<std::size_t>(tri[c]) + 1];
@@ -150,8 +159,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
             std::array<double, 3> w = plane_weights(at[v], corner(at, 0), corner(at, 1), corner(at, 2));
             if (!covers(w, on_triangle)) return;
             // Through material: behind the triangle in the rest shape already.
-            const Eigen::Vector3d rest_normal = triangle_normal(patch, patch.rest_mm, tri);
-            const double rest_distance = rest_normal.dot(patch.rest_mm[v] - corner(patch.rest_mm, 0));
+            const double rest_distance = rest_normal[t].dot(patch.rest_mm[v] - corner(patch.rest_mm, 0));
             if (rest_distance < -parameters.rest_tolerance_mm &&
                 covers(plane_weights(patch.rest_mm[v], corner(patch.rest_mm, 0), corner(patch.rest_mm, 1), corner(patch.rest_mm, 2)), on_triangle))
                 return;

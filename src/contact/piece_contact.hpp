@@ -44,7 +44,7 @@ namespace vox::contact {
 
 struct PieceContactParameters {
     double stiffness_n_per_mm = 10.0;   ///< per cm^2 of contact (> 0)
-    double max_depth_mm = 2.0;          ///< deeper is not a contact (> 0)
+    double max_depth_mm = 1.0;          ///< deeper is not a contact (> 0)
     double approach_mm = 0.9;           ///< broad phase: elements nearer than this are tested
     double skin_mm = 0.02;              ///< apart by less than this is touching
     double rest_tolerance_mm = 0.5;     ///< behind the rest triangle by more: through material

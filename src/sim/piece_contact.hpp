@@ -17,9 +17,9 @@ struct PieceContactFigures {
     double ms = 0.0;                 ///< time to find them and gather them on the model
 };
 
-/// The contact parameters for a scene whose voxels are `voxel_mm` long. Deeper than two voxels
-/// is not a contact: a step under gravity alone moves g dt^2 (a voxel of 1 mm at dt 0.01 s), and
-/// a vertex caught there must still be pushed back. Elements are tested when they come within
+/// The contact parameters for a scene whose voxels are `voxel_mm` long. Deeper than a voxel is
+/// not a contact (vertices arriving are caught before they are in: contact/piece_contact.hpp;
+/// deeper is the far side of a thin part or gone through). Elements are tested when they come within
 /// 0.9 voxel of each other (so never two of a whole object: at level 0 the nearest elements that
 /// share no node are a voxel apart); apart by less than 2 % of a voxel is touching. Behind the
 /// rest surface by more than half a voxel is through material.
@@ -27,7 +27,7 @@ struct PieceContactFigures {
 {
     contact::PieceContactParameters p;
     p.stiffness_n_per_mm = scene.piece_contact.stiffness_n_per_mm;
-    p.max_depth_mm = 2.0 * voxel_mm;
+    p.max_depth_mm = voxel_mm;
     p.approach_mm = 0.9 * voxel_mm;
     p.skin_mm = 0.02 * voxel_mm;
     p.rest_tolerance_mm = 0.5 * voxel_mm;
