@@ -82,10 +82,7 @@ void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weigh
     for (int corner = 0; corner < 8; ++corner) {
         const double w = weight * grid::hex8_shape(corner, local);
         if (w == 0.0) continue;
-        const std::uint32_t node = el.dof_node[static_cast<std::size_t>(corner)];
-        auto it = std::find_if(terms.begin(), terms.end(), [&](const fem::BlockWeight& t) { return t.block == node; });
-        if (it == terms.end()) terms.push_back({node, w});
-        else it->weight += w;
+        fem::add_term(terms, el.dof_node[static_cast<std::size_t>(corner)], w);
     }
 }
 

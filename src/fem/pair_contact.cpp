@@ -6,6 +6,13 @@
 
 namespace vox::fem {
 
+void add_term(std::vector<BlockWeight>& terms, std::uint32_t block, double weight)
+{
+    const auto it = std::find_if(terms.begin(), terms.end(), [&](const BlockWeight& t) { return t.block == block; });
+    if (it == terms.end()) terms.push_back({block, weight});
+    else it->weight += weight;
+}
+
 void PairContacts::set(std::vector<PairContact> pairs, const std::vector<Eigen::Vector3d>& x)
 {
     for (const PairContact& p : pairs) {

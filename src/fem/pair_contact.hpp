@@ -34,6 +34,10 @@ struct PairContact {
     double stiffness_n_per_m = 0.0;                       ///< d force / d gap, >= 0
 };
 
+/// Adds `weight` on `block` to `terms`, merging it with the block's term when it has one (a point
+/// and the face it presses may share blocks).
+void add_term(std::vector<BlockWeight>& terms, std::uint32_t block, double weight);
+
 /// The pair contacts a solver takes for its next steps, with the gaps they were set at.
 class PairContacts {
 public:

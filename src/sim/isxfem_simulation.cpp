@@ -411,11 +411,7 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
         const isxfem::XfemElement& el = m_model->elements()[v.tet];
         const auto w = m_solver->weights(v.tet, v.bary, v.side);
         for (std::size_t a = 0; a < el.block_count(); ++a) {
-            if (w[a] == 0.0) continue;
-            const std::uint32_t block = el.block(a);
-            auto it = std::find_if(terms.begin(), terms.end(), [&](const fem::BlockWeight& t) { return t.block == block; });
-            if (it == terms.end()) terms.push_back({block, weight * w[a]});
-            else it->weight += weight * w[a];
+            if (w[a] != 0.0) fem::add_term(terms, el.block(a), weight * w[a]);
         }
     };
     for (const contact::FaceContact& f : out.faces) {
