@@ -88,13 +88,6 @@ void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weigh
 
 } // namespace
 
-double PieceContact::force_n() const
-{
-    double sum = 0.0;
-    for (const contact::FaceContact& f : faces) sum += f.force_n;
-    return sum;
-}
-
 PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
                           const std::vector<Eigen::Vector3d>& node_velocities, double dt_s, const contact::PieceContactParameters& parameters)
 {

@@ -24,7 +24,6 @@ struct PieceContact {
     std::vector<contact::FaceContact> faces;    ///< indices into the patch
     std::vector<fem::PairContact> pairs;        ///< the same on the model's nodes (N, N/m)
     std::size_t element_pairs = 0;              ///< element pairs the broad phase kept
-    [[nodiscard]] double force_n() const;       ///< the sum of the contacts' force magnitudes
 };
 
 /// Contact of the surface, deformed by `node_positions` (m) and moving at `node_velocities`

@@ -564,19 +564,15 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
         if (m_fixed[static_cast<std::size_t>(i)]) next[i] = 0.0;
     double residual = 0.0;
     s.cg_iterations += solve(rhs, next, residual);
-    if (!m_pairs.empty()) {
-        // A pair contact is linear in the solve and would pull two sides that part during the
-        // step back together (a piece rocking on another sticks to it by one edge): those let go
-        // and the step is solved again without them (the solve starts from the first answer).
-        std::vector<Eigen::Vector3d> end(m_x.size());
-        for (std::size_t i = 0; i < m_x.size(); ++i) end[i] = m_x[i] + dt * next.segment<3>(3 * static_cast<Eigen::Index>(i));
-        if (m_pairs.release_pulling(end) > 0) {
-            f_ext = external_force();
-            mass_times(m_v, rhs);
-            rhs += dt * (f_ext - m_internal);
-            apply_constraints(rhs);
-            s.cg_iterations += solve(rhs, next, residual, true);
-        }
+    // A pair contact is linear in the solve and would pull two sides that part during the step
+    // back together (a piece rocking on another sticks to it by one edge): those let go and the
+    // step is solved again without them (the solve starts from the first answer).
+    if (m_pairs.release_pulling(m_x, dt, next) > 0) {
+        f_ext = external_force();
+        mass_times(m_v, rhs);
+        rhs += dt * (f_ext - m_internal);
+        apply_constraints(rhs);
+        s.cg_iterations += solve(rhs, next, residual, true);
     }
     s.residual = std::max(s.residual, residual);
     s.converged = s.converged && residual <= m_options.cg_tolerance;

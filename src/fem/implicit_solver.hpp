@@ -106,7 +106,6 @@ public:
     /// fem/pair_contact.hpp) for the following steps, replacing the previous ones; blocks are
     /// nodes. Taken implicitly, as set_contact's. Throws std::invalid_argument for a node out of range.
     void set_pair_contact(std::vector<PairContact> pairs) { m_pairs.set(std::move(pairs), m_x); }
-    [[nodiscard]] const std::vector<PairContact>& pair_contact() const { return m_pairs.pairs(); }
     /// The pair contacts' total force magnitude at the current positions (after a step: what it
     /// applied at its end), N.
     [[nodiscard]] double pair_contact_force_n() const { return m_pairs.total_force(m_x); }

@@ -36,7 +36,7 @@ void PairContacts::add_forces(const std::vector<Eigen::Vector3d>& x, Eigen::Vect
 {
     for (std::size_t i = 0; i < m_pairs.size(); ++i) {
         const PairContact& p = m_pairs[i];
-        const double force = p.force_n - p.stiffness_n_per_m * (gap(p, x) - m_gap_set[i]);
+        const double force = force_at(i, x);
         for (const BlockWeight& t : p.terms) f.segment<3>(3 * static_cast<Eigen::Index>(t.block)) += t.weight * force * p.normal;
     }
 }
@@ -67,7 +67,7 @@ double PairContacts::total_force(const std::vector<Eigen::Vector3d>& x) const
 {
     double sum = 0.0;
     for (std::size_t i = 0; i < m_pairs.size(); ++i)
-        sum += std::max(0.0, m_pairs[i].force_n - m_pairs[i].stiffness_n_per_m * (gap(m_pairs[i], x) - m_gap_set[i]));
+        sum += std::max(0.0, force_at(i, x));
     return sum;
 }
 
@@ -76,11 +76,19 @@ std::size_t PairContacts::release_pulling(const std::vector<Eigen::Vector3d>& x)
     std::size_t released = 0;
     for (std::size_t i = 0; i < m_pairs.size(); ++i) {
         PairContact& p = m_pairs[i];
-        if (p.stiffness_n_per_m == 0.0 || p.force_n - p.stiffness_n_per_m * (gap(p, x) - m_gap_set[i]) >= 0.0) continue;
+        if (p.stiffness_n_per_m == 0.0 || force_at(i, x) >= 0.0) continue;
         p.force_n = p.stiffness_n_per_m = 0.0;
         ++released;
     }
     return released;
+}
+
+std::size_t PairContacts::release_pulling(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v)
+{
+    if (m_pairs.empty()) return 0;
+    std::vector<Eigen::Vector3d> end(x.size());
+    for (std::size_t b = 0; b < x.size(); ++b) end[b] = x[b] + dt * v.segment<3>(3 * static_cast<Eigen::Index>(b));
+    return release_pulling(end);
 }
 
 double PairContacts::potential(const std::vector<Eigen::Vector3d>& x) const

@@ -60,11 +60,18 @@ public:
     /// Lets go of the contacts that would pull at positions x (f(x) < 0: the two sides part
     /// farther than the penalty's linear model allows): a contact only ever pushes. Returns how many.
     std::size_t release_pulling(const std::vector<Eigen::Vector3d>& x);
+    /// The same at the end of a step of `dt` from x at velocities `v` (3 per block).
+    std::size_t release_pulling(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v);
     /// v^T K v (per block velocities): what a step's linearised contact loses to the work check.
     [[nodiscard]] double stiffness_product(const std::vector<Eigen::Vector3d>& v) const;
 
 private:
     [[nodiscard]] double gap(const PairContact& p, const std::vector<Eigen::Vector3d>& x) const;
+    /// Contact i's force at positions x (negative: it would pull).
+    [[nodiscard]] double force_at(std::size_t i, const std::vector<Eigen::Vector3d>& x) const
+    {
+        return m_pairs[i].force_n - m_pairs[i].stiffness_n_per_m * (gap(m_pairs[i], x) - m_gap_set[i]);
+    }
     std::vector<PairContact> m_pairs;
     std::vector<double> m_gap_set;
 };

@@ -165,20 +165,16 @@ XfemStepStats XfemSolver::step()
     s.assembly_ms = ms_since(start);
     const auto t = std::chrono::steady_clock::now();
     s.cg_iterations = solve(rhs, next, s.residual);
-    if (!m_pairs.empty()) {
-        // A pair contact that would pull two parting sides together at the step's end lets go,
-        // and the step is solved again without it (from the first answer).
-        std::vector<Eigen::Vector3d> end(m_x.size());
-        for (std::size_t b = 0; b < m_x.size(); ++b) end[b] = m_x[b] + dt * next.segment<3>(3 * static_cast<Eigen::Index>(b));
-        if (m_pairs.release_pulling(end) > 0) {
-            rhs -= dt * contact;
-            contact.setZero();
-            m_pairs.add_forces(m_x, contact);
-            rhs += dt * contact;
-            for (Eigen::Index i = 0; i < n; ++i)
-                if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = 0.0;
-            s.cg_iterations += solve(rhs, next, s.residual, true);
-        }
+    // A pair contact that would pull two parting sides together at the step's end lets go, and
+    // the step is solved again without it (from the first answer).
+    if (m_pairs.release_pulling(m_x, dt, next) > 0) {
+        rhs -= dt * contact;
+        contact.setZero();
+        m_pairs.add_forces(m_x, contact);
+        rhs += dt * contact;
+        for (Eigen::Index i = 0; i < n; ++i)
+            if (m_fixed[static_cast<std::size_t>(i)]) rhs[i] = 0.0;
+        s.cg_iterations += solve(rhs, next, s.residual, true);
     }
     s.converged = s.residual <= m_options.cg_tolerance;
     s.solve_ms = ms_since(t);

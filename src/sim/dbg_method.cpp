@@ -297,7 +297,7 @@ void DbgMethod::end_tools()
         const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
         cut::PieceContact c = cut::touch_pieces(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(),
                                                 m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), c.force_n(), 0.0};
+        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), 0.0, 0.0}; // force_n: after the step
         // A piece pressed by one that moves wakes as a tool's reach would wake it.
         for (const contact::FaceContact& f : c.faces)
             m_tool_reach.emplace_back(c.patch.start_mm[f.vertex] - Eigen::Vector3d::Constant(voxel_mm),

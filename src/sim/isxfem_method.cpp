@@ -168,7 +168,7 @@ void IsxfemMethod::end_tools()
         Stopwatch clock;
         const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
         IsxfemSimulation::PieceTouch t = m_sim->touch_pieces(m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0};
+        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0}; // force_n: after the step
         m_sim->solver().set_pair_contact(std::move(t.pairs));
         m_piece_contact.ms = clock.lap();
     }
