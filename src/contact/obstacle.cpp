@@ -80,7 +80,7 @@ TriangleMesh Obstacle::drawing_mesh(const Eigen::Vector3d& centre_mm, double ext
 
 ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::Vector3d> points, std::span<const double> areas,
                                std::span<const Eigen::Vector3d> velocities_mm_s, double dt_s, std::span<const std::uint64_t> keys,
-                               FrictionAnchors& anchors)
+                               FrictionAnchors& anchors, double skin_mm, std::span<const Eigen::Vector3d> ends_mm)
 {
     ContactResult out;
     FrictionAnchors held;
@@ -88,37 +88,41 @@ ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::
     for (std::size_t i = 0; i < points.size(); ++i) {
         Eigen::Vector3d g;
         const double depth = -obstacle.signed_distance(points[i], &g);
-        if (!(depth > 0.0)) continue;
+        // Touching, or arriving within the step (inside where the step would take it freely).
+        const bool arriving = depth > -skin_mm || (!ends_mm.empty() && obstacle.signed_distance(ends_mm[i]) < 0.0);
+        if (!(depth > 0.0) && !arriving) continue;
         const double k = obstacle.stiffness_n_per_mm / 100.0 * areas[i]; // per mm^2 of contact
         PointContact c;
         c.point = static_cast<std::uint32_t>(i);
         c.depth_mm = depth;
         c.normal = g;
         c.stiffness_n_per_mm = k;
-        c.force_n = k * depth * g;
-        // Friction: the spring to the anchor, across the normal, slipping beyond mu |f_n|.
-        const auto found = anchors.find(keys[i]);
-        Eigen::Vector3d anchor = found == anchors.end() ? points[i] : found->second;
-        const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - g * g.transpose();
-        const Eigen::Vector3d stretch = across * (points[i] - anchor);
-        const double limit = obstacle.friction * k * depth; // mu |f_n|
-        // The spring reaches the limit over the larger of k_stick_give_mm and the step's expected
-        // slide: within one step it cannot pull much beyond mu |f_n|.
-        const double slide = (across * velocities_mm_s[i]).norm() * dt_s;
-        const double spring = std::min(k, limit / std::max(k_stick_give_mm, slide));
-        const double pull = spring * stretch.norm();
-        if (pull <= limit) {
-            c.force_n -= spring * stretch;
-            c.friction_stiffness_n_per_mm = spring * across;
-        } else { // slips: the anchor follows at the distance where the spring pulls with mu |f_n|
-            const Eigen::Vector3d way = stretch / stretch.norm();
-            anchor = points[i] - (limit / spring) * way;
-            c.force_n -= limit * way;
-            c.friction_stiffness_n_per_mm = spring * (across - way * way.transpose());
+        c.force_n = k * depth * g; // apart: pulls, until the step's end says whether it pushes
+        if (depth > 0.0) {
+            out.area_mm2 += areas[i];
+            // Friction: the spring to the anchor, across the normal, slipping beyond mu |f_n|.
+            const auto found = anchors.find(keys[i]);
+            Eigen::Vector3d anchor = found == anchors.end() ? points[i] : found->second;
+            const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - g * g.transpose();
+            const Eigen::Vector3d stretch = across * (points[i] - anchor);
+            const double limit = obstacle.friction * k * depth; // mu |f_n|
+            // The spring reaches the limit over the larger of k_stick_give_mm and the step's expected
+            // slide: within one step it cannot pull much beyond mu |f_n|.
+            const double slide = (across * velocities_mm_s[i]).norm() * dt_s;
+            const double spring = std::min(k, limit / std::max(k_stick_give_mm, slide));
+            const double pull = spring * stretch.norm();
+            if (pull <= limit) {
+                c.force_n -= spring * stretch;
+                c.friction_stiffness_n_per_mm = spring * across;
+            } else { // slips: the anchor follows at the distance where the spring pulls with mu |f_n|
+                const Eigen::Vector3d way = stretch / stretch.norm();
+                anchor = points[i] - (limit / spring) * way;
+                c.force_n -= limit * way;
+                c.friction_stiffness_n_per_mm = spring * (across - way * way.transpose());
+            }
+            held.emplace(keys[i], anchor);
+            total += c.force_n;
         }
-        held.emplace(keys[i], anchor);
-        total += c.force_n;
-        out.area_mm2 += areas[i];
         out.points.push_back(c);
     }
     anchors = std::move(held);

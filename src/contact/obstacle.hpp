@@ -76,12 +76,22 @@ private:
 
 /// Contact of surface points (world mm, each carrying `areas[i]` mm^2, moving at
 /// `velocities_mm_s[i]`, identified by `keys[i]`) with `obstacle` for a step of `dt_s`: the
-/// normal penalty and the friction of the header, each point's force and
-/// stiffness. `anchors` holds the anchors of the last call and receives this call's (points no
-/// longer touching let go). Points outside are skipped. force_on_tool_n is the force on the
-/// obstacle, friction included.
+/// normal penalty and the friction of the header, each point's force and stiffness. A point
+/// outside that touches (nearer than `skin_mm`) or whose end of the step moving freely,
+/// `ends_mm[i]` (its velocity and gravity; none given: not looked at), is inside is a contact too, with a normal force k d a that is zero or pulls (d <= 0) and no friction: the
+/// solver takes the normal force at the step's end (fem/pair_contact.hpp) and lets it go if it
+/// would still pull there, so an arriving point is stopped at the surface instead of sinking a
+/// step's fall into it and being thrown back out (a lagged penalty bounces a resting piece by
+/// that much every other step, for ever). Such a point waits out of the solve until a solve ends
+/// with it pressed in (fem::PairContact::waiting): a piece at rest on a table has hundreds of
+/// points within gravity's look-ahead (g dt^2) of it, and each pulling in the first solve would
+/// drag it down. `anchors` holds the anchors of the last call and
+/// receives this call's (points no longer pressed in let go). force_on_tool_n is the force on
+/// the obstacle at the points' positions, friction included (arriving points add none); area_mm2
+/// the area of the points inside.
 [[nodiscard]] ContactResult obstacle_contact(const Obstacle& obstacle, std::span<const Eigen::Vector3d> points,
                                              std::span<const double> areas, std::span<const Eigen::Vector3d> velocities_mm_s,
-                                             double dt_s, std::span<const std::uint64_t> keys, FrictionAnchors& anchors);
+                                             double dt_s, std::span<const std::uint64_t> keys, FrictionAnchors& anchors,
+                                             double skin_mm = 0.0, std::span<const Eigen::Vector3d> ends_mm = {});
 
 } // namespace vox::contact

@@ -33,7 +33,7 @@ struct ContactParameters {
 
 struct PointContact {
     std::uint32_t point = 0;                ///< index into the points given
-    double depth_mm = 0.0;                  ///< inside the outer shape, > 0
+    double depth_mm = 0.0;                  ///< inside the outer shape, > 0 (an obstacle's arriving point: <= 0)
     Eigen::Vector3d normal = Eigen::Vector3d::Zero(); ///< direction the point is pushed (unit), world
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero(); ///< on the surface point
     /// d |force| / d depth. The solver takes the contact's stiffness as this times normal
@@ -46,6 +46,9 @@ struct PointContact {
     Eigen::Matrix3d friction_stiffness_n_per_mm = Eigen::Matrix3d::Zero();
     bool inside_inner = false;              ///< the point is inside the inner (cutting) shape too
     double area_mm2 = 0.0;                  ///< the surface area this contact stands for
+    /// The force along the normal (an obstacle's arriving point: <= 0) and across it (friction).
+    [[nodiscard]] double normal_force_n() const { return force_n.dot(normal); }
+    [[nodiscard]] Eigen::Vector3d across_force_n() const { return force_n - normal_force_n() * normal; }
     /// The whole stiffness, N/mm: along the normal and across it (friction).
     [[nodiscard]] Eigen::Matrix3d stiffness_matrix_n_per_mm() const
     {

@@ -1,5 +1,7 @@
 #include "cut/piece_contact.hpp"
 
+#include "cut/surface_contact.hpp"
+
 #include "grid/hex8.hpp"
 
 #include <Eigen/Geometry>
@@ -74,26 +76,13 @@ std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, con
     return out;
 }
 
-/// Adds weight times vertex slot v's trilinear weights on its element's nodes to `terms`.
-void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weight, std::vector<fem::BlockWeight>& terms)
-{
-    const fem::HexElement& el = surface.model().elements()[surface.vertex_element(v)];
-    const Eigen::Vector3d local = surface.vertex_local(v);
-    for (int corner = 0; corner < 8; ++corner) {
-        const double w = weight * grid::hex8_shape(corner, local);
-        if (w == 0.0) continue;
-        fem::add_term(terms, el.dof_node[static_cast<std::size_t>(corner)], w);
-    }
-}
-
 } // namespace
 
 PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                          const std::vector<Eigen::Vector3d>& node_velocities, double dt_s, const contact::PieceContactParameters& parameters)
+                          const std::vector<Eigen::Vector3d>& node_ends, const contact::PieceContactParameters& parameters)
 {
     PieceContact out;
-    std::vector<Eigen::Vector3d> end(node_positions.size());
-    for (std::size_t n = 0; n < end.size(); ++n) end[n] = node_positions[n] + dt_s * node_velocities[n];
+    const std::vector<Eigen::Vector3d>& end = node_ends;
     const std::vector<std::uint32_t> near = elements_near_others(surface, node_positions, end, parameters.approach_mm, out.element_pairs);
     if (near.empty()) return out;
     // The patch: the near elements' vertices and the corners of their triangles, each once.
@@ -143,6 +132,7 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
         pair.normal = f.normal;
         pair.force_n = f.force_n;
         pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
+        pair.waiting = f.depth_mm < -parameters.skin_mm;
         out.pairs.push_back(std::move(pair));
     }
     return out;

@@ -26,11 +26,11 @@ struct PieceContact {
     std::size_t element_pairs = 0;              ///< element pairs the broad phase kept
 };
 
-/// Contact of the surface, deformed by `node_positions` (m) and moving at `node_velocities`
-/// (m/s) for a step of `dt_s`, with itself. Two elements are tested when their boxes, swept over
-/// the predicted step, come within `parameters.approach_mm` of each other.
+/// Contact of the surface, deformed by `node_positions` (m) and predicted at `node_ends` (m) at
+/// the step's end (fem::ImplicitSolver::free_step_positions), with itself. Two elements are
+/// tested when their boxes, swept from start to end, come within `parameters.approach_mm` of
+/// each other.
 [[nodiscard]] PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                                        const std::vector<Eigen::Vector3d>& node_velocities, double dt_s,
-                                        const contact::PieceContactParameters& parameters);
+                                        const std::vector<Eigen::Vector3d>& node_ends, const contact::PieceContactParameters& parameters);
 
 } // namespace vox::cut

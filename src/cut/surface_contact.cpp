@@ -158,42 +158,83 @@ SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eige
 }
 
 SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
-                              const std::vector<Eigen::Vector3d>& node_velocities, double dt_s, const contact::Obstacle& obstacle,
-                              contact::FrictionAnchors& anchors)
+                              const std::vector<Eigen::Vector3d>& node_ends, const std::vector<Eigen::Vector3d>& node_velocities,
+                              double dt_s, const contact::Obstacle& obstacle, contact::FrictionAnchors& anchors, double skin_mm)
 {
     SurfaceContact out;
     const fem::HexModel& model = surface.model();
-    std::vector<std::uint32_t> inside;
-    std::vector<Eigen::Vector3d> inside_mm;
+    std::vector<std::uint32_t> near;
+    std::vector<Eigen::Vector3d> near_mm, ends_mm, velocities;
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
+        // The element's box swept over the step, so that a vertex arriving is caught.
+        const fem::HexElement& el = model.elements()[e];
         Eigen::AlignedBox3d box;
         box.setEmpty();
-        for (std::uint32_t n : model.elements()[e].dof_node) box.extend(1e3 * node_positions[n]);
-        if (!obstacle.may_reach(box)) continue;
+        for (std::uint32_t n : el.dof_node) {
+            box.extend(1e3 * node_positions[n]);
+            box.extend(1e3 * node_ends[n]);
+        }
+        if (!obstacle.may_reach(Eigen::AlignedBox3d(box.min().array() - skin_mm, box.max().array() + skin_mm))) continue;
         surface.for_each_element_vertex(e, [&](std::uint32_t v) {
-            const Eigen::Vector3d p = surface.vertex_mm(v, node_positions);
-            if (obstacle.signed_distance(p) >= 0.0) return;
-            inside.push_back(v);
-            inside_mm.push_back(p);
+            const Eigen::Vector3d p = surface.vertex_mm(v, node_positions), end = surface.vertex_mm(v, node_ends);
+            if (obstacle.signed_distance(p) >= skin_mm && obstacle.signed_distance(end) >= 0.0) return;
+            Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+            for (int corner = 0; corner < 8; ++corner)
+                velocity += 1e3 * grid::hex8_shape(corner, surface.vertex_local(v)) * node_velocities[el.dof_node[corner]];
+            near.push_back(v);
+            near_mm.push_back(p);
+            ends_mm.push_back(end);
+            velocities.push_back(velocity);
         });
     }
-    if (inside.empty()) return out;
-    DeformedPositions position(surface, node_positions, inside, inside_mm);
-    std::vector<double> areas(inside.size(), 0.0);
-    std::vector<std::uint64_t> keys(inside.size());
-    std::vector<Eigen::Vector3d> velocities(inside.size(), Eigen::Vector3d::Zero());
+    if (near.empty()) return out;
+    DeformedPositions position(surface, node_positions, near, near_mm);
+    std::vector<double> areas(near.size(), 0.0);
+    std::vector<std::uint64_t> keys(near.size());
     Eigen::Vector3d normal;
-    for (std::size_t i = 0; i < inside.size(); ++i) {
-        const std::uint32_t v = inside[i];
-        area_and_normal(surface, v, position, areas[i], normal);
-        keys[i] = surface.embedded().vertices()[v].key;
-        const fem::HexElement& el = model.elements()[surface.vertex_element(v)];
-        for (int corner = 0; corner < 8; ++corner)
-            velocities[i] += 1e3 * grid::hex8_shape(corner, surface.vertex_local(v)) * node_velocities[el.dof_node[corner]];
+    for (std::size_t i = 0; i < near.size(); ++i) {
+        area_and_normal(surface, near[i], position, areas[i], normal);
+        keys[i] = surface.embedded().vertices()[near[i]].key;
     }
-    out.contact = contact::obstacle_contact(obstacle, inside_mm, areas, velocities, dt_s, keys, anchors);
-    gather_on_nodes(surface, inside, out);
+    out.contact = contact::obstacle_contact(obstacle, near_mm, areas, velocities, dt_s, keys, anchors, skin_mm, ends_mm);
+    gather_on_nodes(surface, near, out);
+    // The push along the normal is taken at the step's end and let go if it would pull there: a
+    // pair contact with one side (the obstacle does not move). Friction stays on the nodes.
+    out.nodes.clear();
+    std::unordered_map<std::uint32_t, std::size_t> node_index;
+    for (const contact::PointContact& c : out.contact.points) {
+        const std::uint32_t v = out.vertices[c.point];
+        fem::PairContact pair;
+        add_vertex_terms(surface, v, 1.0, pair.terms);
+        pair.normal = c.normal;
+        pair.force_n = c.normal_force_n();
+        pair.stiffness_n_per_m = 1e3 * c.stiffness_n_per_mm;
+        pair.waiting = c.depth_mm <= -skin_mm;
+        out.pairs.push_back(std::move(pair));
+        if (c.friction_stiffness_n_per_mm.isZero()) continue;
+        const fem::HexElement& el = model.elements()[surface.vertex_element(v)];
+        for (int corner = 0; corner < 8; ++corner) {
+            const double w = grid::hex8_shape(corner, surface.vertex_local(v));
+            if (w == 0.0) continue;
+            const std::uint32_t node = el.dof_node[corner];
+            auto [it, added] = node_index.emplace(node, out.nodes.size());
+            if (added) out.nodes.push_back({node, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()});
+            out.nodes[it->second].force_n += w * c.across_force_n();
+            out.nodes[it->second].stiffness_n_per_m += w * 1e3 * c.friction_stiffness_n_per_mm;
+        }
+    }
     return out;
+}
+
+void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weight, std::vector<fem::BlockWeight>& terms)
+{
+    const fem::HexElement& el = surface.model().elements()[surface.vertex_element(v)];
+    const Eigen::Vector3d local = surface.vertex_local(v);
+    for (int corner = 0; corner < 8; ++corner) {
+        const double w = weight * grid::hex8_shape(corner, local);
+        if (w == 0.0) continue;
+        fem::add_term(terms, el.dof_node[static_cast<std::size_t>(corner)], w);
+    }
 }
 
 std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const SurfaceContact& contact)

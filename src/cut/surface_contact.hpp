@@ -18,6 +18,9 @@ struct SurfaceContact {
     std::vector<std::uint32_t> vertices;    ///< surface vertex slot of each contact point
     std::vector<std::uint64_t> keys;        ///< and that vertex's identity (SurfaceVertex::key)
     std::vector<fem::NodeContact> nodes;    ///< the forces on the model's nodes (N, N/m)
+    /// An obstacle's push along its normal, one side's pair contact per point (taken at the
+    /// step's end, let go if it would pull); `nodes` then holds only the friction.
+    std::vector<fem::PairContact> pairs;
     std::vector<std::uint32_t> elements;    ///< model elements holding contact points (sorted, unique)
 };
 
@@ -32,11 +35,20 @@ struct SurfaceContact {
 
 /// Contact of the surface deformed by `node_positions` (m) and moving at `node_velocities` (m/s)
 /// with a static obstacle for a step of `dt_s` (contact::obstacle_contact; `anchors` its
-/// friction's, by surface vertex key): its penalty and friction gathered on the nodes. Only
-/// elements whose deformed corner box may reach into the obstacle are visited.
+/// friction's, by surface vertex key; vertices nearer than `skin_mm`, or inside at the nodes'
+/// free step's end `node_ends` (fem::ImplicitSolver::free_step_positions), are caught; those
+/// apart wait: fem::PairContact::waiting): the push
+/// along the obstacle's normal as one-sided pair contacts, the friction gathered on the nodes.
+/// Only elements whose deformed corner box, swept over the step, may reach into the obstacle are
+/// visited.
 [[nodiscard]] SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
+                                            const std::vector<Eigen::Vector3d>& node_ends,
                                             const std::vector<Eigen::Vector3d>& node_velocities, double dt_s,
-                                            const contact::Obstacle& obstacle, contact::FrictionAnchors& anchors);
+                                            const contact::Obstacle& obstacle, contact::FrictionAnchors& anchors, double skin_mm);
+
+/// Adds `weight` times vertex slot v's trilinear weights on its element's nodes to `terms` (a
+/// surface point as a pair contact's side: fem/pair_contact.hpp).
+void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weight, std::vector<fem::BlockWeight>& terms);
 
 /// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
 /// the corners of its element with the trilinear weights, the penalty stiffness lumped the same

@@ -349,11 +349,34 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
             }
         }
     });
-    if (output != Output::forces) m_pairs.add_diagonal(m_contact_scale, m_diagonal); // not in the matrix: multiply() adds them
+    if (output != Output::forces) m_pairs.add_diagonal(m_contact_scale, m_diagonal);
+    m_pair_in_matrix.assign(m_pairs.pairs().size(), 0);
+    if (output == Output::matrix) pairs_into_matrix(1.0);
     m_update_plastic = false;
     double energy = 0.0;
     for (double e : m_element_energy) energy += e;
     return energy;
+}
+
+void ImplicitSolver::pairs_into_matrix(double sign, const std::vector<std::size_t>* which)
+{
+    auto add = [&](std::size_t i) {
+        if (sign > 0.0) m_pair_in_matrix[i] = add_to_matrix(m_pairs.pairs()[i], m_contact_scale, m_fixed, m_matrix);
+        else if (m_pair_in_matrix[i]) add_to_matrix(m_pairs.pairs()[i], -m_contact_scale, m_fixed, m_matrix);
+    };
+    if (which) for (std::size_t i : *which) add(i);
+    else for (std::size_t i = 0; i < m_pairs.pairs().size(); ++i) add(i);
+}
+
+std::vector<Eigen::Vector3d> ImplicitSolver::free_step_positions(double dt) const
+{
+    std::vector<Eigen::Vector3d> out(m_x.size());
+    for (std::size_t n = 0; n < m_x.size(); ++n) {
+        out[n] = m_x[n];
+        for (int a = 0; a < 3; ++a)
+            if (!m_fixed[3 * n + static_cast<std::size_t>(a)]) out[n][a] += dt * (m_v[n][a] + dt * m_gravity[a]);
+    }
+    return out;
 }
 
 void ImplicitSolver::mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const
@@ -426,7 +449,7 @@ void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) co
     if (!m_matrix_current) multiply_element_wise(p, out);
     else multiply_matrix(p, out);
     // Pair contacts couple nodes the matrix's pattern may not join (two pieces): added here.
-    m_pairs.add_product(p, m_contact_scale, m_fixed, out);
+    m_pairs.add_product(p, m_contact_scale, m_fixed, out, m_matrix_current ? &m_pair_in_matrix : nullptr);
 }
 
 void ImplicitSolver::multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
@@ -565,9 +588,17 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     double residual = 0.0;
     s.cg_iterations += solve(rhs, next, residual);
     // A pair contact is linear in the solve and would pull two sides that part during the step
-    // back together (a piece rocking on another sticks to it by one edge): those let go and the
-    // step is solved again without them (the solve starts from the first answer).
-    if (m_pairs.release_pulling(m_x, dt, next) > 0) {
+    // back together (a piece rocking on another sticks to it by one edge): those let go, the
+    // waiting ones that end pressed in join, and the step is solved again (from the last answer),
+    // until nothing changes (k_release_passes).
+    for (int pass = 0; pass < k_release_passes; ++pass) {
+        const std::vector<std::size_t> pulling = m_pairs.pulling(m_x, dt, next);
+        const std::vector<std::size_t> arriving = m_pairs.arriving(m_x, dt, next);
+        if (pulling.empty() && arriving.empty()) break;
+        if (m_matrix_current) pairs_into_matrix(-1.0, &pulling);
+        m_pairs.release(pulling);
+        m_pairs.activate(arriving);
+        if (m_matrix_current) pairs_into_matrix(1.0, &arriving);
         f_ext = external_force();
         mass_times(m_v, rhs);
         rhs += dt * (f_ext - m_internal);
@@ -666,7 +697,7 @@ double ImplicitSolver::newton_step(double dt, StepStats& s, double& energy_befor
             converged = true;
         }
         for (std::size_t i = 0; i < m_x.size(); ++i) m_x[i] = x0[i] + dt * m_v[i];
-        if (m_pairs.release_pulling(m_x) > 0) next = incremental_potential(dt, x0, m_v0); // a contact only pushes
+        if (m_pairs.settle(m_x) > 0) next = incremental_potential(dt, x0, m_v0); // a contact only pushes
         phi = next;
     }
     s.converged = s.converged && converged;
@@ -806,7 +837,7 @@ StepStats ImplicitSolver::step()
             s.solve_ms += ms_since(t);
             x += dx;
             m_element_pass_current = false;
-            m_pairs.release_pulling(m_x); // a contact only pushes
+            m_pairs.settle(m_x); // a contact only pushes
             ++s.newton_iterations;
         }
     }

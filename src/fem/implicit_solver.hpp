@@ -94,6 +94,10 @@ public:
     void set_asleep(const std::vector<unsigned char>& asleep);
     /// Uniform acceleration of every mass, m/s^2 (gravity).
     void set_gravity(const Eigen::Vector3d& g) { m_gravity = g; }
+    /// Where each node would be after a step of dt moving freely, x + dt (v + dt g), held dofs
+    /// where they are: what contact looks ahead to (a piece at rest on a table falls g dt^2 into
+    /// it in a step; its velocity alone says it stays).
+    [[nodiscard]] std::vector<Eigen::Vector3d> free_step_positions(double dt) const;
     /// Extra external forces per node, N (point forces, tool contact); zero by default.
     [[nodiscard]] std::vector<Eigen::Vector3d>& external_forces() { return m_external; }
 
@@ -105,10 +109,17 @@ public:
     /// Contacts between material points the elements do not join (pieces, the walls of a cut;
     /// fem/pair_contact.hpp) for the following steps, replacing the previous ones; blocks are
     /// nodes. Taken implicitly, as set_contact's. Throws std::invalid_argument for a node out of range.
-    void set_pair_contact(std::vector<PairContact> pairs) { m_pairs.set(std::move(pairs), m_x); }
-    /// The pair contacts' total force magnitude at the current positions (after a step: what it
-    /// applied at its end), N.
-    [[nodiscard]] double pair_contact_force_n() const { return m_pairs.total_force(m_x); }
+    void set_pair_contact(std::vector<PairContact> pairs)
+    {
+        m_pairs.set(std::move(pairs), m_x);
+        m_pair_in_matrix.assign(m_pairs.pairs().size(), 0);
+        m_matrix_current = false; // the matrix holds the old pairs
+    }
+    /// Pair contacts first..last-1's force at the current positions (after a step: what they
+    /// applied at its end).
+    [[nodiscard]] PairForceSum pair_contact_force(std::size_t first, std::size_t last) const { return m_pairs.force_sum(m_x, first, last); }
+    /// The pair contacts of the last step (those it let go: stiffness 0).
+    [[nodiscard]] const PairContacts& pair_contacts() const { return m_pairs; }
 
     /// Preconditions the CG solves with `p` instead of Jacobi (null: back to Jacobi).
     /// Throws InputError in the matrix-free mode, which has no matrix to build one from.
@@ -173,6 +184,10 @@ private:
     double plastic_correction(std::size_t e, const Vector24d& u, Vector24d& force);
     /// out = M v (lumped or consistent, with the added mass floor).
     void mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const;
+    /// Adds sign times the step's stiffness of the pair contacts `which` (all when null) to the
+    /// assembled matrix, those whose blocks its pattern joins (fem::add_to_matrix); adding marks
+    /// them in m_pair_in_matrix (multiply() then leaves them out), taking away only the marked.
+    void pairs_into_matrix(double sign, const std::vector<std::size_t>* which = nullptr);
     Eigen::VectorXd external_force() const;
     void apply_constraints(Eigen::VectorXd& rhs);
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
@@ -216,6 +231,7 @@ private:
     std::vector<std::int32_t> m_contact_of_node; ///< per node: index in m_contact, or -1
     double m_contact_scale = 0.0;                ///< factor of the contact stiffness in the system matrix
     PairContacts m_pairs;
+    std::vector<unsigned char> m_pair_in_matrix; ///< per pair: the assembled matrix holds its stiffness
     Eigen::Vector3d m_gravity = Eigen::Vector3d::Zero();
     SystemMatrix m_matrix;
     std::vector<std::uint16_t> m_rank;          ///< per element and corner pair (c, d): d's node among c's node's neighbours

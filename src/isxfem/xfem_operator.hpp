@@ -20,6 +20,7 @@
 
 #include "isxfem/xfem_model.hpp"
 
+#include "fem/pair_contact.hpp"
 #include "fem/preconditioner.hpp"
 
 #include <Eigen/Geometry>
@@ -54,6 +55,9 @@ public:
     /// (its local numbering: nodes, then enriched): the stiffness m of a point load acting through
     /// the weights w. Held dofs keep their identity rows and columns; until the next update().
     void add_point_stiffness(std::size_t e, const std::array<double, k_max_blocks>& w, const Eigen::Matrix3d& m);
+    /// Adds `scale` times a pair contact's stiffness when the pattern joins its blocks
+    /// (fem::add_to_matrix; held dofs kept); until the next update(). Returns whether it did.
+    bool add_pair_stiffness(const fem::PairContact& p, double scale) { return fem::add_to_matrix(p, scale, m_fixed, m_matrix); }
 
     /// out = A p, the matrix of the last update().
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;

@@ -96,7 +96,7 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
 {
     const double contact_scale = m_options.dt_s * m_options.dt_s;
     Eigen::VectorXd inv_d = m_operator.diagonal();
-    m_pairs.add_diagonal(contact_scale, inv_d);
+    m_pairs.add_diagonal(contact_scale, inv_d, &m_pair_in_matrix); // those in the matrix are in its diagonal
     for (Eigen::Index i = 0; i < inv_d.size(); ++i)
         inv_d[i] = m_fixed[static_cast<std::size_t>(i)] || !(inv_d[i] > 0.0) ? 1.0 : 1.0 / inv_d[i];
     const bool factor = m_preconditioner && !m_preconditioner_failed && !same_system;
@@ -117,7 +117,7 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
     // Pair contacts couple blocks the matrix's pattern may not join (two pieces): added to its product.
     const auto multiply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& out) {
         m_operator.multiply(p, out);
-        m_pairs.add_product(p, contact_scale, m_fixed, out);
+        m_pairs.add_product(p, contact_scale, m_fixed, out, &m_pair_in_matrix);
     };
     const fem::CgResult cg = fem::conjugate_gradient(multiply,
                                                      precondition, rhs, inv_d.cwiseSqrt(), m_options.cg_tolerance,
@@ -157,6 +157,10 @@ XfemStepStats XfemSolver::step()
     for (std::uint32_t b : m_regularised) rhs.segment<3>(3 * static_cast<Eigen::Index>(b)) += shift * v.segment<3>(3 * static_cast<Eigen::Index>(b));
     Eigen::VectorXd next = v;
     if (m_previous_v.size() == n) next += v - m_previous_v; // CG starts from the velocity extrapolated (one iteration fewer at the median)
+    // Pair contacts (obstacles, pieces) in the matrix where its pattern joins their blocks, so
+    // that the factor sees them; the others are added to its product.
+    m_pair_in_matrix.assign(m_pairs.pairs().size(), 0);
+    for (std::size_t i = 0; i < m_pairs.pairs().size(); ++i) m_pair_in_matrix[i] = m_operator.add_pair_stiffness(m_pairs.pairs()[i], dt * dt);
     Eigen::VectorXd contact = Eigen::VectorXd::Zero(n);
     m_pairs.add_forces(m_x, contact);
     rhs += dt * contact;
@@ -165,9 +169,18 @@ XfemStepStats XfemSolver::step()
     s.assembly_ms = ms_since(start);
     const auto t = std::chrono::steady_clock::now();
     s.cg_iterations = solve(rhs, next, s.residual);
-    // A pair contact that would pull two parting sides together at the step's end lets go, and
-    // the step is solved again without it (from the first answer).
-    if (m_pairs.release_pulling(m_x, dt, next) > 0) {
+    // A pair contact that would pull two parting sides together at the step's end lets go, the
+    // waiting ones that end pressed in join, and the step is solved again (from the last answer),
+    // until nothing changes.
+    for (int pass = 0; pass < fem::k_release_passes; ++pass) {
+        const std::vector<std::size_t> pulling = m_pairs.pulling(m_x, dt, next);
+        const std::vector<std::size_t> arriving = m_pairs.arriving(m_x, dt, next);
+        if (pulling.empty() && arriving.empty()) break;
+        for (std::size_t i : pulling)
+            if (m_pair_in_matrix[i]) m_operator.add_pair_stiffness(m_pairs.pairs()[i], -dt * dt);
+        m_pairs.release(pulling);
+        m_pairs.activate(arriving);
+        for (std::size_t i : arriving) m_pair_in_matrix[i] = m_operator.add_pair_stiffness(m_pairs.pairs()[i], dt * dt);
         rhs -= dt * contact;
         contact.setZero();
         m_pairs.add_forces(m_x, contact);

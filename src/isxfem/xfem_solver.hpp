@@ -101,9 +101,14 @@ public:
     /// fem/pair_contact.hpp) for the following steps, on dof blocks, replacing the previous ones:
     /// taken implicitly; those that would pull at the step's end are let go and the step solved
     /// again. Throws std::invalid_argument for a block out of range.
-    void set_pair_contact(std::vector<fem::PairContact> pairs) { m_pairs.set(std::move(pairs), m_x); }
-    /// Their total force magnitude at the current state (after a step: what it applied at its end), N.
-    [[nodiscard]] double pair_contact_force_n() const { return m_pairs.total_force(m_x); }
+    void set_pair_contact(std::vector<fem::PairContact> pairs)
+    {
+        m_pairs.set(std::move(pairs), m_x);
+        m_pair_in_matrix.assign(m_pairs.pairs().size(), 0); // step() puts them in its matrix
+    }
+    /// Contacts first..last-1's force at the current state (after a step: what they applied at its end).
+    [[nodiscard]] fem::PairForceSum pair_contact_force(std::size_t first, std::size_t last) const { return m_pairs.force_sum(m_x, first, last); }
+    [[nodiscard]] const fem::PairContacts& pair_contacts() const { return m_pairs; }
     /// The weights of the dof blocks of tetrahedron t (its nodes, then per cut their enriched
     /// blocks: psi_jc N_c) at the point with barycentric coordinates `n` in region `region`
     /// (XfemElement::region_at): the point moves by sum_a w_a x_a, and a force f there acts on
@@ -147,6 +152,7 @@ private:
     std::vector<std::uint32_t> m_regularised; ///< enriched blocks below the volume-ratio threshold
     std::vector<PointLoad> m_loads;
     fem::PairContacts m_pairs;
+    std::vector<unsigned char> m_pair_in_matrix; ///< per pair: this step's matrix holds its stiffness
     Eigen::VectorXd m_previous_v;
 };
 

@@ -8,6 +8,8 @@
 #include "cut/voxel_cut.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -283,28 +285,35 @@ void DbgMethod::end_tools()
         if (!m_fresh[k]) m_touch[k].nodes = cut::node_contacts(m_sim->surface(), m_touch[k]); // onto the rebuilt model's nodes
         cut::merge_node_contacts(nodes, m_touch[k].nodes);
     }
+    // Obstacles and pieces push along their normals as pair contacts, the obstacles' first.
+    const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
+    std::vector<fem::PairContact> pairs;
     m_obstacle_force.setZero();
+    const fem::ImplicitSolver& solver = m_sim->solver();
+    std::vector<Eigen::Vector3d> ends;
+    if (!m_obstacles.empty() || m_scene.piece_contact.enabled) ends = solver.free_step_positions(m_scene.solver.dt_s);
     for (std::size_t k = 0; k < m_obstacles.size(); ++k) {
-        const cut::SurfaceContact c = cut::touch_obstacle(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(),
-                                                          m_scene.solver.dt_s, m_obstacles[k], m_anchors[k]);
-        m_obstacle_force -= c.contact.force_on_tool_n;
+        cut::SurfaceContact c = cut::touch_obstacle(m_sim->surface(), solver.positions(), ends, solver.velocities(), m_scene.solver.dt_s,
+                                                    m_obstacles[k], m_anchors[k], obstacle_skin_mm(voxel_mm));
+        m_obstacle_force += friction_force_n(c.contact); // the push: after the step
         cut::merge_node_contacts(nodes, c.nodes);
+        std::move(c.pairs.begin(), c.pairs.end(), std::back_inserter(pairs));
     }
+    m_obstacle_pairs = pairs.size();
     m_sim->solver().set_contact(std::move(nodes));
     m_piece_contact = {};
     if (m_scene.piece_contact.enabled) {
         Stopwatch clock;
-        const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
-        cut::PieceContact c = cut::touch_pieces(m_sim->surface(), m_sim->solver().positions(), m_sim->solver().velocities(),
-                                                m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), 0.0, 0.0}; // force_n: after the step
+        cut::PieceContact c = cut::touch_pieces(m_sim->surface(), solver.positions(), ends, piece_contact_parameters(m_scene, voxel_mm));
+        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), 0.0, 0.0, deepest_mm(c.faces)}; // force_n: after the step
         // A piece pressed by one that moves wakes as a tool's reach would wake it.
         for (const contact::FaceContact& f : c.faces)
             m_tool_reach.emplace_back(c.patch.start_mm[f.vertex] - Eigen::Vector3d::Constant(voxel_mm),
                                       c.patch.start_mm[f.vertex] + Eigen::Vector3d::Constant(voxel_mm));
-        m_sim->solver().set_pair_contact(std::move(c.pairs));
+        std::move(c.pairs.begin(), c.pairs.end(), std::back_inserter(pairs));
         m_piece_contact.ms = clock.lap();
     }
+    m_sim->solver().set_pair_contact(std::move(pairs));
     m_sim->set_tool_reach(std::move(m_tool_reach));
     m_tool_reach.clear();
 }
@@ -312,7 +321,8 @@ void DbgMethod::end_tools()
 StepFigures DbgMethod::step()
 {
     const fem::StepStats s = m_sim->step();
-    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force_n();
+    m_obstacle_force += m_sim->solver().pair_contact_force(0, m_obstacle_pairs).vector_n;
+    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force(m_obstacle_pairs, SIZE_MAX).magnitude_n;
     StepFigures out;
     out.step_ms = s.step_ms;
     out.assembly_ms = s.assembly_ms;

@@ -6,7 +6,9 @@
 #include "core/union_find.hpp"
 #include "sim/dbg_simulation.hpp"
 
+#include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <utility>
 
 namespace vox::sim {
@@ -155,23 +157,30 @@ void IsxfemMethod::end_tools()
             m_loads[i].side = static_cast<int>((static_cast<unsigned>(m_loads[i].side) & known) | (now & ~known));
         }
     // The obstacles press on the surface as the frame's cuts left it (their loads know every cut).
+    // Obstacles and pieces push along their normals as pair contacts, the obstacles' first.
+    const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
     std::vector<isxfem::PointLoad> loads = m_loads;
+    std::vector<fem::PairContact> pairs;
     m_obstacle_force.setZero();
     for (std::size_t k = 0; k < m_obstacles.size(); ++k) {
-        IsxfemSimulation::Touch t = m_sim->touch_obstacle(m_obstacles[k], m_scene.solver.dt_s, m_anchors[k]);
-        m_obstacle_force -= t.contact.force_on_tool_n;
+        // Points arriving from within two voxels are caught (faster ones a step late).
+        IsxfemSimulation::ObstacleTouch t =
+            m_sim->touch_obstacle(m_obstacles[k], m_scene.solver.dt_s, m_anchors[k], obstacle_skin_mm(voxel_mm), 2.0 * voxel_mm);
+        m_obstacle_force += friction_force_n(t.contact); // the push: after the step
         loads.insert(loads.end(), t.loads.begin(), t.loads.end());
+        std::move(t.pairs.begin(), t.pairs.end(), std::back_inserter(pairs));
     }
+    m_obstacle_pairs = pairs.size();
     m_sim->solver().set_point_loads(std::move(loads));
     m_piece_contact = {};
     if (m_scene.piece_contact.enabled) {
         Stopwatch clock;
-        const double voxel_mm = 1e3 * m_grid->voxels().voxel_size_m().maxCoeff();
         IsxfemSimulation::PieceTouch t = m_sim->touch_pieces(m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0}; // force_n: after the step
-        m_sim->solver().set_pair_contact(std::move(t.pairs));
+        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0, deepest_mm(t.faces)}; // force_n: after the step
+        std::move(t.pairs.begin(), t.pairs.end(), std::back_inserter(pairs));
         m_piece_contact.ms = clock.lap();
     }
+    m_sim->solver().set_pair_contact(std::move(pairs));
     // The run's counts, and what the user is told once.
     const isxfem::CutReport& c = m_frame_cut;
     if (c.crossed_tets > 0 && m_crossed == 0)
@@ -194,7 +203,8 @@ void IsxfemMethod::end_tools()
 StepFigures IsxfemMethod::step()
 {
     const isxfem::XfemStepStats s = m_sim->solver().step();
-    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force_n();
+    m_obstacle_force += m_sim->solver().pair_contact_force(0, m_obstacle_pairs).vector_n;
+    if (m_piece_contact.enabled) m_piece_contact.force_n = m_sim->solver().pair_contact_force(m_obstacle_pairs, SIZE_MAX).magnitude_n;
     StepFigures out;
     out.step_ms = s.step_ms;
     out.assembly_ms = s.assembly_ms;

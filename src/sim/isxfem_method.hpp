@@ -82,6 +82,7 @@ private:
     std::unique_ptr<IsxfemSimulation> m_sim;
     std::vector<contact::Obstacle> m_obstacles;
     std::vector<contact::FrictionAnchors> m_anchors; ///< per obstacle
+    std::size_t m_obstacle_pairs = 0;                ///< the solver's first pair contacts are the obstacles' pushes
     Eigen::Vector3d m_obstacle_force = Eigen::Vector3d::Zero(); ///< on the object, this frame
     PieceContactFigures m_piece_contact;                        ///< this frame
     // Per tool.

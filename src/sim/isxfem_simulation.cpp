@@ -362,29 +362,57 @@ IsxfemSimulation::Touch IsxfemSimulation::touch(const contact::PlacedShape& tool
     return out;
 }
 
-IsxfemSimulation::Touch IsxfemSimulation::touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors) const
+IsxfemSimulation::ObstacleTouch IsxfemSimulation::touch_obstacle(const contact::Obstacle& obstacle, double dt_s,
+                                                                 contact::FrictionAnchors& anchors, double skin_mm, double approach_mm) const
 {
-    const NearSurface s = near_surface(obstacle.bounds(), 0.0);
+    Eigen::AlignedBox3d reach = obstacle.bounds();
+    reach.min().array() -= approach_mm;
+    reach.max().array() += approach_mm;
+    const NearSurface s = near_surface(reach, 0.0);
     // A material point is its rest position (to 1 nm) and side: the same point after a cut.
     std::vector<std::uint64_t> keys;
-    std::vector<Eigen::Vector3d> velocities;
+    std::vector<Eigen::Vector3d> velocities, ends;
     keys.reserve(s.near.size());
     velocities.reserve(s.near.size());
-    for (std::uint32_t k : s.near) {
-        const isxfem::SurfacePoint& v = (*s.vertices)[k];
+    for (std::size_t i = 0; i < s.near.size(); ++i) {
+        const isxfem::SurfacePoint& v = (*s.vertices)[s.near[i]];
         velocities.push_back(1e3 * m_solver->velocity(v.tet, v.bary, v.side));
+        ends.push_back(s.positions[i] + free_step_mm(velocities.back(), dt_s));
         std::uint64_t key = static_cast<std::uint64_t>(v.side);
         for (int a = 0; a < 3; ++a)
             key = key * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(std::llround(v.rest_m[a] * 1e9));
         keys.push_back(key);
     }
-    Touch out;
-    out.contact = contact::obstacle_contact(obstacle, s.positions, s.areas, velocities, dt_s, keys, anchors);
+    ObstacleTouch out;
+    out.contact = contact::obstacle_contact(obstacle, s.positions, s.areas, velocities, dt_s, keys, anchors, skin_mm, ends);
+    // The push along the normal at the step's end, as a one-sided pair contact; friction as loads.
     for (const contact::PointContact& c : out.contact.points) {
         const isxfem::SurfacePoint& v = (*s.vertices)[s.near[c.point]];
-        out.loads.push_back({v.tet, v.bary, v.side, c.force_n, 1e3 * c.stiffness_matrix_n_per_mm()});
+        fem::PairContact pair;
+        add_point_terms(v, 1.0, pair.terms);
+        pair.normal = c.normal;
+        pair.force_n = c.normal_force_n();
+        pair.stiffness_n_per_m = 1e3 * c.stiffness_n_per_mm;
+        pair.waiting = c.depth_mm <= -skin_mm;
+        out.pairs.push_back(std::move(pair));
+        if (!c.friction_stiffness_n_per_mm.isZero())
+            out.loads.push_back({v.tet, v.bary, v.side, c.across_force_n(), 1e3 * c.friction_stiffness_n_per_mm});
     }
     return out;
+}
+
+Eigen::Vector3d IsxfemSimulation::free_step_mm(const Eigen::Vector3d& velocity_mm_s, double dt_s) const
+{
+    return dt_s * (velocity_mm_s + 1e3 * dt_s * m_gravity);
+}
+
+void IsxfemSimulation::add_point_terms(const isxfem::SurfacePoint& v, double weight, std::vector<fem::BlockWeight>& terms) const
+{
+    const isxfem::XfemElement& el = m_model->elements()[v.tet];
+    const auto w = m_solver->weights(v.tet, v.bary, v.side);
+    for (std::size_t a = 0; a < el.block_count(); ++a) {
+        if (w[a] != 0.0) fem::add_term(terms, el.block(a), weight * w[a]);
+    }
 }
 
 IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const
@@ -400,28 +428,21 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
     for (const isxfem::SurfacePoint& v : vertices) {
         const Eigen::Vector3d x = 1e3 * m_solver->position(v.tet, v.bary, v.side);
         patch.start_mm.push_back(x);
-        patch.end_mm.push_back(x + 1e3 * dt_s * m_solver->velocity(v.tet, v.bary, v.side));
+        patch.end_mm.push_back(x + free_step_mm(1e3 * m_solver->velocity(v.tet, v.bary, v.side), dt_s));
         patch.rest_mm.push_back(1e3 * v.rest_m);
     }
     PieceTouch out;
     out.vertices = vertices.size();
     out.faces = contact::face_contacts(patch, parameters);
-    // Each point moves with its tetrahedron's blocks (Is-XFEM's weights on its side of the cuts).
-    auto add = [&](const isxfem::SurfacePoint& v, double weight, std::vector<fem::BlockWeight>& terms) {
-        const isxfem::XfemElement& el = m_model->elements()[v.tet];
-        const auto w = m_solver->weights(v.tet, v.bary, v.side);
-        for (std::size_t a = 0; a < el.block_count(); ++a) {
-            if (w[a] != 0.0) fem::add_term(terms, el.block(a), weight * w[a]);
-        }
-    };
     for (const contact::FaceContact& f : out.faces) {
         fem::PairContact pair;
-        add(vertices[f.vertex], 1.0, pair.terms);
+        add_point_terms(vertices[f.vertex], 1.0, pair.terms);
         for (int c = 0; c < 3; ++c)
-            add(vertices[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
+            add_point_terms(vertices[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
         pair.normal = f.normal;
         pair.force_n = f.force_n;
         pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
+        pair.waiting = f.depth_mm < -parameters.skin_mm;
         out.pairs.push_back(std::move(pair));
     }
     return out;

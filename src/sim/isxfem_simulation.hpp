@@ -91,8 +91,16 @@ public:
 
     /// The closed surface pressed against a static obstacle for a step of `dt_s`
     /// (contact::obstacle_contact; `anchors` its friction's, by material point: rest position and
-    /// side), with the forces as point loads.
-    [[nodiscard]] Touch touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors) const;
+    /// side; points nearer than `skin_mm` or arriving within the step are caught, of those within
+    /// `approach_mm` of the obstacle's bounds; those apart wait: fem::PairContact::waiting): the push along its normal as one-sided pair
+    /// contacts (fem/pair_contact.hpp), the friction as point loads.
+    struct ObstacleTouch {
+        contact::ContactResult contact;
+        std::vector<fem::PairContact> pairs;
+        std::vector<isxfem::PointLoad> loads;
+    };
+    [[nodiscard]] ObstacleTouch touch_obstacle(const contact::Obstacle& obstacle, double dt_s, contact::FrictionAnchors& anchors,
+                                               double skin_mm, double approach_mm) const;
 
     /// The closed surface pressed against itself over a step of `dt_s` (contact/piece_contact.hpp:
     /// pieces on pieces, the walls of a crack), every vertex pressing, and each contact as a pair
@@ -133,6 +141,13 @@ private:
     void make_solver();
     struct NearSurface;
     [[nodiscard]] NearSurface near_surface(const Eigen::AlignedBox3d& box, double closed_walls_mm) const;
+    /// How far a point moving at `velocity_mm_s` goes in a step of dt_s moving freely (gravity
+    /// too: a piece at rest on a table falls g dt^2 into it in a step), mm; what contact looks
+    /// ahead to (held points are looked at as if free: a contact more, tested and let go).
+    [[nodiscard]] Eigen::Vector3d free_step_mm(const Eigen::Vector3d& velocity_mm_s, double dt_s) const;
+    /// Adds `weight` times material point v's weights on its tetrahedron's blocks (on its side of
+    /// the cuts) to `terms`: a point as a pair contact's side.
+    void add_point_terms(const isxfem::SurfacePoint& v, double weight, std::vector<fem::BlockWeight>& terms) const;
     /// The closed surface's vertices (material points) and triangles, kept until the next cut.
     void refresh_closed_surface() const;
 

@@ -51,6 +51,13 @@ std::vector<contact::Obstacle> make_obstacles(const io::Scene& scene)
     return out;
 }
 
+Eigen::Vector3d friction_force_n(const contact::ContactResult& contact)
+{
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const contact::PointContact& c : contact.points) sum += c.across_force_n();
+    return sum;
+}
+
 contact::TriangleMesh obstacles_mesh(const std::vector<contact::Obstacle>& obstacles, const Eigen::AlignedBox3d& bounds)
 {
     contact::TriangleMesh out;

@@ -17,6 +17,14 @@ namespace vox::sim {
 /// consistently oriented (its inside would not be defined).
 [[nodiscard]] std::vector<contact::Obstacle> make_obstacles(const io::Scene& scene);
 
+/// Apart from an obstacle by less than this is touching it (contact::obstacle_contact), for voxels
+/// `voxel_mm` long: as for pieces (sim/piece_contact.hpp).
+[[nodiscard]] inline double obstacle_skin_mm(double voxel_mm) { return 0.02 * voxel_mm; }
+
+/// The sum of the obstacles' friction forces on the object at the contacts' points (their push
+/// along the normal is the solver's pair contacts', taken at the step's end).
+[[nodiscard]] Eigen::Vector3d friction_force_n(const contact::ContactResult& contact);
+
 /// The triangles to draw for every obstacle, world mm: planes as squares around `bounds` (the
 /// object's box) reaching well beyond it.
 [[nodiscard]] contact::TriangleMesh obstacles_mesh(const std::vector<contact::Obstacle>& obstacles, const Eigen::AlignedBox3d& bounds);

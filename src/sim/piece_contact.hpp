@@ -5,7 +5,9 @@
 #include "contact/piece_contact.hpp"
 #include "io/scene.hpp"
 
+#include <algorithm>
 #include <cstddef>
+#include <vector>
 
 namespace vox::sim {
 
@@ -15,7 +17,16 @@ struct PieceContactFigures {
     std::size_t tested_vertices = 0; ///< surface vertices the broad phase passed on
     double force_n = 0.0;            ///< sum of the contacts' force magnitudes at the step's end
     double ms = 0.0;                 ///< time to find them and gather them on the model
+    double max_depth_mm = 0.0;       ///< the deepest vertex in a face at the step's start (interpenetration)
 };
+
+/// The deepest of `faces` at the step's start, mm (0 when none is in).
+[[nodiscard]] inline double deepest_mm(const std::vector<contact::FaceContact>& faces)
+{
+    double out = 0.0;
+    for (const contact::FaceContact& f : faces) out = std::max(out, f.depth_mm);
+    return out;
+}
 
 /// The contact parameters for a scene whose voxels are `voxel_mm` long. Deeper than a voxel is
 /// not a contact (vertices arriving are caught before they are in: contact/piece_contact.hpp;

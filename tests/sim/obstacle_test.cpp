@@ -88,6 +88,25 @@ TEST_P(Obstacles, BlockDroppedOnATableRestsOnItCarriedByItsWeight)
     EXPECT_GT(r.lowest.z(), -2.5 - 2.0 * sink);
 }
 
+TEST_P(Obstacles, StiffBlockLetGoJustAboveATableComesToRestInsteadOfBouncing)
+{
+    // 5 MPa, let go 0.3 mm above the table: less than one step's fall from rest (g dt^2 = 1 mm).
+    // A penalty that only sees points already inside lets it fall a step's worth in, throws it
+    // back out as fast as it came and bounces it every other frame for ever (measured before the
+    // look-ahead: 0.5 mm up and down, kinetic energy 1.5e-5 J on a 13 g piece after 3 s).
+    nlohmann::json doc = block_scene(GetParam(), nlohmann::json::array({plane(-0.8)}), {0, 0, -k_g});
+    doc["materials"]["default"]["youngs_modulus_pa"] = 5e6;
+    const Settled r = run(doc, 60);
+    const double weight = r.mass_kg * k_g;
+    EXPECT_LT(r.kinetic_j, 1e-9);
+    const std::vector<double>& x = r.mean_x_mm;
+    EXPECT_LT(std::abs(x[59] - x[58]), 1e-4);
+    const Eigen::Vector3d f = r.method->obstacle_force_n();
+    EXPECT_NEAR(f.z(), weight, 0.02 * weight);
+    EXPECT_GT(r.lowest.z(), -0.8 - 0.01); // a step's fall would be 1 mm in
+    std::printf("rests on %.4f N (weight %.4f N), lowest %.4f mm, kinetic %.2e J\n", f.z(), weight, r.lowest.z(), r.kinetic_j);
+}
+
 TEST_P(Obstacles, BlockOnASlopeSlidesOrStaysAsFrictionSays)
 {
     // The table is level and gravity leans 20 degrees: tan 20 = 0.36.
