@@ -591,9 +591,9 @@ double ImplicitSolver::linear_step(double dt, StepStats& s, double& energy_befor
     // back together (a piece rocking on another sticks to it by one edge): those let go, the
     // waiting ones that end pressed in join, and the step is solved again (from the last answer),
     // until nothing changes (k_release_passes).
-    for (int pass = 0; pass < k_release_passes; ++pass) {
-        const std::vector<std::size_t> pulling = m_pairs.pulling(m_x, dt, next);
-        const std::vector<std::size_t> arriving = m_pairs.arriving(m_x, dt, next);
+    for (int pass = 0; pass < k_release_passes && !m_pairs.empty(); ++pass) {
+        const std::vector<Eigen::Vector3d> end = m_pairs.step_end(m_x, dt, next);
+        const std::vector<std::size_t> pulling = m_pairs.pulling(end), arriving = m_pairs.arriving(end);
         if (pulling.empty() && arriving.empty()) break;
         if (m_matrix_current) pairs_into_matrix(-1.0, &pulling);
         m_pairs.release(pulling);

@@ -128,12 +128,11 @@ std::vector<std::size_t> PairContacts::pulling(const std::vector<Eigen::Vector3d
     return out;
 }
 
-std::vector<std::size_t> PairContacts::pulling(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v) const
+std::vector<Eigen::Vector3d> PairContacts::step_end(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v)
 {
-    if (m_pairs.empty()) return {};
     std::vector<Eigen::Vector3d> end(x.size());
     for (std::size_t b = 0; b < x.size(); ++b) end[b] = x[b] + dt * v.segment<3>(3 * static_cast<Eigen::Index>(b));
-    return pulling(end);
+    return end;
 }
 
 void PairContacts::release(const std::vector<std::size_t>& which)
@@ -147,14 +146,6 @@ std::vector<std::size_t> PairContacts::arriving(const std::vector<Eigen::Vector3
     for (std::size_t i = 0; i < m_pairs.size(); ++i)
         if (m_pairs[i].waiting && m_waiting[i].first - m_waiting[i].second * (gap(m_pairs[i], x) - m_gap_set[i]) > 0.0) out.push_back(i);
     return out;
-}
-
-std::vector<std::size_t> PairContacts::arriving(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v) const
-{
-    if (m_pairs.empty()) return {};
-    std::vector<Eigen::Vector3d> end(x.size());
-    for (std::size_t b = 0; b < x.size(); ++b) end[b] = x[b] + dt * v.segment<3>(3 * static_cast<Eigen::Index>(b));
-    return arriving(end);
 }
 
 void PairContacts::activate(const std::vector<std::size_t>& which)

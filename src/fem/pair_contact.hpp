@@ -89,14 +89,12 @@ public:
     /// The contacts still held that would pull at positions x (f(x) < 0: the two sides part
     /// farther than the penalty's linear model allows).
     [[nodiscard]] std::vector<std::size_t> pulling(const std::vector<Eigen::Vector3d>& x) const;
-    /// The same at the end of a step of `dt` from x at velocities `v` (3 per block).
-    [[nodiscard]] std::vector<std::size_t> pulling(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v) const;
+    /// The block positions at the end of a step of `dt` from x at velocities `v` (3 per block).
+    [[nodiscard]] static std::vector<Eigen::Vector3d> step_end(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v);
     /// Lets go of contacts `which`: a contact only ever pushes.
     void release(const std::vector<std::size_t>& which);
     /// The waiting contacts that would be pressed in at positions x: they are to join the solve.
     [[nodiscard]] std::vector<std::size_t> arriving(const std::vector<Eigen::Vector3d>& x) const;
-    /// The same at the end of a step of `dt` from x at velocities `v` (3 per block).
-    [[nodiscard]] std::vector<std::size_t> arriving(const std::vector<Eigen::Vector3d>& x, double dt, const Eigen::VectorXd& v) const;
     /// Lets contacts `which` (waiting) join the solve.
     void activate(const std::vector<std::size_t>& which);
     /// Lets go of the contacts that would pull at positions x and lets in the waiting ones pressed

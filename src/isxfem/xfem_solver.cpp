@@ -172,9 +172,9 @@ XfemStepStats XfemSolver::step()
     // A pair contact that would pull two parting sides together at the step's end lets go, the
     // waiting ones that end pressed in join, and the step is solved again (from the last answer),
     // until nothing changes.
-    for (int pass = 0; pass < fem::k_release_passes; ++pass) {
-        const std::vector<std::size_t> pulling = m_pairs.pulling(m_x, dt, next);
-        const std::vector<std::size_t> arriving = m_pairs.arriving(m_x, dt, next);
+    for (int pass = 0; pass < fem::k_release_passes && !m_pairs.empty(); ++pass) {
+        const std::vector<Eigen::Vector3d> end = m_pairs.step_end(m_x, dt, next);
+        const std::vector<std::size_t> pulling = m_pairs.pulling(end), arriving = m_pairs.arriving(end);
         if (pulling.empty() && arriving.empty()) break;
         for (std::size_t i : pulling)
             if (m_pair_in_matrix[i]) m_operator.add_pair_stiffness(m_pairs.pairs()[i], -dt * dt);
