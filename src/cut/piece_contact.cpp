@@ -124,17 +124,10 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
     out.faces = contact::face_contacts(patch, parameters);
     // On the nodes: the vertex's element's weights, minus the pressed point's (its triangle's
     // corners' weights times their elements').
-    for (const contact::FaceContact& f : out.faces) {
-        fem::PairContact pair;
-        add_vertex_terms(surface, out.slots[f.vertex], 1.0, pair.terms);
-        for (int c = 0; c < 3; ++c)
-            add_vertex_terms(surface, out.slots[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
-        pair.normal = f.normal;
-        pair.force_n = f.force_n;
-        pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
-        pair.waiting = f.depth_mm < -parameters.skin_mm;
-        out.pairs.push_back(std::move(pair));
-    }
+    for (const contact::FaceContact& f : out.faces)
+        out.pairs.push_back(face_pair(f, patch, parameters.skin_mm, [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) {
+            add_vertex_terms(surface, out.slots[i], w, terms);
+        }));
     return out;
 }
 

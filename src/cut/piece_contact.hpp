@@ -14,6 +14,7 @@
 #include "cut/model_surface.hpp"
 #include "fem/pair_contact.hpp"
 
+#include <cstdint>
 #include <vector>
 
 namespace vox::cut {
@@ -25,6 +26,24 @@ struct PieceContact {
     std::vector<fem::PairContact> pairs;        ///< the same on the model's nodes (N, N/m)
     std::size_t element_pairs = 0;              ///< element pairs the broad phase kept
 };
+
+/// `f` as a pair contact on a model's dof blocks: the vertex's point minus the pressed point
+/// (its triangle's corners by their weights). `add(i, weight, terms)` adds patch vertex i's point
+/// times weight to terms (a method's weights of a surface point on its blocks). It waits
+/// (fem::PairContact::waiting) when apart by more than `skin_mm` at the start.
+template <class AddPoint>
+[[nodiscard]] fem::PairContact face_pair(const contact::FaceContact& f, const contact::SurfacePatch& patch, double skin_mm, AddPoint&& add)
+{
+    fem::PairContact pair;
+    add(f.vertex, 1.0, pair.terms);
+    for (std::size_t c = 0; c < 3; ++c)
+        add(static_cast<std::uint32_t>(patch.triangles[f.triangle][static_cast<int>(c)]), -f.weights[c], pair.terms);
+    pair.normal = f.normal;
+    pair.force_n = f.force_n;
+    pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
+    pair.waiting = f.depth_mm < -skin_mm;
+    return pair;
+}
 
 /// Contact of the surface, deformed by `node_positions` (m) and predicted at `node_ends` (m) at
 /// the step's end (fem::ImplicitSolver::free_step_positions), with itself. Two elements are

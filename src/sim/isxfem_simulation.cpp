@@ -3,6 +3,7 @@
 #include "sim/dbg_simulation.hpp"
 #include "core/error.hpp"
 #include "cut/model_surface.hpp"
+#include "cut/piece_contact.hpp"
 #include "cut/pieces.hpp"
 #include "sim/rigid_parts.hpp"
 #include "fem/hex_model.hpp"
@@ -434,17 +435,10 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
     PieceTouch out;
     out.vertices = vertices.size();
     out.faces = contact::face_contacts(patch, parameters);
-    for (const contact::FaceContact& f : out.faces) {
-        fem::PairContact pair;
-        add_point_terms(vertices[f.vertex], 1.0, pair.terms);
-        for (int c = 0; c < 3; ++c)
-            add_point_terms(vertices[static_cast<std::size_t>(patch.triangles[f.triangle][c])], -f.weights[static_cast<std::size_t>(c)], pair.terms);
-        pair.normal = f.normal;
-        pair.force_n = f.force_n;
-        pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
-        pair.waiting = f.depth_mm < -parameters.skin_mm;
-        out.pairs.push_back(std::move(pair));
-    }
+    for (const contact::FaceContact& f : out.faces)
+        out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) {
+            add_point_terms(vertices[i], w, terms);
+        }));
     return out;
 }
 
