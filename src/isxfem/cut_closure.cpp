@@ -9,6 +9,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <map>
+#include <set>
 #include <unordered_map>
 
 namespace vox::isxfem {
@@ -175,9 +176,11 @@ private:
     std::multimap<NodeEdge, int> m_leaving;               ///< R's boundary: its segments by start
     std::map<std::pair<std::size_t, int>, int> m_on_face; ///< (tet, face) -> its segment
     std::map<std::pair<NodeEdge, unsigned>, int> m_corner_points; ///< R's boundary vertices placed so far, by region
-    /// A swept cut's vertices (its crossings of the cut tetrahedra's edges) and a cut tetrahedron
-    /// at each: what a crack face takes inside it to follow the cut where it bends.
-    std::map<NodeEdge, std::pair<Eigen::Vector3d, std::size_t>> m_crack_vertices;
+    /// The cut's crossings of the cut tetrahedra's edges, each moved a hundredth of the way to the
+    /// centre of the cut's polygon in a tetrahedron there, and that tetrahedron: what a crack face
+    /// takes inside it to follow the material (and the cut where it bends).
+    std::vector<std::pair<Eigen::Vector3d, std::size_t>> m_crack_vertices;
+    std::set<NodeEdge> m_crack_vertex_edges;
 };
 
 void Closer::build_boundary()
@@ -205,10 +208,15 @@ void Closer::build_boundary()
                     const auto [edge, x] = on_edge(a, b);
                     centre += x;
                     ++count;
-                    if (!m_surface.is_plane()) m_crack_vertices.try_emplace(edge, x, t);
                 }
         if (count < 3) continue;
         centre /= count;
+        for (std::size_t a = 0; a < 4; ++a)
+            for (std::size_t b = a + 1; b < 4; ++b)
+                if (crossed(a, b)) {
+                    const auto [edge, x] = on_edge(a, b);
+                    if (m_crack_vertex_edges.insert(edge).second) m_crack_vertices.emplace_back(x + 0.01 * (centre - x), t);
+                }
         for (int face = 0; face < 4; ++face) {
             if (in_crack(m_neighbours[t][static_cast<std::size_t>(face)])) continue;
             std::vector<std::pair<NodeEdge, Eigen::Vector3d>> ends;
@@ -459,18 +467,18 @@ void Closer::emit(std::vector<std::array<int, 2>> ids, std::vector<Eigen::Vector
     std::vector<std::array<int, 3>> faces;
     for (const std::array<int, 3>& f : triangulate_polygon(in_plane, shared))
         if (!shared[static_cast<std::size_t>(f[0])] || !shared[static_cast<std::size_t>(f[1])] || !shared[static_cast<std::size_t>(f[2])]) faces.push_back(f);
-    // Where a swept cut bends, triangles across its face would cut through the material: the
-    // cut's own vertices inside the face are added where they lie off the triangles so far.
+    // The cut's vertices inside the face (m_crack_vertices) are added: where a swept cut bends,
+    // triangles across its face would cut through the material; and a face spanned by its rim
+    // alone is drawn flat however the material inside it bends, and two walls pressed together
+    // would touch only at their rims (piece contact presses vertices into faces). Each is moved a
+    // hundredth of the way into a tetrahedron: on the mesh's edges, a later cut along a row of
+    // nodes passed exactly through them (its level 0 at a vertex) and its crossings there did not
+    // join into faces. (The polygons' centres alone made walls that sank into each other.)
     const std::size_t boundary = ids.size();
-    for (const auto& [edge, at] : m_crack_vertices) {
-        const auto& [point, tet] = at;
+    for (const auto& [point, tet] : m_crack_vertices) {
         const Eigen::Vector2d unrolled = flat(point);
-        const int holder = locate(in_plane, faces, unrolled);
-        if (holder < 0) continue;
-        const std::array<int, 3>& f = faces[static_cast<std::size_t>(holder)];
-        const Eigen::Vector3d& x0 = x[static_cast<std::size_t>(f[0])];
-        const Eigen::Vector3d normal = (x[static_cast<std::size_t>(f[1])] - x0).cross(x[static_cast<std::size_t>(f[2])] - x0);
-        if (std::abs(normal.normalized().dot(point - x0)) <= 1e-3 * m_model.longest_edge()) continue;
+        const Location holder = locate(in_plane, faces, unrolled);
+        if (holder.triangle < 0) continue;
         insert_point(in_plane, faces, holder, unrolled, boundary);
         const std::array<double, 4> bary = clamped(barycentric(m_model.mesh(), tet, point));
         const unsigned region = m_model.elements()[tet].region_at(bary);

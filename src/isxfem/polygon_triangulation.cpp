@@ -97,28 +97,78 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vec
     return out;
 }
 
-int locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p)
+Location locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p)
 {
+    auto at = [&](int i) -> const Eigen::Vector2d& { return points[static_cast<std::size_t>(i)]; };
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        const Eigen::Vector2d& a = points[static_cast<std::size_t>(triangles[k][0])];
-        const Eigen::Vector2d& b = points[static_cast<std::size_t>(triangles[k][1])];
-        const Eigen::Vector2d& c = points[static_cast<std::size_t>(triangles[k][2])];
-        // Clear of the edges by a millionth of the area: a point on an edge would leave a flat triangle.
-        const double clear = 1e-6 * cross(a, b, c);
-        if (clear > 0.0 && cross(a, b, p) > clear && cross(b, c, p) > clear && cross(c, a, p) > clear) return static_cast<int>(k);
+        const std::array<int, 3>& t = triangles[k];
+        if (!(cross(at(t[0]), at(t[1]), at(t[2])) > 0.0)) continue;
+        // Distances to the edges (positive inside), against a hundredth of the longest edge: a
+        // point nearer than that to an edge lies on it (split there, not beside it: a nearly flat
+        // triangle would be left).
+        double longest = 0.0;
+        std::array<double, 3> distance{};
+        for (std::size_t e = 0; e < 3; ++e) {
+            const Eigen::Vector2d& a = at(t[e]);
+            const Eigen::Vector2d& b = at(t[(e + 1) % 3]);
+            longest = std::max(longest, (b - a).norm());
+            distance[e] = cross(a, b, p) / (b - a).norm();
+        }
+        const double tolerance = 1e-2 * longest;
+        int on = -1, clear = 0;
+        for (std::size_t e = 0; e < 3; ++e) {
+            if (distance[e] > tolerance) ++clear;
+            else if (distance[e] >= -tolerance) on = static_cast<int>(e);
+        }
+        if (clear == 3) return {static_cast<int>(k), -1};
+        if (clear == 2 && on >= 0) {
+            const int u = t[static_cast<std::size_t>(on)], v = t[static_cast<std::size_t>((on + 1) % 3)], w = t[static_cast<std::size_t>((on + 2) % 3)];
+            for (std::size_t j = 0; j < triangles.size(); ++j)
+                for (std::size_t e = 0; e < 3; ++e)
+                    if (triangles[j][e] == v && triangles[j][(e + 1) % 3] == u) {
+                        // The four triangles the split makes must all face the same way: p just
+                        // beyond the edge of a thin triangle across could turn one over.
+                        const int z = triangles[j][(e + 2) % 3];
+                        const bool turns = cross(at(w), at(u), p) <= 0.0 || cross(at(v), at(w), p) <= 0.0 || cross(at(z), at(v), p) <= 0.0 ||
+                                           cross(at(u), at(z), p) <= 0.0;
+                        return turns ? Location{} : Location{static_cast<int>(k), on};
+                    }
+            return {}; // on the polygon's boundary: not inside
+        }
     }
-    return -1;
+    return {};
 }
 
-void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, int holder, const Eigen::Vector2d& p,
-                  std::size_t boundary)
+void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, const Location& where,
+                  const Eigen::Vector2d& p, std::size_t boundary)
 {
     const int id = static_cast<int>(points.size());
     points.push_back(p);
-    const std::array<int, 3> split = triangles[static_cast<std::size_t>(holder)];
-    triangles[static_cast<std::size_t>(holder)] = {split[0], split[1], id};
-    triangles.push_back({split[1], split[2], id});
-    triangles.push_back({split[2], split[0], id});
+    const std::array<int, 3> split = triangles[static_cast<std::size_t>(where.triangle)];
+    // The edges opposite p, each with a triangle (a, b, p) on its left.
+    std::vector<std::pair<int, int>> edges;
+    if (where.edge < 0) { // inside: three triangles
+        triangles[static_cast<std::size_t>(where.triangle)] = {split[0], split[1], id};
+        triangles.push_back({split[1], split[2], id});
+        triangles.push_back({split[2], split[0], id});
+        edges = {{split[0], split[1]}, {split[1], split[2]}, {split[2], split[0]}};
+    } else { // on the edge u-v: it and the triangle across it, two each
+        const auto e = static_cast<std::size_t>(where.edge);
+        const int u = split[e], v = split[(e + 1) % 3], w = split[(e + 2) % 3];
+        std::size_t across = 0;
+        int z = -1;
+        for (std::size_t j = 0; j < triangles.size() && z < 0; ++j)
+            for (std::size_t c = 0; c < 3; ++c)
+                if (triangles[j][c] == v && triangles[j][(c + 1) % 3] == u) {
+                    across = j;
+                    z = triangles[j][(c + 2) % 3];
+                }
+        triangles[static_cast<std::size_t>(where.triangle)] = {w, u, id};
+        triangles.push_back({v, w, id});
+        triangles[across] = {z, v, id};
+        triangles.push_back({u, z, id});
+        edges = {{w, u}, {v, w}, {z, v}, {u, z}};
+    }
     auto at = [&](int i) -> const Eigen::Vector2d& { return points[static_cast<std::size_t>(i)]; };
     auto fixed = [&](int a, int b) {
         const auto n = static_cast<int>(boundary);
@@ -126,7 +176,6 @@ void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<i
     };
     // Each triangle (a, b, id) holds p; its edge a-b is flipped when the point across it lies in
     // its circumcircle, and the two new edges opposite p are checked in turn.
-    std::vector<std::pair<int, int>> edges{{split[0], split[1]}, {split[1], split[2]}, {split[2], split[0]}};
     while (!edges.empty()) {
         const auto [a, b] = edges.back();
         edges.pop_back();

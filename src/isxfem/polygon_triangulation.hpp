@@ -16,15 +16,23 @@ namespace vox::isxfem {
 /// vertices are avoided where another ear will do.
 std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector2d>& polygon, const std::vector<bool>& apart = {});
 
-/// The triangle (counter-clockwise, indices into `points`) that holds p clear of its edges, or -1.
-int locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p);
+/// Where a point falls in a triangulation (counter-clockwise triangles, indices into the points).
+struct Location {
+    int triangle = -1; ///< -1: in none (or on the triangulated polygon's boundary)
+    int edge = -1;     ///< the triangle's edge it lies on (from corner `edge` to the next), or -1: clear of all three
+};
 
-/// Adds p to the triangulation inside triangle `holder` (locate()): the triangle is split in three
-/// and the edges opposite p are flipped while the point across lies in their circumcircle (Lawson),
-/// except the boundary's (the polygon points[0 .. boundary - 1] in order, bridges included): the
-/// triangles around p come out locally Delaunay, the rest as they were. p is appended to `points`.
-void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, int holder, const Eigen::Vector2d& p,
-                  std::size_t boundary);
+/// The triangle that holds p, and whether p lies on one of its edges (within a hundredth of its
+/// longest edge) that another triangle shares.
+Location locate(const std::vector<Eigen::Vector2d>& points, const std::vector<std::array<int, 3>>& triangles, const Eigen::Vector2d& p);
+
+/// Adds p to the triangulation where locate() found it: the triangle is split in three (or, p on
+/// an edge, it and the triangle across in two each) and the edges opposite p are flipped while
+/// the point across lies in their circumcircle (Lawson), except the boundary's (the polygon
+/// points[0 .. boundary - 1] in order, bridges included): the triangles around p come out locally
+/// Delaunay, the rest as they were. p is appended to `points`.
+void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<int, 3>>& triangles, const Location& where,
+                  const Eigen::Vector2d& p, std::size_t boundary);
 
 /// A corner of one of several loops.
 struct LoopCorner {
