@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
+#include "fem/stiffness_product.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -43,9 +44,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_stiffness_scale.assign(model.elements().size(), 1.0);
     m_behaviour.resize(model.materials().size());
     m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
-    m_element_force.assign(model.elements().size(), Vector24d::Zero());
     m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
-    m_element_product.assign(model.elements().size(), Vector24d::Zero());
     if (same_mesh && same_mesh->m_options.matrix_free == m_options.matrix_free && same_connectivity(same_mesh->m_model, model)) {
         // A cut that changed element matrices only (a drill taking a voxel a frame): the
         // incidence and the matrix pattern are those of the previous solver.
@@ -53,11 +52,57 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
         m_incidence = same_mesh->m_incidence;
         m_rank = same_mesh->m_rank;
         m_diagonal_rank = same_mesh->m_diagonal_rank;
+        m_run_groups = same_mesh->m_run_groups;
         m_matrix = same_mesh->m_matrix;
         std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + m_matrix.nonZeros(), 0.0);
         return;
     }
     build_pattern();
+}
+
+namespace {
+/// Elements per run of the matrix-free product: consecutive elements lie close together (the
+/// branched grid numbers them along its octree), so a run's nodes stay in cache while it adds
+/// into them.
+constexpr std::size_t k_product_run = 64;
+} // namespace
+
+void ImplicitSolver::group_runs()
+{
+    const auto& elements = m_model.elements();
+    const std::size_t runs = (elements.size() + k_product_run - 1) / k_product_run;
+    std::vector<std::int32_t> group_of(runs, -1);
+    std::vector<std::size_t> seen_by; // per group: the last run that found it beside itself, plus one
+    m_run_groups.clear();
+    for (std::size_t run = 0; run < runs; ++run) {
+        const std::size_t end = std::min(elements.size(), (run + 1) * k_product_run);
+        for (std::size_t e = run * k_product_run; e < end; ++e)
+            for (std::uint32_t node : elements[e].dof_node)
+                for (std::uint32_t k = m_incidence_start[node]; k < m_incidence_start[node + 1]; ++k)
+                    if (const std::int32_t g = group_of[m_incidence[k] / 8 / k_product_run]; g >= 0) seen_by[static_cast<std::size_t>(g)] = run + 1;
+        std::size_t g = 0;
+        while (g < m_run_groups.size() && seen_by[g] == run + 1) ++g;
+        if (g == m_run_groups.size()) {
+            m_run_groups.emplace_back();
+            seen_by.push_back(0);
+        }
+        m_run_groups[g].push_back(static_cast<std::uint32_t>(run));
+        group_of[run] = static_cast<std::int32_t>(g);
+    }
+}
+
+template <typename F>
+void ImplicitSolver::for_each_element_by_runs(F&& f) const
+{
+    const std::size_t count = m_model.elements().size();
+    for (const std::vector<std::uint32_t>& group : m_run_groups)
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, group.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                const std::size_t first = group[i] * k_product_run, end = std::min(count, first + k_product_run);
+                for (std::size_t e = first; e < end; ++e)
+                    if (m_active[e]) f(e);
+            }
+        });
 }
 
 bool ImplicitSolver::same_connectivity(const HexModel& a, const HexModel& b)
@@ -81,6 +126,7 @@ void ImplicitSolver::build_pattern()
     std::vector<std::uint32_t> fill(m_incidence_start.begin(), m_incidence_start.end() - 1);
     for (std::uint32_t e = 0; e < model.elements().size(); ++e)
         for (std::uint32_t c = 0; c < 8; ++c) m_incidence[fill[model.elements()[e].dof_node[c]]++] = 8 * e + c;
+    group_runs();
     if (m_options.matrix_free) return; // no matrix
 
     // The matrix pattern: a 3 x 3 block for every pair of nodes sharing an element. Built from
@@ -197,8 +243,6 @@ void ImplicitSolver::update_active()
                 break;
             }
         if (m_active[e]) continue;
-        m_element_force[e].setZero();
-        m_element_product[e].setZero();
         m_element_energy[e] = 0.0;
     }
     m_active_current = true;
@@ -263,92 +307,96 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
     // ends with this pass at its new positions (the energy check); the next step starts from the
     // same positions and reuses it, unless plastic strain is due to creep first.
     if (!(m_element_pass_current && m_plastic.empty())) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t e = range.begin(); e != range.end(); ++e) {
-                if (!m_active[e]) continue;
-                const HexElement& el = elements[e];
-                // Displacements relative to corner 0: K ignores translations, and far from the origin
-                // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
-                const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
-                Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-                for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
-                extract_rotation(frame.transpose() * f, m_rotation[e]);
-                const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
-                m_element_rotation[e] = r;
-                const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
-                Vector24d u;
-                for (int c = 0; c < 8; ++c)
-                    u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
-                const double scale = m_stiffness_scale[e];
-                Vector24d fl = scale * ((*el.stiffness) * u);
-                m_element_energy[e] = 0.5 * u.dot(fl);
-                if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
-                    m_element_energy[e] += plastic_correction(e, u, fl);
-                for (int c = 0; c < 8; ++c) m_element_force[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
-            }
+        // Each element adds its forces straight into its nodes (for_each_element_by_runs).
+        m_internal.setZero(static_cast<Eigen::Index>(3 * m_x.size()));
+        for_each_element_by_runs([&](std::size_t e) {
+            const HexElement& el = elements[e];
+            // Displacements relative to corner 0: K ignores translations, and far from the origin
+            // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
+            const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
+            Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+            for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
+            extract_rotation(frame.transpose() * f, m_rotation[e]);
+            const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
+            m_element_rotation[e] = r;
+            const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
+            Vector24d u;
+            for (int c = 0; c < 8; ++c)
+                u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
+            const double scale = m_stiffness_scale[e];
+            Vector24d fl = scale * stiffness_times(*el.stiffness, u);
+            m_element_energy[e] = 0.5 * u.dot(fl);
+            if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
+                m_element_energy[e] += plastic_correction(e, u, fl);
+            for (int c = 0; c < 8; ++c) m_internal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += r * fl.segment<3>(3 * c);
         });
     }
     m_element_pass_current = true;
-    // Node pass: each node gathers its forces and writes its own three matrix rows, so threads
-    // never write the same entry and every write stays within a few cache lines.
     double* values = m_matrix.valuePtr();
     const bool lumped = m_options.lumped_mass;
     m_m_scale = m_scale;
     m_k_scale = k_scale;
     m_matrix_current = output == Output::matrix;
-    if (output != Output::forces) m_diagonal.resize(static_cast<Eigen::Index>(3 * m_x.size()));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t n = range.begin(); n != range.end(); ++n) {
-            Eigen::Vector3d force = Eigen::Vector3d::Zero();
-            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k)
-                force += m_element_force[m_incidence[k] / 8].segment<3>(3 * (m_incidence[k] % 8));
-            m_internal.segment<3>(static_cast<Eigen::Index>(3 * n)) = force;
-            if (output == Output::forces) continue;
-            const double diagonal_mass = lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n];
-            if (output == Output::diagonal) { // for the Jacobi preconditioner and the scaled residual
-                Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * diagonal_mass);
+    if (output == Output::diagonal) { // for the Jacobi preconditioner and the scaled residual
+        // Each element adds the diagonals of its corners' blocks into its nodes, then each node
+        // its mass and contact.
+        m_diagonal.setZero(static_cast<Eigen::Index>(3 * m_x.size()));
+        for_each_element_by_runs([&](std::size_t e) {
+            const HexElement& el = elements[e];
+            const Eigen::Matrix3d& r = m_element_rotation[e];
+            const double ks = k_scale * m_stiffness_scale[e];
+            for (int c = 0; c < 8; ++c) {
+                // The diagonal of r K_cc r^T alone: row i of r K_cc dotted with row i of r.
+                const Eigen::Matrix3d rk = r * el.stiffness->block<3, 3>(3 * c, 3 * c);
+                Eigen::Vector3d d = ks * rk.cwiseProduct(r).rowwise().sum();
+                if (!lumped) d.array() += m_scale * el.mass(c, c);
+                m_diagonal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += d;
+            }
+        });
+        for (std::size_t n = 0; n < m_x.size(); ++n) {
+            Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]));
+            if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
+                d += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m.diagonal();
+            m_diagonal.segment<3>(static_cast<Eigen::Index>(3 * n)) += d;
+        }
+    }
+    if (output == Output::matrix) {
+        // Each node writes its own three rows, so threads never write the same entry and every
+        // write stays within a few cache lines.
+        m_diagonal.resize(static_cast<Eigen::Index>(3 * m_x.size()));
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t n = range.begin(); n != range.end(); ++n) {
+                const double diagonal_mass = lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n];
+                const int* outer = m_matrix.outerIndexPtr();
+                std::fill(values + outer[3 * n], values + outer[3 * n + 3], 0.0); // this node's three rows
+                const int row_length = outer[3 * n + 1] - outer[3 * n];
                 for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
                     const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
                     if (!m_active[e]) continue;
+                    const HexElement& el = elements[e];
                     const Eigen::Matrix3d& r = m_element_rotation[e];
-                    const Eigen::Matrix3d block = r * elements[e].stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * static_cast<int>(c)) * r.transpose();
-                    d += k_scale * m_stiffness_scale[e] * block.diagonal();
-                    if (!lumped) d.array() += m_scale * elements[e].mass(c, c);
+                    const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
+                    const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
+                    for (int d = 0; d < 8; ++d) {
+                        Eigen::Matrix3d block = rk * el.stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * d) * r.transpose();
+                        if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
+                        double* at = values + outer[3 * n] + 3 * ranks[d];
+                        for (int i = 0; i < 3; ++i)
+                            for (int j = 0; j < 3; ++j) at[i * row_length + j] += block(i, j);
+                    }
                 }
+                double* diagonal = values + outer[3 * n] + 3 * m_diagonal_rank[n];
                 if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
-                    d += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m.diagonal();
-                m_diagonal.segment<3>(static_cast<Eigen::Index>(3 * n)) = d;
-                continue;
-            }
-            const int* outer = m_matrix.outerIndexPtr();
-            std::fill(values + outer[3 * n], values + outer[3 * n + 3], 0.0); // this node's three rows
-            const int row_length = outer[3 * n + 1] - outer[3 * n];
-            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
-                const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
-                if (!m_active[e]) continue;
-                const HexElement& el = elements[e];
-                const Eigen::Matrix3d& r = m_element_rotation[e];
-                const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
-                const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
-                for (int d = 0; d < 8; ++d) {
-                    Eigen::Matrix3d block = rk * el.stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * d) * r.transpose();
-                    if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
-                    double* at = values + outer[3 * n] + 3 * ranks[d];
                     for (int i = 0; i < 3; ++i)
-                        for (int j = 0; j < 3; ++j) at[i * row_length + j] += block(i, j);
+                        for (int j = 0; j < 3; ++j)
+                            diagonal[i * row_length + j] += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m(i, j);
+                for (int i = 0; i < 3; ++i) {
+                    diagonal[i * row_length + i] += m_scale * diagonal_mass;
+                    m_diagonal[static_cast<Eigen::Index>(3 * n) + i] = diagonal[i * row_length + i];
                 }
             }
-            double* diagonal = values + outer[3 * n] + 3 * m_diagonal_rank[n];
-            if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j)
-                        diagonal[i * row_length + j] += m_contact_scale * m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m(i, j);
-            for (int i = 0; i < 3; ++i) {
-                diagonal[i * row_length + i] += m_scale * diagonal_mass;
-                m_diagonal[static_cast<Eigen::Index>(3 * n) + i] = diagonal[i * row_length + i];
-            }
-        }
-    });
+        });
+    }
     if (output != Output::forces) m_pairs.add_diagonal(m_contact_scale, m_diagonal);
     m_pair_in_matrix.assign(m_pairs.pairs().size(), 0);
     if (output == Output::matrix) pairs_into_matrix(1.0);
@@ -470,34 +518,31 @@ void ImplicitSolver::multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& 
 void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
     // out = m_scale M p + k_scale sum_e R K R^T p, element by element; held dofs map to themselves
-    // (CG keeps them zero in p).
+    // (CG keeps them zero in p). Each element adds its product straight into its nodes: the runs
+    // of one group share no node, so they run in parallel without two writing the same entry.
     const auto& elements = m_model.elements();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, elements.size(), 64), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t e = range.begin(); e != range.end(); ++e) {
-            if (!m_active[e]) continue;
-            const HexElement& el = elements[e];
-            const Eigen::Matrix3d& r = m_element_rotation[e];
-            Vector24d local;
-            for (int c = 0; c < 8; ++c)
-                local.segment<3>(3 * c) = r.transpose() * p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
-            const Vector24d fl = m_stiffness_scale[e] * ((*el.stiffness) * local);
-            for (int c = 0; c < 8; ++c) m_element_product[e].segment<3>(3 * c) = r * fl.segment<3>(3 * c);
-        }
+    m_stiffness_product.setZero(p.size());
+    for_each_element_by_runs([&](std::size_t e) {
+        const HexElement& el = elements[e];
+        const Eigen::Matrix3d& r = m_element_rotation[e];
+        Vector24d local;
+        for (int c = 0; c < 8; ++c) local.segment<3>(3 * c) = r.transpose() * p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
+        const Vector24d fl = m_stiffness_scale[e] * stiffness_times(*el.stiffness, local);
+        for (int c = 0; c < 8; ++c) m_stiffness_product.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += r * fl.segment<3>(3 * c);
     });
     out.resize(p.size());
     const bool lumped = m_options.lumped_mass;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t n = range.begin(); n != range.end(); ++n) {
             const auto i = static_cast<Eigen::Index>(3 * n);
-            Eigen::Vector3d sum = Eigen::Vector3d::Zero(), mass = Eigen::Vector3d::Zero();
-            for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
-                const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
-                sum += m_element_product[e].segment<3>(3 * c);
-                if (!lumped)
+            Eigen::Vector3d mass = Eigen::Vector3d::Zero();
+            if (!lumped)
+                for (std::uint32_t k = m_incidence_start[n]; k < m_incidence_start[n + 1]; ++k) {
+                    const std::uint32_t e = m_incidence[k] / 8, c = m_incidence[k] % 8;
                     for (int d = 0; d < 8; ++d) mass += elements[e].mass(c, d) * p.segment<3>(3 * static_cast<Eigen::Index>(elements[e].dof_node[d]));
-            }
+                }
             mass += (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]) * p.segment<3>(i);
-            out.segment<3>(i) = m_k_scale * sum + m_m_scale * mass;
+            out.segment<3>(i) = m_k_scale * m_stiffness_product.segment<3>(i) + m_m_scale * mass;
             if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
                 out.segment<3>(i) += m_contact_scale * (m_contact[static_cast<std::size_t>(c)].stiffness_n_per_m * p.segment<3>(i));
             for (int a = 0; a < 3; ++a)

@@ -169,6 +169,13 @@ public:
 private:
     /// Node incidence of the elements and, unless matrix-free, the matrix pattern.
     void build_pattern();
+    /// Fills m_run_groups from the incidence (greedy: each run in the first group none of whose
+    /// runs shares a node with it).
+    void group_runs();
+    /// Calls f(e) for every active element, the runs of one group of m_run_groups in parallel:
+    /// f may add into the element's nodes, since no two elements running at once share one.
+    template <typename F>
+    void for_each_element_by_runs(F&& f) const;
     /// Whether the two models have the same elements on the same nodes.
     [[nodiscard]] static bool same_connectivity(const HexModel& a, const HexModel& b);
     /// What an assembly produces beyond the element rotations, elastic forces and energy.
@@ -239,8 +246,11 @@ private:
     std::vector<std::uint32_t> m_incidence_start;     ///< per node, into m_incidence
     std::vector<std::uint32_t> m_incidence;           ///< 8 element + corner, grouped by node
     std::vector<Eigen::Matrix3d> m_element_rotation;  ///< per element, world frame
-    std::vector<Vector24d> m_element_force;           ///< per element, rotated elastic forces, N
-    mutable std::vector<Vector24d> m_element_product; ///< matrix-free products, per element
+    /// Runs of k_product_run consecutive elements, grouped so that no two runs of a group share a
+    /// node (group_runs): the matrix-free product adds each run's element products straight into
+    /// its nodes, the runs of one group in parallel.
+    std::vector<std::vector<std::uint32_t>> m_run_groups;
+    mutable Eigen::VectorXd m_stiffness_product; ///< sum over elements of R K R^T p, per dof (matrix-free product)
     bool m_matrix_current = false;                    ///< m_matrix holds the system being solved
     Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
     double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K
