@@ -4,9 +4,11 @@
 // section crossed + grid update + local remesh: the branched-grid paper's phases, target 5 ms),
 // and the whole frame a user feels (the frame loop's frame_ms: those phases, the model's update
 // after the cut and the solver's step; target 16.7 ms, 60 Hz). Each run replays the whole scene
-// from scratch with each preconditioner in turn: the scene's own (Jacobi, matrix-free, nothing to
-// keep across a cut) and the warped Cholesky factor, which a cut now patches instead of taking
-// anew. Run it pinned to one core (`taskset -c 0`) for the one-core figure.
+// from scratch in three configurations in turn: as bundled (Jacobi, matrix-free, nothing to keep
+// across a cut; pieces not touching), with piece contact on (the incision's walls pressing on
+// each other, as a user who turns it on feels the frame), and with it on and the warped Cholesky
+// factor, which a cut patches instead of taking anew. Run it pinned to one core
+// (`taskset -c 0`) for the one-core figure.
 
 #include "bench/harness/cutting.hpp"
 
@@ -73,9 +75,14 @@ void run_cutting_bench(int runs, const std::filesystem::path& dir)
 {
     const io::Scene scene = io::load_scene(VOX_DATA_DIR "/scenes/liver_incision.json");
     const auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-    io::Scene cholesky = scene;
+    // The scene as bundled, then with pieces touching (the walls of the incision press on each
+    // other), with its Jacobi preconditioner and with the warped Cholesky factor.
+    io::Scene touching = scene;
+    touching.piece_contact.enabled = true;
+    io::Scene cholesky = touching;
     cholesky.solver.preconditioner = io::PreconditionerChoice::cholesky;
-    const std::vector<std::pair<const char*, const io::Scene*>> configurations = {{"jacobi (the scene's)", &scene}, {"cholesky", &cholesky}};
+    const std::vector<std::pair<const char*, const io::Scene*>> configurations = {
+        {"jacobi (the scene's)", &scene}, {"jacobi, piece contact", &touching}, {"cholesky, piece contact", &cholesky}};
     std::vector<CuttingRun> results;
     for (int run = 1; run <= runs; ++run)
         for (const auto& [name, s] : configurations) {
@@ -89,12 +96,13 @@ void run_cutting_bench(int runs, const std::filesystem::path& dir)
     md << "# Cutting (`voxsculpt bench cutting`)\n\n"
           "The 5 cm scalpel incision of `data/scenes/liver_incision.json` (the liver, label 255, at level "
        << scene.object.levels
-       << ", separate mode), replayed from scratch with each preconditioner in turn, alternating. A cutting frame is a frame "
+       << ", separate mode), replayed from scratch in each configuration in turn, alternating: the scene as bundled (Jacobi, "
+          "pieces not touching), with `piece_contact` on, and with it on and the warped Cholesky factor. A cutting frame is a frame "
           "in which the scalpel cut. *Cut phases*: collision + propagation + grid update + local remesh (the "
           "branched-grid paper's phases; target p95 under 5 ms). *Whole frame*: the frame loop's wall clock, those phases, "
           "the model's update after the cut and the solver's step (target p95 under 16.7 ms, 60 Hz). Machine: "
        << machine_description() << ".\n\n";
-    md << "| run | preconditioner | cutting frames | faces opened | cut phases median / p95 (ms) | whole frame median / p95 / max (ms) | "
+    md << "| run | configuration | cutting frames | faces opened | cut phases median / p95 (ms) | whole frame median / p95 / max (ms) | "
           "model update (median, ms) | step (median, ms) | CG iterations (median) |\n|---|---|---|---|---|---|---|---|---|\n";
     nlohmann::json j = {{"scene", "data/scenes/liver_incision.json"}, {"level", scene.object.levels}, {"machine", machine_description()},
                         {"runs", nlohmann::json::array()}};
