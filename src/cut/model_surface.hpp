@@ -46,6 +46,16 @@ public:
         else
             for (std::uint32_t v : m_surface.element_vertices(ge)) f(v);
     }
+    /// Whether element `e` holds a surface vertex (without visiting them: at level 1 and up a
+    /// coarse element can hold hundreds).
+    [[nodiscard]] bool element_has_vertex(std::uint32_t e) const
+    {
+        const std::uint32_t ge = m_model.elements()[e].grid_element;
+        if (m_model.level() != 0) return !m_surface.element_vertices(ge).empty();
+        bool any = false;
+        m_surface.for_each_voxel_vertex(ge, [&](std::uint32_t) { any = true; });
+        return any;
+    }
     /// Triangle slots using vertex slot `v`.
     [[nodiscard]] std::span<const std::uint32_t> vertex_triangles(std::uint32_t v) const { return m_surface.vertex_triangles(v); }
 

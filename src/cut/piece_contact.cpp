@@ -8,25 +8,24 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 namespace vox::cut {
 
 namespace {
 
 /// Elements holding surface vertices whose swept, deformed boxes come within `gap_mm` of another
-/// such element's without sharing a node with it (the broad phase of the header); sets `pairs`.
+/// such element's without sharing a node with it (the broad phase of the header), and those
+/// pairs (indices into the list returned).
 std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& start_m,
-                                                const std::vector<Eigen::Vector3d>& end_m, double gap_mm, std::size_t& pairs)
+                                                const std::vector<Eigen::Vector3d>& end_m, double gap_mm,
+                                                std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs)
 {
     const fem::HexModel& model = surface.model();
     const auto& elements = model.elements();
     std::vector<std::uint32_t> candidates;
     std::vector<Eigen::AlignedBox3d> boxes;
     for (std::uint32_t e = 0; e < elements.size(); ++e) {
-        bool has_vertex = false;
-        surface.for_each_element_vertex(e, [&](std::uint32_t) { has_vertex = true; });
-        if (!has_vertex) continue;
+        if (!surface.element_has_vertex(e)) continue;
         Eigen::AlignedBox3d box;
         box.setEmpty();
         for (std::uint32_t n : elements[e].dof_node) {
@@ -68,11 +67,15 @@ std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, con
     }
     std::sort(found.begin(), found.end());
     found.erase(std::unique(found.begin(), found.end()), found.end());
-    pairs = found.size();
     for (const auto& [p, q] : found) kept[p] = kept[q] = 1;
-    std::vector<std::uint32_t> out;
+    std::vector<std::uint32_t> out, place(candidates.size(), 0);
     for (std::uint32_t i = 0; i < candidates.size(); ++i)
-        if (kept[i]) out.push_back(candidates[i]);
+        if (kept[i]) {
+            place[i] = static_cast<std::uint32_t>(out.size());
+            out.push_back(candidates[i]);
+        }
+    pairs.clear();
+    for (const auto& [p, q] : found) pairs.emplace_back(place[p], place[q]);
     return out;
 }
 
@@ -83,26 +86,59 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
 {
     PieceContact out;
     const std::vector<Eigen::Vector3d>& end = node_ends;
-    const std::vector<std::uint32_t> near = elements_near_others(surface, node_positions, end, parameters.approach_mm, out.element_pairs);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> near_pairs;
+    const std::vector<std::uint32_t> near = elements_near_others(surface, node_positions, end, parameters.approach_mm, near_pairs);
+    out.element_pairs = near_pairs.size();
     if (near.empty()) return out;
     // The patch: the near elements' vertices and the corners of their triangles, each once.
-    std::unordered_map<std::uint32_t, std::uint32_t> index;
+    // By vertex slot, its place in the patch (none: ~0u); an array, not a hash map: the patch
+    // takes tens of thousands of lookups a frame.
+    constexpr std::uint32_t none = ~0u;
+    std::vector<std::uint32_t> index(surface.embedded().vertices().size(), none);
     const auto& triangles = surface.embedded().triangles();
     contact::SurfacePatch& patch = out.patch;
     auto add = [&](std::uint32_t v, bool presses) {
-        const auto [it, added] = index.emplace(v, static_cast<std::uint32_t>(out.slots.size()));
-        if (added) {
+        if (index[v] == none) {
+            index[v] = static_cast<std::uint32_t>(out.slots.size());
             out.slots.push_back(v);
             patch.presses.push_back(0);
         }
-        if (presses) patch.presses[it->second] = 1;
+        if (presses) patch.presses[index[v]] = 1;
     };
-    for (std::uint32_t e : near)
-        surface.for_each_element_vertex(e, [&](std::uint32_t v) {
+    // Each near element's own vertices, swept over the step: a vertex presses only where it comes
+    // within the gap of the surface of an element it is near (the elements' boxes are those of
+    // coarse cells, and two parts of one cell have the same box: most of their vertices lie far
+    // from the other part's surface, and cost the narrow phase nothing).
+    std::vector<std::vector<std::uint32_t>> own(near.size());
+    std::vector<Eigen::AlignedBox3d> swept(near.size());
+    for (std::size_t i = 0; i < near.size(); ++i) {
+        swept[i].setEmpty();
+        surface.for_each_element_vertex(near[i], [&](std::uint32_t v) {
+            own[i].push_back(v);
+            swept[i].extend(surface.vertex_mm(v, node_positions));
+            swept[i].extend(surface.vertex_mm(v, end));
+        });
+    }
+    std::vector<std::vector<std::uint32_t>> partners(near.size());
+    for (const auto& [p, q] : near_pairs) {
+        partners[p].push_back(q);
+        partners[q].push_back(p);
+    }
+    // The gap, plus room for the triangles a vertex presses (a voxel's diagonal) and how deep it
+    // may be (max_depth): a triangle comes in when any of its corners does.
+    const double gap = parameters.approach_mm + 2.0 * parameters.max_depth_mm;
+    for (std::size_t i = 0; i < near.size(); ++i)
+        for (std::uint32_t v : own[i]) {
+            Eigen::AlignedBox3d box(surface.vertex_mm(v, node_positions));
+            box.extend(surface.vertex_mm(v, end));
+            box.min().array() -= gap;
+            box.max().array() += gap;
+            const bool reaches = std::any_of(partners[i].begin(), partners[i].end(), [&](std::uint32_t j) { return swept[j].intersects(box); });
+            if (!reaches) continue;
             add(v, true);
             for (std::uint32_t t : surface.vertex_triangles(v))
                 for (std::uint32_t c : triangles[t]) add(c, false);
-        });
+        }
     patch.outward_sign = surface.outward_sign();
     for (std::uint32_t v : out.slots) {
         patch.start_mm.push_back(surface.vertex_mm(v, node_positions));
@@ -115,9 +151,9 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
             Eigen::Vector3i corners;
             bool all = true;
             for (int c = 0; c < 3 && all; ++c) {
-                const auto found = index.find(triangles[t][static_cast<std::size_t>(c)]);
-                all = found != index.end();
-                if (all) corners[c] = static_cast<int>(found->second);
+                const std::uint32_t at = index[triangles[t][static_cast<std::size_t>(c)]];
+                all = at != none;
+                if (all) corners[c] = static_cast<int>(at);
             }
             if (all && static_cast<std::uint32_t>(corners.minCoeff()) == i) patch.triangles.push_back(corners);
         }
