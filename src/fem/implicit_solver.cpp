@@ -246,6 +246,7 @@ void ImplicitSolver::update_active()
         m_element_energy[e] = 0.0;
     }
     m_active_current = true;
+    m_element_pass_current = false; // the internal forces it left hold the elements now left out
 }
 
 void ImplicitSolver::set_materials(std::vector<MaterialBehaviour> behaviour)
