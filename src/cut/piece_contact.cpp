@@ -109,14 +109,19 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
     // within the gap of the surface of an element it is near (the elements' boxes are those of
     // coarse cells, and two parts of one cell have the same box: most of their vertices lie far
     // from the other part's surface, and cost the narrow phase nothing).
-    std::vector<std::vector<std::uint32_t>> own(near.size());
+    struct Own {
+        std::uint32_t vertex;
+        Eigen::AlignedBox3d swept; ///< from its start to its end, mm
+    };
+    std::vector<std::vector<Own>> own(near.size());
     std::vector<Eigen::AlignedBox3d> swept(near.size());
     for (std::size_t i = 0; i < near.size(); ++i) {
         swept[i].setEmpty();
         surface.for_each_element_vertex(near[i], [&](std::uint32_t v) {
-            own[i].push_back(v);
-            swept[i].extend(surface.vertex_mm(v, node_positions));
-            swept[i].extend(surface.vertex_mm(v, end));
+            Eigen::AlignedBox3d box(surface.vertex_mm(v, node_positions));
+            box.extend(surface.vertex_mm(v, end));
+            own[i].push_back({v, box});
+            swept[i].extend(box);
         });
     }
     std::vector<std::vector<std::uint32_t>> partners(near.size());
@@ -128,9 +133,8 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
     // may be (max_depth): a triangle comes in when any of its corners does.
     const double gap = parameters.approach_mm + 2.0 * parameters.max_depth_mm;
     for (std::size_t i = 0; i < near.size(); ++i)
-        for (std::uint32_t v : own[i]) {
-            Eigen::AlignedBox3d box(surface.vertex_mm(v, node_positions));
-            box.extend(surface.vertex_mm(v, end));
+        for (const auto& [v, moved] : own[i]) {
+            Eigen::AlignedBox3d box = moved;
             box.min().array() -= gap;
             box.max().array() += gap;
             const bool reaches = std::any_of(partners[i].begin(), partners[i].end(), [&](std::uint32_t j) { return swept[j].intersects(box); });

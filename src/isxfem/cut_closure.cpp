@@ -201,22 +201,17 @@ void Closer::build_boundary()
         };
         auto crossed = [&](std::size_t a, std::size_t b) { return (phi[a] < 0.0) != (phi[b] < 0.0); };
         Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-        int count = 0;
+        std::vector<std::pair<NodeEdge, Eigen::Vector3d>> crossings; // at most four
         for (std::size_t a = 0; a < 4; ++a)
             for (std::size_t b = a + 1; b < 4; ++b)
                 if (crossed(a, b)) {
-                    const auto [edge, x] = on_edge(a, b);
-                    centre += x;
-                    ++count;
+                    crossings.push_back(on_edge(a, b));
+                    centre += crossings.back().second;
                 }
-        if (count < 3) continue;
-        centre /= count;
-        for (std::size_t a = 0; a < 4; ++a)
-            for (std::size_t b = a + 1; b < 4; ++b)
-                if (crossed(a, b)) {
-                    const auto [edge, x] = on_edge(a, b);
-                    if (m_crack_vertex_edges.insert(edge).second) m_crack_vertices.emplace_back(x + 0.01 * (centre - x), t);
-                }
+        if (crossings.size() < 3) continue;
+        centre /= static_cast<double>(crossings.size());
+        for (const auto& [edge, x] : crossings)
+            if (m_crack_vertex_edges.insert(edge).second) m_crack_vertices.emplace_back(x + 0.01 * (centre - x), t);
         for (int face = 0; face < 4; ++face) {
             if (in_crack(m_neighbours[t][static_cast<std::size_t>(face)])) continue;
             std::vector<std::pair<NodeEdge, Eigen::Vector3d>> ends;

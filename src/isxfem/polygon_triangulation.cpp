@@ -131,7 +131,7 @@ Location locate(const std::vector<Eigen::Vector2d>& points, const std::vector<st
                         const int z = triangles[j][(e + 2) % 3];
                         const bool turns = cross(at(w), at(u), p) <= 0.0 || cross(at(v), at(w), p) <= 0.0 || cross(at(z), at(v), p) <= 0.0 ||
                                            cross(at(u), at(z), p) <= 0.0;
-                        return turns ? Location{} : Location{static_cast<int>(k), on};
+                        return turns ? Location{} : Location{static_cast<int>(k), on, static_cast<int>(j)};
                     }
             return {}; // on the polygon's boundary: not inside
         }
@@ -155,14 +155,9 @@ void insert_point(std::vector<Eigen::Vector2d>& points, std::vector<std::array<i
     } else { // on the edge u-v: it and the triangle across it, two each
         const auto e = static_cast<std::size_t>(where.edge);
         const int u = split[e], v = split[(e + 1) % 3], w = split[(e + 2) % 3];
-        std::size_t across = 0;
-        int z = -1;
-        for (std::size_t j = 0; j < triangles.size() && z < 0; ++j)
-            for (std::size_t c = 0; c < 3; ++c)
-                if (triangles[j][c] == v && triangles[j][(c + 1) % 3] == u) {
-                    across = j;
-                    z = triangles[j][(c + 2) % 3];
-                }
+        const auto across = static_cast<std::size_t>(where.across);
+        const std::array<int, 3>& other = triangles[across];
+        const int z = other[0] != u && other[0] != v ? other[0] : other[1] != u && other[1] != v ? other[1] : other[2];
         triangles[static_cast<std::size_t>(where.triangle)] = {w, u, id};
         triangles.push_back({v, w, id});
         triangles[across] = {z, v, id};

@@ -20,6 +20,7 @@ std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vec
 struct Location {
     int triangle = -1; ///< -1: in none (or on the triangulated polygon's boundary)
     int edge = -1;     ///< the triangle's edge it lies on (from corner `edge` to the next), or -1: clear of all three
+    int across = -1;   ///< on an edge: the triangle on its other side
 };
 
 /// The triangle that holds p, and whether p lies on one of its edges (within a hundredth of its
