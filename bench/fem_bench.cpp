@@ -11,7 +11,8 @@
 // Each case runs 5 warm-up steps (3 for the beam), then RUNS timed steps (20 at level 3, 5 at
 // level 2).
 // Usage: vox_fem_bench [RUNS] [THREADS] (defaults 100 and 1). Prints Markdown tables for the README.
-// VOX_BENCH_BEAM_ONLY=1: only the beam; VOX_BENCH_QUICK=1: the liver at levels 5 and 4 only.
+// VOX_BENCH_BEAM_ONLY=1: only the beam (=matrix-free: only its matrix-free case, for profiling);
+// VOX_BENCH_QUICK=1: the liver at levels 5 and 4 only.
 
 #include "bench/bench_stats.hpp"
 #include "fem/implicit_solver.hpp"
@@ -27,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <numeric>
+#include <string_view>
 
 using namespace vox;
 
@@ -118,7 +120,7 @@ void liver_rows(int runs, bool quick)
 }
 
 /// The SOFA comparison beam, assembled and matrix-free.
-void beam_rows(int runs)
+void beam_rows(int runs, bool matrix_free_only)
 {
     grid::PhantomSpec beam = grid::default_phantom(grid::PhantomShape::beam);
     beam.size_mm = {75, 15, 15};
@@ -126,6 +128,7 @@ void beam_rows(int runs)
     const grid::BranchedGrid bg(grid::FineVoxels(grid::make_phantom(beam), [](std::int32_t) { return 0; }), rubber, 1);
     const fem::HexModel model(bg, 0);
     for (bool matrix_free : {false, true}) {
+        if (matrix_free_only && !matrix_free) continue;
         fem::SolverOptions o;
         o.dt_s = 0.04;
         o.cg_max_iterations = 10;
@@ -151,6 +154,7 @@ int main(int argc, char** argv)
     std::printf("| case | elements | DOFs | step (median) | min - max | mean | assembly | solve | CG iterations | factorisations |\n"
                 "|---|---|---|---|---|---|---|---|---|---|\n");
     if (!std::getenv("VOX_BENCH_BEAM_ONLY")) liver_rows(runs, std::getenv("VOX_BENCH_QUICK") != nullptr);
-    beam_rows(runs);
+    const char* beam_only = std::getenv("VOX_BENCH_BEAM_ONLY");
+    beam_rows(runs, beam_only && std::string_view(beam_only) == "matrix-free");
     return 0;
 }

@@ -1,6 +1,7 @@
 #include "fem/hex_model.hpp"
 
 #include "core/error.hpp"
+#include "fem/element_kernel.hpp"
 #include "grid/hex8.hpp"
 #include "core/union_find.hpp"
 
@@ -72,7 +73,7 @@ void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
                 if ((c >> axis) & 1) sets.unite(8 * a + static_cast<std::uint32_t>(c), 8 * b + static_cast<std::uint32_t>(c ^ (1 << axis)));
         }
     }
-    for (const grid::ElasticMaterial& m : grid.materials()) m_full_stiffness.push_back(grid::hex8_stiffness(h, m.lame));
+    for (const grid::ElasticMaterial& m : grid.materials()) m_full_stiffness.push_back(to_component_major(grid::hex8_stiffness(h, m.lame)));
     std::vector<Matrix8d> mass;
     for (const grid::ElasticMaterial& m : grid.materials()) mass.push_back(grid::hex8_mass(h, m.density_kg_m3));
     const Eigen::Matrix<double, 8, 3> gradient = corner_gradients(Eigen::Vector3d::Constant(0.5), h);
@@ -155,7 +156,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     m_nodal_mass.assign(m_grid_node.size(), 0.0);
 
     for (const grid::ElasticMaterial& m : grid.materials())
-        m_full_stiffness.push_back(cell * grid::hex8_stiffness(h, m.lame));
+        m_full_stiffness.push_back(to_component_major(cell * grid::hex8_stiffness(h, m.lame)));
     m_partial_stiffness.reserve(alive);
     m_elements.reserve(alive);
     for (std::uint32_t e = 0; e < lv.elements.size(); ++e) {
@@ -172,7 +173,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
             m_partial_stiffness.push_back(previous->m_partial_stiffness[kept[e]]); // fictitious material included
             el.stiffness = m_partial_stiffness.back().get();
         } else {
-            auto k = std::make_shared<Matrix24d>(grid.stiffness(level, e));
+            auto k = std::make_shared<Matrix24d>(to_component_major(grid.stiffness(level, e)));
             // The element's nodes get their material's stiffness times a small fraction from the
             // empty part of the cell (the finite cell method's fictitious material), matching the
             // mass floor: a corner far from the element's few voxels otherwise has almost no

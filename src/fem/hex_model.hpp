@@ -17,7 +17,9 @@ namespace vox::fem {
 
 struct HexElement {
     std::array<std::uint32_t, 8> dof_node{};   ///< dense node index (0 .. node_count-1) per corner
-    const Matrix24d* stiffness = nullptr;      ///< N/m, index-aligned frame; shared for full cells
+    /// N/m, index-aligned frame, rows and columns component-major (element_kernel.hpp: the x of
+    /// corners 0..7, then y, then z); shared for full cells.
+    const Matrix24d* stiffness = nullptr;
     Matrix8d mass = Matrix8d::Zero();          ///< kg, scalar consistent mass (times I3 per axis)
     Eigen::Matrix<double, 8, 3> gradient;      ///< dN_c/dX at the material centroid, 1/m, index-aligned frame
     Vector24d rest;                            ///< corner rest positions, m, index-aligned frame

@@ -4,16 +4,18 @@
 
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
-#include "fem/stiffness_product.hpp"
+#include "fem/element_kernel.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace vox::fem {
 
@@ -91,6 +93,17 @@ void ImplicitSolver::group_runs()
     }
 }
 
+namespace {
+/// A batch function for for_each_element_by_runs that calls f on each element of the batch.
+template <typename F>
+auto each_element(F&& f)
+{
+    return [&f](const std::array<std::size_t, 4>& batch, int count) {
+        for (int i = 0; i < count; ++i) f(batch[static_cast<std::size_t>(i)]);
+    };
+}
+} // namespace
+
 template <typename F>
 void ImplicitSolver::for_each_element_by_runs(F&& f) const
 {
@@ -99,8 +112,14 @@ void ImplicitSolver::for_each_element_by_runs(F&& f) const
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, group.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
             for (std::size_t i = range.begin(); i != range.end(); ++i) {
                 const std::size_t first = group[i] * k_product_run, end = std::min(count, first + k_product_run);
+                std::array<std::size_t, 4> batch{};
+                int size = 0;
                 for (std::size_t e = first; e < end; ++e)
-                    if (m_active[e]) f(e);
+                    if (m_active[e]) {
+                        batch[static_cast<std::size_t>(size++)] = e;
+                        if (size == 4) f(batch, std::exchange(size, 0));
+                    }
+                if (size > 0) f(batch, size);
             }
         });
 }
@@ -310,26 +329,37 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
     if (!(m_element_pass_current && m_plastic.empty())) {
         // Each element adds its forces straight into its nodes (for_each_element_by_runs).
         m_internal.setZero(static_cast<Eigen::Index>(3 * m_x.size()));
-        for_each_element_by_runs([&](std::size_t e) {
-            const HexElement& el = elements[e];
+        for_each_element_by_runs([&](const std::array<std::size_t, 4>& batch, int count) {
             // Displacements relative to corner 0: K ignores translations, and far from the origin
             // (a scan sits ~0.2 m away) subtracting them first keeps the small strains exact.
-            const Eigen::Vector3d x0 = m_x[el.dof_node[0]];
-            Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-            for (int c = 1; c < 8; ++c) f.noalias() += (m_x[el.dof_node[c]] - x0) * el.gradient.row(c);
-            extract_rotation(frame.transpose() * f, m_rotation[e]);
-            const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
-            m_element_rotation[e] = r;
-            const Eigen::Vector3d rest0 = el.rest.segment<3>(0);
-            Vector24d u;
-            for (int c = 0; c < 8; ++c)
-                u.segment<3>(3 * c) = r.transpose() * (m_x[el.dof_node[c]] - x0) - (el.rest.segment<3>(3 * c) - rest0);
-            const double scale = m_stiffness_scale[e];
-            Vector24d fl = scale * stiffness_times(*el.stiffness, u);
-            m_element_energy[e] = 0.5 * u.dot(fl);
-            if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic())
-                m_element_energy[e] += plastic_correction(e, u, fl);
-            for (int c = 0; c < 8; ++c) m_internal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += r * fl.segment<3>(3 * c);
+            std::array<CornerVectors, 4> moved; // each corner's position less corner 0's
+            std::array<Eigen::Matrix3d, 4> f;   // deformation gradients, index-aligned frame
+            std::array<const Eigen::Matrix3d*, 4> from{};
+            std::array<Eigen::Quaterniond*, 4> to{};
+            for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+                const HexElement& el = elements[batch[i]];
+                moved[i] = minus(gather(m_x.front().data(), el.dof_node), m_x[el.dof_node[0]]);
+                f[i] = frame.transpose() * outer_sum(moved[i], el.gradient);
+                from[i] = &f[i];
+                to[i] = &m_rotation[batch[i]];
+            }
+            extract_rotations(from.data(), to.data(), count);
+            for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+                const std::size_t e = batch[i];
+                const HexElement& el = elements[e];
+                const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
+                m_element_rotation[e] = r;
+                const CornerVectors rest = from_corner_major(el.rest);
+                const CornerVectors u = turn(r, moved[i], true) - minus(rest, Eigen::Vector3d(rest.at(0, 0), rest.at(0, 1), rest.at(0, 2)));
+                CornerVectors fl = m_stiffness_scale[e] * stiffness_times(*el.stiffness, u);
+                m_element_energy[e] = 0.5 * dot(u, fl);
+                if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic()) {
+                    Vector24d force = to_corner_major(fl);
+                    m_element_energy[e] += plastic_correction(e, to_corner_major(u), force);
+                    fl = from_corner_major(force);
+                }
+                scatter_add(turn(r, fl, false), m_internal.data(), el.dof_node);
+            }
         });
     }
     m_element_pass_current = true;
@@ -342,18 +372,18 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
         // Each element adds the diagonals of its corners' blocks into its nodes, then each node
         // its mass and contact.
         m_diagonal.setZero(static_cast<Eigen::Index>(3 * m_x.size()));
-        for_each_element_by_runs([&](std::size_t e) {
+        for_each_element_by_runs(each_element([&](std::size_t e) {
             const HexElement& el = elements[e];
             const Eigen::Matrix3d& r = m_element_rotation[e];
             const double ks = k_scale * m_stiffness_scale[e];
             for (int c = 0; c < 8; ++c) {
                 // The diagonal of r K_cc r^T alone: row i of r K_cc dotted with row i of r.
-                const Eigen::Matrix3d rk = r * el.stiffness->block<3, 3>(3 * c, 3 * c);
+                const Eigen::Matrix3d rk = r * corner_block(*el.stiffness, c, c);
                 Eigen::Vector3d d = ks * rk.cwiseProduct(r).rowwise().sum();
                 if (!lumped) d.array() += m_scale * el.mass(c, c);
                 m_diagonal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += d;
             }
-        });
+        }));
         for (std::size_t n = 0; n < m_x.size(); ++n) {
             Eigen::Vector3d d = Eigen::Vector3d::Constant(m_scale * (lumped ? m_model.nodal_mass()[n] : m_model.added_mass()[n]));
             if (const std::int32_t c = m_contact_of_node[n]; c >= 0)
@@ -379,7 +409,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                     const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
                     const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
                     for (int d = 0; d < 8; ++d) {
-                        Eigen::Matrix3d block = rk * el.stiffness->block<3, 3>(3 * static_cast<int>(c), 3 * d) * r.transpose();
+                        Eigen::Matrix3d block = rk * corner_block(*el.stiffness, static_cast<int>(c), d) * r.transpose();
                         if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
                         double* at = values + outer[3 * n] + 3 * ranks[d];
                         for (int i = 0; i < 3; ++i)
@@ -523,14 +553,12 @@ void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::Vect
     // of one group share no node, so they run in parallel without two writing the same entry.
     const auto& elements = m_model.elements();
     m_stiffness_product.setZero(p.size());
-    for_each_element_by_runs([&](std::size_t e) {
+    for_each_element_by_runs(each_element([&](std::size_t e) {
         const HexElement& el = elements[e];
         const Eigen::Matrix3d& r = m_element_rotation[e];
-        Vector24d local;
-        for (int c = 0; c < 8; ++c) local.segment<3>(3 * c) = r.transpose() * p.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c]));
-        const Vector24d fl = m_stiffness_scale[e] * stiffness_times(*el.stiffness, local);
-        for (int c = 0; c < 8; ++c) m_stiffness_product.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += r * fl.segment<3>(3 * c);
-    });
+        const CornerVectors local = turn(r, gather(p.data(), el.dof_node), true);
+        scatter_add(turn(r, m_stiffness_scale[e] * stiffness_times(*el.stiffness, local), false), m_stiffness_product.data(), el.dof_node);
+    }));
     out.resize(p.size());
     const bool lumped = m_options.lumped_mass;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_x.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {

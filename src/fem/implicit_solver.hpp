@@ -172,8 +172,9 @@ private:
     /// Fills m_run_groups from the incidence (greedy: each run in the first group none of whose
     /// runs shares a node with it).
     void group_runs();
-    /// Calls f(e) for every active element, the runs of one group of m_run_groups in parallel:
-    /// f may add into the element's nodes, since no two elements running at once share one.
+    /// Calls f(elements, count) for the active elements of every run, up to four at a time (their
+    /// indices, in order), the runs of one group of m_run_groups in parallel: f may add into the
+    /// elements' nodes, since no two elements running at once share one.
     template <typename F>
     void for_each_element_by_runs(F&& f) const;
     /// Whether the two models have the same elements on the same nodes.
