@@ -93,13 +93,14 @@ TEST_P(PieceContact, ABlockLetGoAboveAnotherLandsOnItAndRestsCarriedByItsWeight)
 {
     // Lower block of 40 x 20 x 10 voxels held at its base; upper of 20 x 20 x 10 voxels one voxel
     // above it (voxel centres at whole millimetres, those on a box's faces inside: surfaces at 9.5
-    // and 10.5 mm). Even counts, so that both lie symmetric in the level's cells.
-    const fs::path mesh = boxes_obj("stacked.obj", {{{0, 0, 0}, {39, 19, 9}}, {{10, 0, 11}, {29, 19, 20}}});
+    // and 10.5 mm). Even counts, so that both lie symmetric in the level's cells. A third block,
+    // held a metre away, spreads the broad phase's grid so far that it merges its cells.
+    const fs::path mesh = boxes_obj("stacked.obj", {{{0, 0, 0}, {39, 19, 9}}, {{10, 0, 11}, {29, 19, 20}}, {{1000, 0, 0}, {1009, 9, 9}}});
     nlohmann::json doc = two_blocks(GetParam(), mesh);
-    doc["constraints"] = {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {40, 20, 1.2}}}}};
+    doc["constraints"] = {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {40, 20, 1.2}}}}, {{"type", "fixed"}, {"box_mm", {{999, -1, -1}, {1010, 10, 10}}}}};
     doc["gravity_m_s2"] = {0, 0, -k_g};
     Session r = open(doc);
-    ASSERT_EQ(r.method->piece_count(), 2u);
+    ASSERT_EQ(r.method->piece_count(), 3u);
     const auto [lo0, hi0] = upper_span(*r.method, 10.0);
     double force = 0.0;
     std::size_t contacts = 0;
