@@ -121,10 +121,28 @@ CutFigures DbgMethod::follow(std::size_t tool, const io::ToolSpec& spec, const i
     } else {
         faces = cut::faces_crossed(m_grid->voxels(), cut::sweep_polygons(previous.empty() ? rest_section : previous, rest_section,
                                                                          at.orientation * Eigen::Vector3d::UnitY()));
+        keep_one_sheet(m_stroke[tool], faces);
     }
     if (removed.empty() && faces.empty()) return {};
     if (spec.cut_mode == io::CutMode::separate) m_stroke[tool].has_cut = true;
     return apply(std::move(removed), std::move(faces));
+}
+
+void DbgMethod::keep_one_sheet(StrokeCarry& stroke, std::vector<std::pair<grid::Coord, int>>& faces)
+{
+    // Two frames of a stroke whose sections lie a fraction of a voxel apart can put one voxel on
+    // either side of the sheet: the first opens the face before it, the next the face after it,
+    // and the voxel between falls out as a sliver (a blade tilted 27 degrees drawn down through a
+    // swinging rod). A stroke makes one sheet, in which no two faces are parallel a voxel apart, so
+    // such a face is not opened: the material there is parted already.
+    std::erase_if(faces, [&](const std::pair<grid::Coord, int>& f) {
+        const auto& [c, axis] = f;
+        std::array<int, 4> before{c.x(), c.y(), c.z(), axis}, after = before;
+        --before[static_cast<std::size_t>(axis)];
+        ++after[static_cast<std::size_t>(axis)];
+        return stroke.opened.contains(before) || stroke.opened.contains(after);
+    });
+    for (const auto& [c, axis] : faces) stroke.opened.insert({c.x(), c.y(), c.z(), axis});
 }
 
 void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const io::ToolPose& from, const contact::PlacedShape& at,
@@ -147,7 +165,7 @@ void DbgMethod::carry_to_rest(std::size_t tool, const io::ToolSpec& spec, const 
     stroke.untouched_s = order.touching ? 0.0 : stroke.untouched_s + m_scene.solver.dt_s;
     const bool goes_on = !m_previous_section[tool].empty() && stroke.going && normal.dot(stroke.normal) >= k_stroke_turn_cos &&
                          stroke.untouched_s < k_stroke_gap_s;
-    if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0};
+    if (!goes_on) stroke = {true, normal, normal.dot(moved), normal, 0.0, false, {}};
     stroke.normal = normal; // it may turn by up to 10 degrees a frame and go on
     moved += (stroke.across_mm - normal.dot(moved)) * normal;
     for (Eigen::Vector3d& p : rest_section) p -= moved;

@@ -10,8 +10,10 @@
 #include "sim/obstacles.hpp"
 #include "sim/method.hpp"
 
+#include <array>
 #include <memory>
 #include <unordered_set>
+#include <set>
 #include <vector>
 
 namespace vox::sim {
@@ -134,7 +136,11 @@ private:
         Eigen::Vector3d cut_normal = Eigen::Vector3d::Zero(); ///< of the plane the edge sweeps
         double untouched_s = 0.0;                              ///< since the blade last touched
         bool has_cut = false;                                  ///< some frame of it opened faces
+        std::set<std::array<int, 4>> opened;                   ///< the faces it opened: voxel x, y, z, axis
     };
+    /// Leaves out of a stroke's new faces those parallel to a face it opened already and one voxel
+    /// beside it, and adds the rest to its faces.
+    static void keep_one_sheet(StrokeCarry& stroke, std::vector<std::pair<grid::Coord, int>>& faces);
     std::vector<StrokeCarry> m_stroke;
     static constexpr double k_stroke_turn_cos = 0.98480775301220802; // cos 10 degrees
     static constexpr double k_stroke_gap_s = 0.2;
