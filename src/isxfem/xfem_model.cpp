@@ -1,5 +1,7 @@
 #include "isxfem/xfem_model.hpp"
 
+#include "core/union_find.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -110,6 +112,87 @@ Eigen::Vector3d XfemModel::crack_normal(int id, std::size_t tet) const
     return m_surfaces[static_cast<std::size_t>(id)].normal(middle);
 }
 
+void XfemModel::leave_out_islands(int id, std::vector<std::uint32_t>& candidates, std::vector<std::array<double, 4>>& phi,
+                                  CutReport& report) const
+{
+    // Where a swept surface ends inside the material (a blade's edge, a shallow stroke), it can
+    // cross a few tetrahedra whole with tetrahedra it crosses only partly between them: islands
+    // of one crack that touch at nodes, each a slit of its own (a two-phase stroke marked a
+    // millimetre deep made two). A crack is one surface: of pieces of it that lie within a
+    // tetrahedron of each other but join across no edge it crosses, the piece the crack already
+    // had (or the largest) is cut, the others wait until the tetrahedra between them are crossed
+    // whole too. Pieces farther apart (a stroke through both arms of a U) are all cut.
+    std::vector<std::uint32_t> tets;
+    std::vector<std::array<bool, 4>> side;
+    for (std::uint32_t t = 0; t < m_elements.size(); ++t)
+        if (const int k = m_elements[t].cut_index(id); k >= 0) {
+            tets.push_back(t);
+            const auto& ns = m_elements[t].cuts[static_cast<std::size_t>(k)].node_side;
+            side.push_back({ns[0] != 0, ns[1] != 0, ns[2] != 0, ns[3] != 0});
+        }
+    const std::size_t existing = tets.size();
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        tets.push_back(candidates[i]);
+        side.push_back({phi[i][0] < 0.0, phi[i][1] < 0.0, phi[i][2] < 0.0, phi[i][3] < 0.0});
+    }
+    if (candidates.empty()) return;
+    // Pieces: tetrahedra joined across the edges the crack crosses.
+    UnionFind piece(tets.size());
+    std::unordered_map<std::uint64_t, std::uint32_t> edge_owner;
+    std::unordered_map<std::uint32_t, std::uint32_t> node_owner;
+    for (std::uint32_t k = 0; k < tets.size(); ++k) {
+        const auto& node = m_elements[tets[k]].node;
+        for (std::size_t a = 0; a < 4; ++a)
+            for (std::size_t b = a + 1; b < 4; ++b)
+                if (side[k][a] != side[k][b]) {
+                    const std::uint64_t edge = std::uint64_t{std::min(node[a], node[b])} << 32 | std::max(node[a], node[b]);
+                    if (const auto [it, fresh] = edge_owner.try_emplace(edge, k); !fresh) piece.unite(it->second, k);
+                }
+    }
+    // Groups: pieces that touch at a node, or at two nodes of one tetrahedron (a tetrahedron the
+    // surface crosses partly between them).
+    UnionFind group(tets.size());
+    for (std::uint32_t k = 0; k < tets.size(); ++k)
+        for (std::uint32_t n : m_elements[tets[k]].node)
+            if (const auto [it, fresh] = node_owner.try_emplace(n, k); !fresh) group.unite(piece.find(it->second), piece.find(k));
+    for (const XfemElement& e : m_elements) {
+        std::uint32_t first = ~0u;
+        for (std::uint32_t n : e.node)
+            if (const auto it = node_owner.find(n); it != node_owner.end()) {
+                if (first == ~0u) first = it->second;
+                else group.unite(piece.find(first), piece.find(it->second));
+            }
+    }
+    // In each group, the pieces the crack had, or else its largest piece.
+    std::unordered_map<std::uint32_t, std::uint32_t> size;
+    std::unordered_map<std::uint32_t, bool> had;
+    for (std::uint32_t k = 0; k < tets.size(); ++k) {
+        const std::uint32_t p = piece.find(k);
+        ++size[p];
+        if (k < existing) had[p] = true;
+    }
+    std::unordered_map<std::uint32_t, std::uint32_t> chosen; // group root -> its largest piece (when it had none)
+    std::unordered_map<std::uint32_t, bool> group_had;
+    for (const auto& [p, n] : size) {
+        const std::uint32_t g = group.find(p);
+        if (had.count(p)) group_had[g] = true;
+        const auto it = chosen.find(g);
+        if (it == chosen.end() || n > size[it->second] || (n == size[it->second] && p < it->second)) chosen[g] = p;
+    }
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+        const std::uint32_t p = piece.find(static_cast<std::uint32_t>(existing + i)), g = group.find(p);
+        if (group_had.count(g) ? had.count(p) > 0 : chosen[g] == p) {
+            candidates[kept] = candidates[i];
+            phi[kept++] = phi[i];
+        } else {
+            ++report.partial_tets;
+        }
+    }
+    candidates.resize(kept);
+    phi.resize(kept);
+}
+
 CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
                                const EdgeTest& covered)
 {
@@ -160,6 +243,7 @@ CutReport XfemModel::cut_along(int id, bool extend, const CutSurface& surface, c
         candidates.push_back(static_cast<std::uint32_t>(t));
         candidate_phi.push_back(phi);
     }
+    leave_out_islands(id, candidates, candidate_phi, report);
     // A first cut by moment fitting (cut_tet); a second by the regions both cuts leave.
     std::vector<MultiCutTet> matrices(candidates.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {

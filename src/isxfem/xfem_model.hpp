@@ -185,6 +185,11 @@ private:
     /// (its ends and the level's crossing point on it).
     CutReport cut_along(int id, bool extend, const CutSurface& surface, const std::function<bool(std::size_t)>& candidate,
                         const EdgeTest& covered);
+    /// Leaves out of `candidates` (tetrahedra about to be cut by `id`, their levels in `phi`) those
+    /// in islands of the crack: tetrahedra the surface crosses whole that lie within a tetrahedron
+    /// of the rest of the crack but join it across no edge it crosses (counted as partial in
+    /// `report`).
+    void leave_out_islands(int id, std::vector<std::uint32_t>& candidates, std::vector<std::array<double, 4>>& phi, CutReport& report) const;
     int m_cuts = 0;
     std::size_t m_revision = 0;
 };
