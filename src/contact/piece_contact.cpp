@@ -109,6 +109,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
     const std::size_t triangle_count = patch.triangles.size();
     std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count), rest_normal(triangle_count);
     std::vector<double> area(triangle_count);
+    std::vector<unsigned char> needle(triangle_count, 0);
     std::vector<Eigen::Vector3d> vertex_normal(n, Eigen::Vector3d::Zero());
     std::vector<std::uint32_t> first(n + 1, 0), around(3 * triangle_count); // each vertex's triangles
     for (std::size_t t = 0; t < triangle_count; ++t) {
@@ -118,6 +119,15 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
         start_normal[t] = triangle_normal(patch, patch.start_mm, tri);
         end_normal[t] = triangle_normal(patch, patch.end_mm, tri);
         rest_normal[t] = triangle_normal(patch, patch.rest_mm, tri);
+        // A needle at rest (height under 5 % of its longest edge: where a cut's closure splits a
+        // long surface triangle along the crossing, two of its corners can share a rest point)
+        // has no direction of its own to press along: its deformed normal points anywhere, and a
+        // vertex a voxel away was pushed through it (an Is-XFEM bracket's crack walls).
+        const Eigen::Vector3d& r0 = patch.rest_mm[static_cast<std::size_t>(tri[0])];
+        const Eigen::Vector3d& r1 = patch.rest_mm[static_cast<std::size_t>(tri[1])];
+        const Eigen::Vector3d& r2 = patch.rest_mm[static_cast<std::size_t>(tri[2])];
+        const double longest = std::max({(r1 - r0).squaredNorm(), (r2 - r1).squaredNorm(), (r0 - r2).squaredNorm()});
+        needle[t] = (r1 - r0).cross(r2 - r0).norm() < 5e-2 * longest;
         for (int c = 0; c < 3; ++c) {
             vertex_normal[static_cast<std::size_t>(tri[c])] += area[t] * start_normal[t];
             ++first[static_cast<std::size_t>(tri[c]) + 1];
@@ -145,7 +155,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
             if (seen[t] == v) return;
             seen[t] = v;
             const Eigen::Vector3i& tri = patch.triangles[t];
-            if (tri[0] == static_cast<int>(v) || tri[1] == static_cast<int>(v) || tri[2] == static_cast<int>(v)) return;
+            if (needle[t] || tri[0] == static_cast<int>(v) || tri[1] == static_cast<int>(v) || tri[2] == static_cast<int>(v)) return;
             const Eigen::Vector3d& n0 = start_normal[t];
             if (!(vertex_normal[v].dot(n0) < facing)) return;
             auto corner = [&](const std::vector<Eigen::Vector3d>& x, int c) -> const Eigen::Vector3d& { return x[static_cast<std::size_t>(tri[c])]; };
