@@ -1,11 +1,12 @@
 #include "contact/piece_contact.hpp"
 
+#include "contact/box_grid.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 #include <utility>
 
 namespace vox::contact {
@@ -25,60 +26,24 @@ std::array<double, 3> plane_weights(const Eigen::Vector3d& p, const Eigen::Vecto
 
 bool covers(const std::array<double, 3>& w, double tolerance) { return w[0] >= -tolerance && w[1] >= -tolerance && w[2] >= -tolerance; }
 
-/// Triangles by the cells of a uniform grid their boxes meet: (cell key, triangle), sorted.
-class TriangleGrid {
-public:
-    TriangleGrid(const SurfacePatch& patch, double min_cell_mm)
-    {
-        double edges = 0.0;
-        for (const Eigen::Vector3i& t : patch.triangles)
-            edges += (patch.start_mm[static_cast<std::size_t>(t[1])] - patch.start_mm[static_cast<std::size_t>(t[0])]).norm();
-        m_cell = std::max({2.0 * edges / static_cast<double>(std::max<std::size_t>(1, patch.triangles.size())), min_cell_mm, 1e-6});
-        for (std::uint32_t i = 0; i < patch.triangles.size(); ++i) {
-            Eigen::AlignedBox3d box;
-            box.setEmpty();
-            for (int c = 0; c < 3; ++c) {
-                box.extend(patch.start_mm[static_cast<std::size_t>(patch.triangles[i][c])]);
-                box.extend(patch.end_mm[static_cast<std::size_t>(patch.triangles[i][c])]);
-            }
-            for_cells(box.min(), box.max(), [&](std::uint64_t key) { m_entries.emplace_back(key, i); });
-        }
-        std::sort(m_entries.begin(), m_entries.end());
-        m_cells.reserve(m_entries.size());
-        for (std::uint32_t a = 0, b = 0; a < m_entries.size(); a = b) {
-            while (b < m_entries.size() && m_entries[b].first == m_entries[a].first) ++b;
-            m_cells.emplace(m_entries[a].first, std::pair<std::uint32_t, std::uint32_t>(a, b));
+/// The triangles' boxes, each swept from its start to its end, in a grid whose cells are about two
+/// edges wide (at least `min_cell_mm`).
+BoxGrid triangle_grid(const SurfacePatch& patch, double min_cell_mm)
+{
+    double edges = 0.0;
+    std::vector<Eigen::AlignedBox3d> boxes(patch.triangles.size());
+    for (std::size_t i = 0; i < patch.triangles.size(); ++i) {
+        const Eigen::Vector3i& t = patch.triangles[i];
+        edges += (patch.start_mm[static_cast<std::size_t>(t[1])] - patch.start_mm[static_cast<std::size_t>(t[0])]).norm();
+        boxes[i].setEmpty();
+        for (int c = 0; c < 3; ++c) {
+            boxes[i].extend(patch.start_mm[static_cast<std::size_t>(t[c])]);
+            boxes[i].extend(patch.end_mm[static_cast<std::size_t>(t[c])]);
         }
     }
-    /// Calls f(triangle) for every triangle listed in a cell `box` meets (a triangle may come more
-    /// than once).
-    template <class F> void near(const Eigen::AlignedBox3d& box, F&& f) const
-    {
-        for_cells(box.min(), box.max(), [&](std::uint64_t key) {
-            const auto found = m_cells.find(key);
-            if (found == m_cells.end()) return;
-            for (std::uint32_t i = found->second.first; i < found->second.second; ++i) f(m_entries[i].second);
-        });
-    }
-
-private:
-    template <class F> void for_cells(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, F&& f) const
-    {
-        const Eigen::Array3d a = (lo.array() / m_cell).floor(), b = (hi.array() / m_cell).floor();
-        for (double z = a.z(); z <= b.z(); ++z)
-            for (double y = a.y(); y <= b.y(); ++y)
-                for (double x = a.x(); x <= b.x(); ++x) f(key(x, y, z));
-    }
-    static std::uint64_t key(double x, double y, double z)
-    {
-        // 21 bits per axis, wrapped: two cells that share a key only cost a few extra tests.
-        auto bits = [](double c) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(c)) & 0x1FFFFFu; };
-        return bits(x) | bits(y) << 21 | bits(z) << 42;
-    }
-    double m_cell = 1.0;
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> m_entries;
-    std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> m_cells; ///< key -> its range of m_entries
-};
+    const double cell = std::max({2.0 * edges / static_cast<double>(std::max<std::size_t>(1, patch.triangles.size())), min_cell_mm, 1e-6});
+    return BoxGrid(std::move(boxes), cell);
+}
 
 /// Outward unit normal of triangle t with corners in `x` (zero when degenerate).
 Eigen::Vector3d triangle_normal(const SurfacePatch& patch, const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3i& t)
@@ -102,7 +67,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
     std::vector<FaceContact> out;
     if (patch.triangles.empty()) return out;
     const double depth = parameters.max_depth_mm;
-    const TriangleGrid grid(patch, 2.0 * depth); // cells about as wide as a vertex's reach: few lookups a vertex
+    const BoxGrid grid = triangle_grid(patch, 2.0 * depth); // cells about as wide as a vertex's reach: few lookups a vertex
     constexpr double facing = -0.25;   // cos 105 degrees
     constexpr double on_triangle = 0.02; // weights this far below zero still press the triangle (its edges)
     const double k_per_mm2 = parameters.stiffness_n_per_mm / 100.0;

@@ -2,13 +2,14 @@
 
 #include "cut/surface_contact.hpp"
 
+#include "contact/box_grid.hpp"
+
 #include "grid/hex8.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace vox::cut {
 
@@ -36,43 +37,6 @@ std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, con
         candidates.push_back(e);
         boxes.emplace_back(box.min().array() - 0.5 * gap_mm, box.max().array() + 0.5 * gap_mm);
     }
-    // A uniform grid of the elements' edge: each box meets a few cells. The boxes are sorted into
-    // the cells they meet by counting (a comparison sort of the entries took a third of the broad
-    // phase on the liver), over the cells spanned by all boxes.
-    const double cell = 1e3 * surface.grid().voxels().voxel_size_m().maxCoeff() * std::ldexp(1.0, model.level());
-    std::vector<Eigen::Array3i> low_cell(candidates.size()), high_cell(candidates.size());
-    Eigen::Array3i lowest = Eigen::Array3i::Constant(std::numeric_limits<int>::max()), highest = -lowest;
-    for (std::size_t i = 0; i < candidates.size(); ++i) {
-        // Clamped so that the grid of a piece flung far away stays countable (boxes clamped into one
-        // far cell are still compared box by box).
-        auto index = [&](const Eigen::Vector3d& at) { return (at.array() / cell).floor().max(-1e6).min(1e6).cast<int>().eval(); };
-        low_cell[i] = index(boxes[i].min());
-        high_cell[i] = index(boxes[i].max());
-        lowest = lowest.min(low_cell[i]);
-        highest = highest.max(high_cell[i]);
-    }
-    const Eigen::Array<std::int64_t, 3, 1> span = (highest - lowest + 1).cast<std::int64_t>().max(1);
-    // A dense grid when it is not much larger than the boxes' cells; else the cells are merged
-    // coarser, by whole factors per axis, until it is (a piece fallen far from the rest).
-    const auto wanted = static_cast<std::int64_t>(std::max<std::size_t>(64, 16 * candidates.size()));
-    int merge = 0; // cells merged 2^merge to a side
-    auto merged = [&](int by) { return span.unaryExpr([by](std::int64_t n) { return (n >> by) + 1; }).eval(); };
-    while (merged(merge).prod() > wanted) ++merge;
-    const Eigen::Array<std::int64_t, 3, 1> dims = merged(merge);
-    auto grid_cell = [&](const Eigen::Array3i& c) { return ((c - lowest).unaryExpr([merge](int n) { return n >> merge; })).eval(); };
-    auto slot = [&](int x, int y, int z) { return static_cast<std::size_t>((z * dims.y() + y) * dims.x() + x); };
-    auto for_each_cell = [&](std::size_t i, auto&& f) {
-        const Eigen::Array3i lo = grid_cell(low_cell[i]), hi = grid_cell(high_cell[i]);
-        for (int z = lo.z(); z <= hi.z(); ++z)
-            for (int y = lo.y(); y <= hi.y(); ++y)
-                for (int x = lo.x(); x <= hi.x(); ++x) f(slot(x, y, z));
-    };
-    std::vector<std::uint32_t> start(static_cast<std::size_t>(dims.prod()) + 1, 0);
-    for (std::size_t i = 0; i < candidates.size(); ++i) for_each_cell(i, [&](std::size_t at) { ++start[at + 1]; });
-    for (std::size_t c = 1; c < start.size(); ++c) start[c] += start[c - 1];
-    std::vector<std::uint32_t> in_cell(start.back()), fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < candidates.size(); ++i) for_each_cell(i, [&](std::size_t at) { in_cell[fill[at]++] = static_cast<std::uint32_t>(i); });
-
     // Whether two elements share a node: eight lanes compared at once per node of the other.
     using Nodes = std::uint32_t __attribute__((vector_size(32)));
     auto joined = [&](std::uint32_t p, std::uint32_t q) {
@@ -84,19 +48,13 @@ std::vector<std::uint32_t> elements_near_others(const ModelSurface& surface, con
             if (same[k]) return true;
         return false;
     };
+    // A grid of cells the elements' edge wide: each box meets a few.
+    const double cell = 1e3 * surface.grid().voxels().voxel_size_m().maxCoeff() * std::ldexp(1.0, model.level());
     std::vector<unsigned char> kept(candidates.size(), 0);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> found;
-    for (std::size_t c = 0; c + 1 < start.size(); ++c)
-        for (std::uint32_t i = start[c]; i < start[c + 1]; ++i)
-            for (std::uint32_t j = i + 1; j < start[c + 1]; ++j) {
-                const std::uint32_t p = std::min(in_cell[i], in_cell[j]), q = std::max(in_cell[i], in_cell[j]);
-                // Two boxes share every cell their overlap meets: the pair is tested in one of them
-                // alone, the cell of the overlap's low corner (the larger of the two boxes' low
-                // cells), first of all, since neighbours share most cells.
-                const Eigen::Array3i corner = grid_cell(low_cell[p].max(low_cell[q]));
-                if (slot(corner.x(), corner.y(), corner.z()) != c || !boxes[p].intersects(boxes[q]) || joined(p, q)) continue;
-                found.emplace_back(p, q);
-            }
+    contact::BoxGrid(std::move(boxes), cell).overlapping_pairs([&](std::uint32_t p, std::uint32_t q) {
+        if (!joined(p, q)) found.emplace_back(p, q);
+    });
     for (const auto& [p, q] : found) kept[p] = kept[q] = 1;
     std::vector<std::uint32_t> out, place(candidates.size(), 0);
     for (std::uint32_t i = 0; i < candidates.size(); ++i)
