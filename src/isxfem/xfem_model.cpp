@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 
 namespace vox::isxfem {
 namespace {
@@ -165,24 +166,24 @@ void XfemModel::leave_out_islands(int id, std::vector<std::uint32_t>& candidates
     }
     // In each group, the pieces the crack had, or else its largest piece.
     std::unordered_map<std::uint32_t, std::uint32_t> size;
-    std::unordered_map<std::uint32_t, bool> had;
+    std::unordered_set<std::uint32_t> had, group_had; // pieces, groups holding tetrahedra cut before
     for (std::uint32_t k = 0; k < tets.size(); ++k) {
         const std::uint32_t p = piece.find(k);
         ++size[p];
-        if (k < existing) had[p] = true;
+        if (k < existing) {
+            had.insert(p);
+            group_had.insert(group.find(p));
+        }
     }
-    std::unordered_map<std::uint32_t, std::uint32_t> chosen; // group root -> its largest piece (when it had none)
-    std::unordered_map<std::uint32_t, bool> group_had;
+    std::unordered_map<std::uint32_t, std::uint32_t> largest; // per group
     for (const auto& [p, n] : size) {
-        const std::uint32_t g = group.find(p);
-        if (had.count(p)) group_had[g] = true;
-        const auto it = chosen.find(g);
-        if (it == chosen.end() || n > size[it->second] || (n == size[it->second] && p < it->second)) chosen[g] = p;
+        const auto [it, fresh] = largest.try_emplace(group.find(p), p);
+        if (!fresh && (n > size[it->second] || (n == size[it->second] && p < it->second))) it->second = p;
     }
     std::size_t kept = 0;
     for (std::size_t i = 0; i < candidates.size(); ++i) {
         const std::uint32_t p = piece.find(static_cast<std::uint32_t>(existing + i)), g = group.find(p);
-        if (group_had.count(g) ? had.count(p) > 0 : chosen[g] == p) {
+        if (group_had.contains(g) ? had.contains(p) : largest[g] == p) {
             candidates[kept] = candidates[i];
             phi[kept++] = phi[i];
         } else {
