@@ -1,75 +1,25 @@
 #include "contact/piece_contact.hpp"
 
-#include "contact/box_grid.hpp"
+#include "contact/patch_geometry.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <utility>
 
 namespace vox::contact {
-namespace {
 
-/// Weights of the point of triangle (a, b, c) nearest to p's projection on its plane (unclamped:
-/// negative outside the triangle).
-std::array<double, 3> plane_weights(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c)
+std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters, std::vector<unsigned char>* turned_near)
 {
-    const Eigen::Vector3d e0 = b - a, e1 = c - a, r = p - a;
-    const double d00 = e0.dot(e0), d01 = e0.dot(e1), d11 = e1.dot(e1), d20 = r.dot(e0), d21 = r.dot(e1);
-    const double det = d00 * d11 - d01 * d01;
-    if (!(det > 0.0)) return {-1.0, -1.0, -1.0}; // a degenerate triangle presses nothing
-    const double wb = (d11 * d20 - d01 * d21) / det, wc = (d00 * d21 - d01 * d20) / det;
-    return {1.0 - wb - wc, wb, wc};
-}
-
-bool covers(const std::array<double, 3>& w, double tolerance) { return w[0] >= -tolerance && w[1] >= -tolerance && w[2] >= -tolerance; }
-
-/// The triangles' boxes, each swept from its start to its end, in a grid whose cells are about two
-/// edges wide (at least `min_cell_mm`).
-BoxGrid triangle_grid(const SurfacePatch& patch, double min_cell_mm)
-{
-    double edges = 0.0;
-    std::vector<Eigen::AlignedBox3d> boxes(patch.triangles.size());
-    for (std::size_t i = 0; i < patch.triangles.size(); ++i) {
-        const Eigen::Vector3i& t = patch.triangles[i];
-        edges += (patch.start_mm[static_cast<std::size_t>(t[1])] - patch.start_mm[static_cast<std::size_t>(t[0])]).norm();
-        boxes[i].setEmpty();
-        for (int c = 0; c < 3; ++c) {
-            boxes[i].extend(patch.start_mm[static_cast<std::size_t>(t[c])]);
-            boxes[i].extend(patch.end_mm[static_cast<std::size_t>(t[c])]);
-        }
-    }
-    const double cell = std::max({2.0 * edges / static_cast<double>(std::max<std::size_t>(1, patch.triangles.size())), min_cell_mm, 1e-6});
-    return BoxGrid(std::move(boxes), cell);
-}
-
-/// Outward unit normal of triangle t with corners in `x` (zero when degenerate).
-Eigen::Vector3d triangle_normal(const SurfacePatch& patch, const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3i& t)
-{
-    const Eigen::Vector3d& a = x[static_cast<std::size_t>(t[0])];
-    const Eigen::Vector3d n = (x[static_cast<std::size_t>(t[1])] - a).cross(x[static_cast<std::size_t>(t[2])] - a);
-    const double length = n.norm();
-    return length > 0.0 ? Eigen::Vector3d(patch.outward_sign * n / length) : Eigen::Vector3d::Zero();
-}
-
-} // namespace
-
-std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters)
-{
+    using namespace patch_geometry;
+    check(patch, "face_contacts");
     const std::size_t n = patch.start_mm.size();
-    if (patch.end_mm.size() != n || patch.rest_mm.size() != n || patch.presses.size() != n)
-        throw std::invalid_argument("contact::face_contacts: the patch's per-vertex arrays differ in length");
-    for (const Eigen::Vector3i& t : patch.triangles)
-        if (t.minCoeff() < 0 || static_cast<std::size_t>(t.maxCoeff()) >= n)
-            throw std::invalid_argument("contact::face_contacts: a triangle's corner is not a vertex of the patch");
     std::vector<FaceContact> out;
+    if (turned_near) turned_near->assign(n, 0);
     if (patch.triangles.empty()) return out;
     const double depth = parameters.max_depth_mm;
     const BoxGrid grid = triangle_grid(patch, 2.0 * depth); // cells about as wide as a vertex's reach: few lookups a vertex
-    constexpr double facing = -0.25;   // cos 105 degrees
-    constexpr double on_triangle = 0.02; // weights this far below zero still press the triangle (its edges)
     const double k_per_mm2 = parameters.stiffness_n_per_mm / 100.0;
     const std::size_t triangle_count = patch.triangles.size();
     std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count), rest_normal(triangle_count);
@@ -84,15 +34,7 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
         start_normal[t] = triangle_normal(patch, patch.start_mm, tri);
         end_normal[t] = triangle_normal(patch, patch.end_mm, tri);
         rest_normal[t] = triangle_normal(patch, patch.rest_mm, tri);
-        // A needle at rest (height under 5 % of its longest edge: where a cut's closure splits a
-        // long surface triangle along the crossing, two of its corners can share a rest point)
-        // has no direction of its own to press along: its deformed normal points anywhere, and a
-        // vertex a voxel away was pushed through it (an Is-XFEM bracket's crack walls).
-        const Eigen::Vector3d& r0 = patch.rest_mm[static_cast<std::size_t>(tri[0])];
-        const Eigen::Vector3d& r1 = patch.rest_mm[static_cast<std::size_t>(tri[1])];
-        const Eigen::Vector3d& r2 = patch.rest_mm[static_cast<std::size_t>(tri[2])];
-        const double longest = std::max({(r1 - r0).squaredNorm(), (r2 - r1).squaredNorm(), (r0 - r2).squaredNorm()});
-        needle[t] = (r1 - r0).cross(r2 - r0).norm() < 5e-2 * longest;
+        needle[t] = is_needle(patch, tri);
         for (int c = 0; c < 3; ++c) {
             vertex_normal[static_cast<std::size_t>(tri[c])] += area[t] * start_normal[t];
             ++first[static_cast<std::size_t>(tri[c]) + 1];
@@ -122,7 +64,8 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
             const Eigen::Vector3i& tri = patch.triangles[t];
             if (needle[t] || tri[0] == static_cast<int>(v) || tri[1] == static_cast<int>(v) || tri[2] == static_cast<int>(v)) return;
             const Eigen::Vector3d& n0 = start_normal[t];
-            if (!(vertex_normal[v].dot(n0) < facing)) return;
+            if (turned_near && !(*turned_near)[v] && vertex_normal[v].dot(n0) < 0.0 && grid.boxes()[t].intersects(box)) (*turned_near)[v] = 1;
+            if (!(vertex_normal[v].dot(n0) < k_facing)) return;
             auto corner = [&](const std::vector<Eigen::Vector3d>& x, int c) -> const Eigen::Vector3d& { return x[static_cast<std::size_t>(tri[c])]; };
             const double p0 = -n0.dot(patch.start_mm[v] - corner(patch.start_mm, 0));
             const double p1 = -end_normal[t].dot(patch.end_mm[v] - corner(patch.end_mm, 0));
@@ -132,11 +75,11 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
             // Where the vertex presses: on the triangle at the pose it is deeper in.
             const std::vector<Eigen::Vector3d>& at = p0 >= p1 ? patch.start_mm : patch.end_mm;
             std::array<double, 3> w = plane_weights(at[v], corner(at, 0), corner(at, 1), corner(at, 2));
-            if (!covers(w, on_triangle)) return;
+            if (!covers(w, k_on_triangle)) return;
             // Through material: behind the triangle in the rest shape already.
             const double rest_distance = rest_normal[t].dot(patch.rest_mm[v] - corner(patch.rest_mm, 0));
             if (rest_distance < -parameters.rest_tolerance_mm &&
-                covers(plane_weights(patch.rest_mm[v], corner(patch.rest_mm, 0), corner(patch.rest_mm, 1), corner(patch.rest_mm, 2)), on_triangle))
+                covers(plane_weights(patch.rest_mm[v], corner(patch.rest_mm, 0), corner(patch.rest_mm, 1), corner(patch.rest_mm, 2)), k_on_triangle))
                 return;
             // Ranked by the deeper of its two depths (a vertex arriving counts by where it would end).
             if (found && !(std::max(p0, p1) > best_depth)) return;

@@ -149,13 +149,14 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
             }
             if (all && static_cast<std::uint32_t>(corners.minCoeff()) == i) patch.triangles.push_back(corners);
         }
-    out.faces = contact::face_contacts(patch, parameters);
-    // On the nodes: the vertex's element's weights, minus the pressed point's (its triangle's
-    // corners' weights times their elements').
-    for (const contact::FaceContact& f : out.faces)
-        out.pairs.push_back(face_pair(f, patch, parameters.skin_mm, [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) {
-            add_vertex_terms(surface, out.slots[i], w, terms);
-        }));
+    std::vector<unsigned char> turned_near;
+    out.faces = contact::face_contacts(patch, parameters, &turned_near);
+    out.edges = contact::edge_contacts(patch, parameters, &turned_near);
+    // On the nodes: the pressing point's weights on its vertices times their elements', minus the
+    // pressed point's.
+    auto on_nodes = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_vertex_terms(surface, out.slots[i], w, terms); };
+    for (const contact::FaceContact& f : out.faces) out.pairs.push_back(face_pair(f, patch, parameters.skin_mm, on_nodes));
+    for (const contact::EdgeContact& e : out.edges) out.pairs.push_back(edge_pair(e, parameters.skin_mm, on_nodes));
     return out;
 }
 

@@ -23,6 +23,7 @@ struct PieceContact {
     contact::SurfacePatch patch;                ///< the surface tested
     std::vector<std::uint32_t> slots;           ///< surface vertex slot of each patch vertex
     std::vector<contact::FaceContact> faces;    ///< indices into the patch
+    std::vector<contact::EdgeContact> edges;    ///< indices into the patch
     std::vector<fem::PairContact> pairs;        ///< the same on the model's nodes (N, N/m)
     std::size_t element_pairs = 0;              ///< element pairs the broad phase kept
 };
@@ -42,6 +43,22 @@ template <class AddPoint>
     pair.force_n = f.force_n;
     pair.stiffness_n_per_m = 1e3 * f.stiffness_n_per_mm;
     pair.waiting = f.depth_mm < -skin_mm;
+    return pair;
+}
+
+/// `e` as a pair contact, as face_pair: the pressing edge's point minus the pressed edge's.
+template <class AddPoint>
+[[nodiscard]] fem::PairContact edge_pair(const contact::EdgeContact& e, double skin_mm, AddPoint&& add)
+{
+    fem::PairContact pair;
+    add(e.edge[0], 1.0 - e.s, pair.terms);
+    add(e.edge[1], e.s, pair.terms);
+    add(e.pressed[0], e.t - 1.0, pair.terms);
+    add(e.pressed[1], -e.t, pair.terms);
+    pair.normal = e.normal;
+    pair.force_n = e.force_n;
+    pair.stiffness_n_per_m = 1e3 * e.stiffness_n_per_mm;
+    pair.waiting = e.depth_mm < -skin_mm;
     return pair;
 }
 

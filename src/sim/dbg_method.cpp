@@ -323,11 +323,13 @@ void DbgMethod::end_tools()
     if (m_scene.piece_contact.enabled) {
         Stopwatch clock;
         cut::PieceContact c = cut::touch_pieces(m_sim->surface(), solver.positions(), ends, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, c.faces.size(), c.patch.start_mm.size(), 0.0, 0.0, deepest_mm(c.faces)}; // force_n: after the step
+        m_piece_contact = {true, c.faces.size() + c.edges.size(), c.edges.size(), c.patch.start_mm.size(), 0.0, 0.0, deepest_mm(c.faces, c.edges)}; // force_n: after the step
         // A piece pressed by one that moves wakes as a tool's reach would wake it.
-        for (const contact::FaceContact& f : c.faces)
-            m_tool_reach.emplace_back(c.patch.start_mm[f.vertex] - Eigen::Vector3d::Constant(voxel_mm),
-                                      c.patch.start_mm[f.vertex] + Eigen::Vector3d::Constant(voxel_mm));
+        auto wake = [&](std::uint32_t v) {
+            m_tool_reach.emplace_back(c.patch.start_mm[v] - Eigen::Vector3d::Constant(voxel_mm), c.patch.start_mm[v] + Eigen::Vector3d::Constant(voxel_mm));
+        };
+        for (const contact::FaceContact& f : c.faces) wake(f.vertex);
+        for (const contact::EdgeContact& e : c.edges) wake(e.edge[0]);
         std::move(c.pairs.begin(), c.pairs.end(), std::back_inserter(pairs));
         m_piece_contact.ms = clock.lap();
     }

@@ -176,7 +176,7 @@ void IsxfemMethod::end_tools()
     if (m_scene.piece_contact.enabled) {
         Stopwatch clock;
         IsxfemSimulation::PieceTouch t = m_sim->touch_pieces(m_scene.solver.dt_s, piece_contact_parameters(m_scene, voxel_mm));
-        m_piece_contact = {true, t.faces.size(), t.vertices, 0.0, 0.0, deepest_mm(t.faces)}; // force_n: after the step
+        m_piece_contact = {true, t.faces.size() + t.edges.size(), t.edges.size(), t.vertices, 0.0, 0.0, deepest_mm(t.faces, t.edges)}; // force_n: after the step
         std::move(t.pairs.begin(), t.pairs.end(), std::back_inserter(pairs));
         m_piece_contact.ms = clock.lap();
     }

@@ -434,11 +434,12 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
     }
     PieceTouch out;
     out.vertices = vertices.size();
-    out.faces = contact::face_contacts(patch, parameters);
-    for (const contact::FaceContact& f : out.faces)
-        out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) {
-            add_point_terms(vertices[i], w, terms);
-        }));
+    std::vector<unsigned char> turned_near;
+    out.faces = contact::face_contacts(patch, parameters, &turned_near);
+    out.edges = contact::edge_contacts(patch, parameters, &turned_near);
+    auto add = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_point_terms(vertices[i], w, terms); };
+    for (const contact::FaceContact& f : out.faces) out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, add));
+    for (const contact::EdgeContact& e : out.edges) out.pairs.push_back(cut::edge_pair(e, parameters.skin_mm, add));
     return out;
 }
 

@@ -107,6 +107,7 @@ public:
     /// contact on the dof blocks of its two material points (fem/pair_contact.hpp).
     struct PieceTouch {
         std::vector<contact::FaceContact> faces;
+        std::vector<contact::EdgeContact> edges;
         std::vector<fem::PairContact> pairs;
         std::size_t vertices = 0; ///< surface vertices tested
     };

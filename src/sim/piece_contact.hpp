@@ -13,18 +13,20 @@ namespace vox::sim {
 
 struct PieceContactFigures {
     bool enabled = false;            ///< the scene's "piece_contact" is on
-    std::size_t contacts = 0;        ///< vertices pressing a face this frame
+    std::size_t contacts = 0;        ///< vertices pressing a face and edges under an edge this frame
+    std::size_t edge_contacts = 0;   ///< of those, edges under an edge
     std::size_t tested_vertices = 0; ///< surface vertices the broad phase passed on
     double force_n = 0.0;            ///< sum of the contacts' force magnitudes at the step's end
     double ms = 0.0;                 ///< time to find them and gather them on the model
-    double max_depth_mm = 0.0;       ///< the deepest vertex in a face at the step's start (interpenetration)
+    double max_depth_mm = 0.0;       ///< the deepest contact at the step's start (interpenetration)
 };
 
-/// The deepest of `faces` at the step's start, mm (0 when none is in).
-[[nodiscard]] inline double deepest_mm(const std::vector<contact::FaceContact>& faces)
+/// The deepest of `faces` and `edges` at the step's start, mm (0 when none is in).
+[[nodiscard]] inline double deepest_mm(const std::vector<contact::FaceContact>& faces, const std::vector<contact::EdgeContact>& edges)
 {
     double out = 0.0;
     for (const contact::FaceContact& f : faces) out = std::max(out, f.depth_mm);
+    for (const contact::EdgeContact& e : edges) out = std::max(out, e.depth_mm);
     return out;
 }
 

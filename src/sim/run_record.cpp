@@ -100,7 +100,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
         frame["obstacle_force_n"] = {force.x(), force.y(), force.z()};
     }
     if (const PieceContactFigures c = method.piece_contact(); c.enabled) {
-        frame["piece_contact"] = {{"contacts", c.contacts}, {"tested_vertices", c.tested_vertices}, {"force_n", c.force_n}, {"ms", c.ms},
+        frame["piece_contact"] = {{"contacts", c.contacts}, {"edge_contacts", c.edge_contacts}, {"tested_vertices", c.tested_vertices}, {"force_n", c.force_n}, {"ms", c.ms},
                                   {"max_depth_mm", c.max_depth_mm}};
     }
     method.add_frame_figures(frame);
