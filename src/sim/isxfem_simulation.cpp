@@ -3,11 +3,15 @@
 #include "sim/dbg_simulation.hpp"
 #include "core/error.hpp"
 #include "cut/model_surface.hpp"
+#include "contact/box_grid.hpp"
 #include "cut/piece_contact.hpp"
 #include "cut/pieces.hpp"
 #include "sim/rigid_parts.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 
@@ -418,28 +422,110 @@ void IsxfemSimulation::add_point_terms(const isxfem::SurfacePoint& v, double wei
 
 IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const
 {
-    // The whole closed surface: no broad phase by elements here (a crack's two walls lie in the
-    // same tetrahedra), the contact's grid of triangles is the only one.
     refresh_closed_surface();
     const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
+    const std::vector<isxfem::XfemElement>& elements = m_model->elements();
+    std::vector<Eigen::Vector3d> start(vertices.size()), end(vertices.size());
+    // Every vertex, each frame: on both cores (a liver at level 4 has 58,000).
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const isxfem::SurfacePoint& v = vertices[i];
+            start[i] = 1e3 * m_solver->position(v.tet, v.bary, v.side);
+            end[i] = start[i] + free_step_mm(1e3 * m_solver->velocity(v.tet, v.bary, v.side), dt_s);
+        }
+    });
+    // Broad phase by tetrahedra, as the branched grid's by elements (cut/piece_contact.hpp): the
+    // surface vertices are grouped by tetrahedron and by cells of four approaches at rest (a
+    // coarse tetrahedron's surface, boxed whole, overlaps the boxes of many it does not touch: the
+    // liver at level 4 passed every vertex on), each group boxed over its vertices' sweep, and
+    // groups are tested in pairs whose boxes come within the approach of each other and that
+    // material does not join. Two whole tetrahedra that share a node are joined; a cut one holds
+    // a crack's two walls, which lie on each other, so it is always tested, and with every group
+    // near it.
+    constexpr std::uint32_t none = ~0u;
+    const double group_mm = 4.0 * parameters.approach_mm;
+    // The vertices bucketed by tetrahedron (a counting sort), then grouped by cell within each.
+    std::vector<std::uint32_t> first(elements.size() + 1, 0), by_tet(vertices.size());
+    for (const isxfem::SurfacePoint& v : vertices) ++first[v.tet + 1];
+    for (std::size_t t = 1; t < first.size(); ++t) first[t] += first[t - 1];
+    {
+        std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
+        for (std::uint32_t i = 0; i < vertices.size(); ++i) by_tet[next[vertices[i].tet]++] = i;
+    }
+    std::vector<std::uint32_t> group_of(vertices.size()), tets;
+    std::vector<Eigen::AlignedBox3d> boxes;
+    std::vector<std::pair<Eigen::Array3i, std::uint32_t>> cells; // of the tetrahedron at hand: cell, group
+    for (std::uint32_t t = 0; t < elements.size(); ++t) {
+        cells.clear();
+        for (std::uint32_t k = first[t]; k < first[t + 1]; ++k) {
+            const std::uint32_t i = by_tet[k];
+            const Eigen::Array3i cell = (1e3 * vertices[i].rest_m.array() / group_mm).floor().cast<int>();
+            auto at = std::find_if(cells.begin(), cells.end(), [&](const auto& c) { return (c.first == cell).all(); });
+            if (at == cells.end()) {
+                cells.emplace_back(cell, static_cast<std::uint32_t>(tets.size()));
+                at = cells.end() - 1;
+                tets.push_back(t);
+                boxes.emplace_back(start[i]);
+            }
+            group_of[i] = at->second;
+            boxes[at->second].extend(start[i]);
+            boxes[at->second].extend(end[i]);
+        }
+    }
+    for (Eigen::AlignedBox3d& box : boxes) {
+        box.min().array() -= 0.5 * parameters.approach_mm;
+        box.max().array() += 0.5 * parameters.approach_mm;
+    }
+    std::vector<unsigned char> kept(tets.size(), 0);
+    for (std::size_t g = 0; g < tets.size(); ++g) kept[g] = elements[tets[g]].is_cut();
+    auto joined = [&](std::uint32_t p, std::uint32_t q) {
+        const isxfem::XfemElement& a = elements[tets[p]];
+        const isxfem::XfemElement& b = elements[tets[q]];
+        if (a.is_cut() || b.is_cut()) return false;
+        if (tets[p] == tets[q]) return true;
+        for (std::uint32_t n : a.node)
+            if (std::find(b.node.begin(), b.node.end(), n) != b.node.end()) return true;
+        return false;
+    };
+    contact::BoxGrid(std::move(boxes), std::max(group_mm, 1e-6)).overlapping_pairs([&](std::uint32_t p, std::uint32_t q) {
+        if (!joined(p, q)) kept[p] = kept[q] = 1;
+    });
+    // The patch: the kept tetrahedra's vertices press; the triangles around them bring their
+    // other corners as its rim.
     contact::SurfacePatch patch;
-    patch.triangles = m_closed_triangles;
-    patch.presses.assign(vertices.size(), 1);
-    patch.start_mm.reserve(vertices.size());
-    for (const isxfem::SurfacePoint& v : vertices) {
-        const Eigen::Vector3d x = 1e3 * m_solver->position(v.tet, v.bary, v.side);
-        patch.start_mm.push_back(x);
-        patch.end_mm.push_back(x + free_step_mm(1e3 * m_solver->velocity(v.tet, v.bary, v.side), dt_s));
-        patch.rest_mm.push_back(1e3 * v.rest_m);
+    std::vector<std::uint32_t> slots, index(vertices.size(), none);
+    auto add = [&](std::uint32_t v, bool presses) {
+        if (index[v] == none) {
+            index[v] = static_cast<std::uint32_t>(slots.size());
+            slots.push_back(v);
+            patch.presses.push_back(0);
+        }
+        if (presses) patch.presses[index[v]] = 1;
+    };
+    for (std::uint32_t v = 0; v < vertices.size(); ++v)
+        if (kept[group_of[v]]) add(v, true);
+    const std::size_t pressing = slots.size();
+    for (const Eigen::Vector3i& t : m_closed_triangles) {
+        const bool touches = (index[static_cast<std::size_t>(t[0])] != none && index[static_cast<std::size_t>(t[0])] < pressing) ||
+                             (index[static_cast<std::size_t>(t[1])] != none && index[static_cast<std::size_t>(t[1])] < pressing) ||
+                             (index[static_cast<std::size_t>(t[2])] != none && index[static_cast<std::size_t>(t[2])] < pressing);
+        if (!touches) continue;
+        for (int c = 0; c < 3; ++c) add(static_cast<std::uint32_t>(t[c]), false);
+        patch.triangles.emplace_back(index[static_cast<std::size_t>(t[0])], index[static_cast<std::size_t>(t[1])], index[static_cast<std::size_t>(t[2])]);
+    }
+    for (std::uint32_t v : slots) {
+        patch.start_mm.push_back(start[v]);
+        patch.end_mm.push_back(end[v]);
+        patch.rest_mm.push_back(1e3 * vertices[v].rest_m);
     }
     PieceTouch out;
-    out.vertices = vertices.size();
+    out.vertices = pressing;
     std::vector<unsigned char> turned_near;
     out.faces = contact::face_contacts(patch, parameters, &turned_near);
     out.edges = contact::edge_contacts(patch, parameters, &turned_near);
-    auto add = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_point_terms(vertices[i], w, terms); };
-    for (const contact::FaceContact& f : out.faces) out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, add));
-    for (const contact::EdgeContact& e : out.edges) out.pairs.push_back(cut::edge_pair(e, parameters.skin_mm, add));
+    auto on_blocks = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_point_terms(vertices[slots[i]], w, terms); };
+    for (const contact::FaceContact& f : out.faces) out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, on_blocks));
+    for (const contact::EdgeContact& e : out.edges) out.pairs.push_back(cut::edge_pair(e, parameters.skin_mm, on_blocks));
     return out;
 }
 

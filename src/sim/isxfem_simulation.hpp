@@ -103,13 +103,14 @@ public:
                                                double skin_mm, double approach_mm) const;
 
     /// The closed surface pressed against itself over a step of `dt_s` (contact/piece_contact.hpp:
-    /// pieces on pieces, the walls of a crack), every vertex pressing, and each contact as a pair
-    /// contact on the dof blocks of its two material points (fem/pair_contact.hpp).
+    /// pieces on pieces, the walls of a crack): the vertices of the tetrahedra that come near
+    /// others material does not join, and of every cut one, press; each contact is a pair contact
+    /// on the dof blocks of its two material points (fem/pair_contact.hpp).
     struct PieceTouch {
         std::vector<contact::FaceContact> faces;
         std::vector<contact::EdgeContact> edges;
         std::vector<fem::PairContact> pairs;
-        std::size_t vertices = 0; ///< surface vertices tested
+        std::size_t vertices = 0; ///< surface vertices the broad phase passed on
     };
     [[nodiscard]] PieceTouch touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const;
 
