@@ -2,6 +2,7 @@
 
 #include "sim/dbg_simulation.hpp"
 #include "core/error.hpp"
+#include "core/union_find.hpp"
 #include "cut/model_surface.hpp"
 #include "contact/box_grid.hpp"
 #include "cut/piece_contact.hpp"
@@ -14,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <limits>
 
 namespace vox::sim {
 
@@ -420,11 +422,58 @@ void IsxfemSimulation::add_point_terms(const isxfem::SurfacePoint& v, double wei
     }
 }
 
+void IsxfemSimulation::refresh_contact_groups(double cell_mm) const
+{
+    refresh_closed_surface();
+    ContactGroups& g = m_contact_groups;
+    if (g.revision == m_closed_revision && g.cell_mm == cell_mm && g.of_vertex.size() == m_closed_vertices.size()) return;
+    g.revision = m_closed_revision;
+    g.cell_mm = cell_mm;
+    g.cell.clear();
+    g.holds_cut.clear();
+    g.of_vertex.resize(m_closed_vertices.size());
+    if (m_closed_vertices.empty()) return;
+    // Cells numbered densely over the surface's box at rest: a lookup per vertex, no sort.
+    std::vector<Eigen::Array3i> at(m_closed_vertices.size());
+    Eigen::Array3i low = Eigen::Array3i::Constant(std::numeric_limits<int>::max()), high = -low;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+        at[i] = (1e3 * m_closed_vertices[i].rest_m.array() / cell_mm).floor().cast<int>();
+        low = low.min(at[i]);
+        high = high.max(at[i]);
+    }
+    // The closed surface's connected parts: each separate piece is closed on its own, and two
+    // pieces are never joined, however near they lie at rest.
+    UnionFind parts(m_closed_vertices.size());
+    for (const Eigen::Vector3i& t : m_closed_triangles) {
+        parts.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]));
+        parts.unite(static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[2]));
+    }
+    g.part.clear();
+    const Eigen::Array<std::int64_t, 3, 1> dims = (high - low + 1).cast<std::int64_t>();
+    std::vector<std::uint32_t> group_of_cell(static_cast<std::size_t>(dims.prod()), ~0u), next_in_cell;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+        const Eigen::Array<std::int64_t, 3, 1> c = (at[i] - low).cast<std::int64_t>();
+        std::uint32_t& first = group_of_cell[static_cast<std::size_t>((c.z() * dims.y() + c.y()) * dims.x() + c.x())];
+        const std::uint32_t part = parts.find(static_cast<std::uint32_t>(i));
+        std::uint32_t group = first;
+        while (group != ~0u && g.part[group] != part) group = next_in_cell[group];
+        if (group == ~0u) {
+            group = static_cast<std::uint32_t>(g.cell.size());
+            next_in_cell.push_back(first);
+            first = group;
+            g.cell.push_back(at[i]);
+            g.part.push_back(part);
+            g.holds_cut.push_back(0);
+        }
+        g.of_vertex[i] = group;
+        if (m_model->elements()[m_closed_vertices[i].tet].is_cut()) g.holds_cut[group] = 1;
+    }
+}
+
 IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const contact::PieceContactParameters& parameters) const
 {
     refresh_closed_surface();
     const std::vector<isxfem::SurfacePoint>& vertices = m_closed_vertices;
-    const std::vector<isxfem::XfemElement>& elements = m_model->elements();
     std::vector<Eigen::Vector3d> start(vertices.size()), end(vertices.size());
     // Every vertex, each frame: on both cores (a liver at level 4 has 58,000).
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -434,64 +483,38 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
             end[i] = start[i] + free_step_mm(1e3 * m_solver->velocity(v.tet, v.bary, v.side), dt_s);
         }
     });
-    // Broad phase by tetrahedra, as the branched grid's by elements (cut/piece_contact.hpp): the
-    // surface vertices are grouped by tetrahedron and by cells of four approaches at rest (a
-    // coarse tetrahedron's surface, boxed whole, overlaps the boxes of many it does not touch: the
-    // liver at level 4 passed every vertex on), each group boxed over its vertices' sweep, and
-    // groups are tested in pairs whose boxes come within the approach of each other and that
-    // material does not join. Two whole tetrahedra that share a node are joined; a cut one holds
-    // a crack's two walls, which lie on each other, so it is always tested, and with every group
-    // near it.
-    constexpr std::uint32_t none = ~0u;
-    const double group_mm = 4.0 * parameters.approach_mm;
-    // The vertices bucketed by tetrahedron (a counting sort), then grouped by cell within each.
-    std::vector<std::uint32_t> first(elements.size() + 1, 0), by_tet(vertices.size());
-    for (const isxfem::SurfacePoint& v : vertices) ++first[v.tet + 1];
-    for (std::size_t t = 1; t < first.size(); ++t) first[t] += first[t - 1];
-    {
-        std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
-        for (std::uint32_t i = 0; i < vertices.size(); ++i) by_tet[next[vertices[i].tet]++] = i;
-    }
-    std::vector<std::uint32_t> group_of(vertices.size()), tets;
-    std::vector<Eigen::AlignedBox3d> boxes;
-    std::vector<std::pair<Eigen::Array3i, std::uint32_t>> cells; // of the tetrahedron at hand: cell, group
-    for (std::uint32_t t = 0; t < elements.size(); ++t) {
-        cells.clear();
-        for (std::uint32_t k = first[t]; k < first[t + 1]; ++k) {
-            const std::uint32_t i = by_tet[k];
-            const Eigen::Array3i cell = (1e3 * vertices[i].rest_m.array() / group_mm).floor().cast<int>();
-            auto at = std::find_if(cells.begin(), cells.end(), [&](const auto& c) { return (c.first == cell).all(); });
-            if (at == cells.end()) {
-                cells.emplace_back(cell, static_cast<std::uint32_t>(tets.size()));
-                at = cells.end() - 1;
-                tets.push_back(t);
-                boxes.emplace_back(start[i]);
-            }
-            group_of[i] = at->second;
-            boxes[at->second].extend(start[i]);
-            boxes[at->second].extend(end[i]);
-        }
+    // Broad phase, as the branched grid's by elements (cut/piece_contact.hpp): the surface
+    // vertices are grouped by cells of four approaches at rest, each group boxed over its
+    // vertices' sweep, and groups are tested in pairs whose boxes come within the approach of
+    // each other and that material does not join. Two groups of whole tetrahedra of one piece in
+    // neighbouring cells at rest are joined: a piece's surfaces within about two cells of each
+    // other at rest count as one material unless a cut passes between them. A group holding a cut tetrahedron holds a
+    // crack's two walls, which lie on each other, so it is always tested, and with every group
+    // near it. (Grouped by tetrahedron, joined when two share a node, the liver at level 4
+    // passed every vertex on: a coarse tetrahedron's surface, boxed whole, overlaps the boxes of
+    // many it does not touch.)
+    refresh_contact_groups(4.0 * parameters.approach_mm);
+    const ContactGroups& groups = m_contact_groups;
+    std::vector<Eigen::AlignedBox3d> boxes(groups.cell.size());
+    for (Eigen::AlignedBox3d& box : boxes) box.setEmpty();
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        boxes[groups.of_vertex[i]].extend(start[i]);
+        boxes[groups.of_vertex[i]].extend(end[i]);
     }
     for (Eigen::AlignedBox3d& box : boxes) {
         box.min().array() -= 0.5 * parameters.approach_mm;
         box.max().array() += 0.5 * parameters.approach_mm;
     }
-    std::vector<unsigned char> kept(tets.size(), 0);
-    for (std::size_t g = 0; g < tets.size(); ++g) kept[g] = elements[tets[g]].is_cut();
+    std::vector<unsigned char> kept(groups.holds_cut);
     auto joined = [&](std::uint32_t p, std::uint32_t q) {
-        const isxfem::XfemElement& a = elements[tets[p]];
-        const isxfem::XfemElement& b = elements[tets[q]];
-        if (a.is_cut() || b.is_cut()) return false;
-        if (tets[p] == tets[q]) return true;
-        for (std::uint32_t n : a.node)
-            if (std::find(b.node.begin(), b.node.end(), n) != b.node.end()) return true;
-        return false;
+        return groups.part[p] == groups.part[q] && !groups.holds_cut[p] && !groups.holds_cut[q] && ((groups.cell[p] - groups.cell[q]).abs() <= 1).all();
     };
-    contact::BoxGrid(std::move(boxes), std::max(group_mm, 1e-6)).overlapping_pairs([&](std::uint32_t p, std::uint32_t q) {
+    contact::BoxGrid(std::move(boxes), std::max(groups.cell_mm, 1e-6)).overlapping_pairs([&](std::uint32_t p, std::uint32_t q) {
         if (!joined(p, q)) kept[p] = kept[q] = 1;
     });
-    // The patch: the kept tetrahedra's vertices press; the triangles around them bring their
-    // other corners as its rim.
+    // The patch: the kept groups' vertices press; the triangles around them bring their other
+    // corners as its rim.
+    constexpr std::uint32_t none = ~0u;
     contact::SurfacePatch patch;
     std::vector<std::uint32_t> slots, index(vertices.size(), none);
     auto add = [&](std::uint32_t v, bool presses) {
@@ -503,7 +526,7 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
         if (presses) patch.presses[index[v]] = 1;
     };
     for (std::uint32_t v = 0; v < vertices.size(); ++v)
-        if (kept[group_of[v]]) add(v, true);
+        if (kept[groups.of_vertex[v]]) add(v, true);
     const std::size_t pressing = slots.size();
     for (const Eigen::Vector3i& t : m_closed_triangles) {
         const bool touches = (index[static_cast<std::size_t>(t[0])] != none && index[static_cast<std::size_t>(t[0])] < pressing) ||

@@ -177,6 +177,19 @@ private:
     mutable std::vector<std::int32_t> m_closed_crack; ///< per closed triangle: the cut whose crack face it is, or -1
     mutable isxfem::ClosureCounts m_closure_counts;
     mutable std::size_t m_closed_revision = 0;
+    /// The closed surface's vertices grouped by cells at rest and by connected part (piece) for
+    /// touch_pieces' broad phase, as of a revision of the model: each group's cell, part and
+    /// whether it holds a vertex of a cut tetrahedron.
+    struct ContactGroups {
+        std::size_t revision = ~std::size_t{0};
+        double cell_mm = 0.0;
+        std::vector<std::uint32_t> of_vertex;
+        std::vector<Eigen::Array3i> cell;
+        std::vector<std::uint32_t> part;
+        std::vector<unsigned char> holds_cut;
+    };
+    mutable ContactGroups m_contact_groups;
+    void refresh_contact_groups(double cell_mm) const;
     std::vector<CutCall> m_cut_log;
 };
 

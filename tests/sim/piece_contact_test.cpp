@@ -2,7 +2,8 @@
 // one voxel above another that is held lands on it and rests there, carried by a contact force
 // equal to its weight; a free block pushed up into another lifts it, the two accelerating
 // together as one body would (the contact only ever pushes the pair apart: their common motion
-// is not resisted, so the momentum follows the external forces exactly).
+// is not resisted, so the momentum follows the external forces exactly); a whole block bending
+// under its weight passes no vertex through the broad phase.
 
 #include "grid/label_grid.hpp"
 #include "io/scene.hpp"
@@ -118,6 +119,24 @@ TEST_P(PieceContact, ABlockLetGoAboveAnotherLandsOnItAndRestsCarriedByItsWeight)
     // The sum of the contacts' force magnitudes: the rim's contacts press along tilted normals,
     // whose sideways parts cancel, so it is a little above the net force that carries the weight.
     EXPECT_NEAR(force, weight, 0.05 * weight);
+}
+
+TEST_P(PieceContact, AWholeBlockSaggingUnderItsWeightTestsNoVertex)
+{
+    // One block held at one end, bending gently under its weight: nothing of it comes near
+    // another part of it, so the broad phase passes no vertex on (it costs one pass over the
+    // surface). (A soft one swinging a millimetre a step is tested: its boxes are swept.)
+    const fs::path mesh = boxes_obj("whole.obj", {{{0, 0, 0}, {39, 9, 5}}});
+    nlohmann::json doc = two_blocks(GetParam(), mesh);
+    doc["materials"]["default"]["youngs_modulus_pa"] = 1e7;
+    doc["constraints"] = {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {4, 10, 6}}}}};
+    doc["gravity_m_s2"] = {0, 0, -k_g};
+    Session r = open(doc);
+    for (int f = 0; f < 20; ++f) {
+        r.loop->next();
+        EXPECT_EQ(r.method->piece_contact().tested_vertices, 0u) << "frame " << f;
+        EXPECT_EQ(r.method->piece_contact().contacts, 0u);
+    }
 }
 
 /// Mean z displacement (mm) of the surface vertices whose rest position is above (`upper`) or
