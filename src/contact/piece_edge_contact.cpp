@@ -160,9 +160,10 @@ std::vector<EdgeContact> edge_contacts(const SurfacePatch& patch, const PieceCon
             seen[t] = e;
             const Eigen::Vector3i& tri = patch.triangles[t];
             if (needle[t] || (tri.array() == static_cast<int>(pressing.a)).any() || (tri.array() == static_cast<int>(pressing.b)).any()) return;
-            // Within 45 degrees of the edge's own side: the surface it lies in, never under.
-            // (A wedge it passes under faces it: its two sides' mean normal more than 105
-            // degrees from the edge's, so neither side's is within 45 degrees of it.)
+            // Within 45 degrees of the edge's own side: the surface it lies in. (A wedge it passes
+            // under faces it, its sides' mean normal more than 105 degrees from the edge's: a side
+            // within 45 degrees would turn over 60 degrees from that mean, a ridge sharper than
+            // the right angles of a voxel surface's corners.)
             if (own_normal.dot(start_normal[t]) > 0.7) return;
             near.push_back(t);
         });

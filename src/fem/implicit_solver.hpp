@@ -194,11 +194,12 @@ private:
     void mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const;
     /// Adds sign times the step's stiffness of the pair contacts `which` (all when null) to the
     /// assembled matrix, those whose blocks its pattern joins (fem::add_to_matrix); adding marks
-    /// them in m_pair_in_matrix, so that taking them away takes away only the marked.
+    /// them in m_pair_in_matrix (multiply() then leaves them out), taking away only the marked.
     void pairs_into_matrix(double sign, const std::vector<std::size_t>* which = nullptr);
     Eigen::VectorXd external_force() const;
     void apply_constraints(Eigen::VectorXd& rhs);
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    void multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void update_node_rotations();
     /// Flags the elements with a degree of freedom free to move (m_active); the others are
