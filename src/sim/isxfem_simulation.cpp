@@ -484,15 +484,15 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
         }
     });
     // Broad phase, as the branched grid's by elements (cut/piece_contact.hpp): the surface
-    // vertices are grouped by cells of four approaches at rest, each group boxed over its
-    // vertices' sweep, and groups are tested in pairs whose boxes come within the approach of
-    // each other and that material does not join. Two groups of whole tetrahedra of one piece in
-    // neighbouring cells at rest are joined: a piece's surfaces within about two cells of each
-    // other at rest count as one material unless a cut passes between them. A group holding a cut tetrahedron holds a
-    // crack's two walls, which lie on each other, so it is always tested, and with every group
-    // near it. (Grouped by tetrahedron, joined when two share a node, the liver at level 4
-    // passed every vertex on: a coarse tetrahedron's surface, boxed whole, overlaps the boxes of
-    // many it does not touch.)
+    // vertices are grouped by cells of four approaches at rest and by piece, each group boxed
+    // over its vertices' sweep, and groups are tested in pairs whose boxes come within the
+    // approach of each other and that material does not join. Two groups of whole tetrahedra of
+    // one piece in neighbouring cells at rest are joined: a piece's surfaces within about two
+    // cells of each other at rest count as one material unless a cut passes between them. A
+    // group holding a cut tetrahedron holds a crack's two walls, which lie on each other, so it
+    // is always tested, and with every group near it. (Grouped by tetrahedron, joined when two
+    // share a node, the liver at level 4 passed every vertex on: a coarse tetrahedron's surface,
+    // boxed whole, overlaps the boxes of many it does not touch.)
     refresh_contact_groups(4.0 * parameters.approach_mm);
     const ContactGroups& groups = m_contact_groups;
     std::vector<Eigen::AlignedBox3d> boxes(groups.cell.size());

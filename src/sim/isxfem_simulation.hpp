@@ -103,9 +103,9 @@ public:
                                                double skin_mm, double approach_mm) const;
 
     /// The closed surface pressed against itself over a step of `dt_s` (contact/piece_contact.hpp:
-    /// pieces on pieces, the walls of a crack): the vertices of the tetrahedra that come near
-    /// others material does not join, and of every cut one, press; each contact is a pair contact
-    /// on the dof blocks of its two material points (fem/pair_contact.hpp).
+    /// pieces on pieces, the walls of a crack): the vertices that come near parts of the surface
+    /// material does not join, and those beside a crack, press (the broad phase: the .cpp); each
+    /// contact is a pair contact on the dof blocks of its two material points (fem/pair_contact.hpp).
     struct PieceTouch {
         std::vector<contact::FaceContact> faces;
         std::vector<contact::EdgeContact> edges;
