@@ -89,4 +89,39 @@ inline bool is_needle(const SurfacePatch& patch, const Eigen::Vector3i& t)
     return (r1 - r0).cross(r2 - r0).norm() < 5e-2 * longest;
 }
 
+/// A patch's triangles measured once for both phases: outward normals at the step's start, end
+/// and rest, areas at the start, which are needles, and the grid of their swept boxes (cells about
+/// two edges wide, at least twice the contact's depth: about a vertex's reach).
+struct MeasuredTriangles {
+    std::vector<Eigen::Vector3d> start_normal, end_normal, rest_normal;
+    std::vector<double> area;
+    std::vector<unsigned char> needle;
+    BoxGrid grid;
+};
+
+inline MeasuredTriangles measure(const SurfacePatch& patch, double max_depth_mm)
+{
+    const std::size_t count = patch.triangles.size();
+    std::vector<Eigen::Vector3d> start(count), end(count), rest(count);
+    std::vector<double> area(count);
+    std::vector<unsigned char> needle(count);
+    for (std::size_t t = 0; t < count; ++t) {
+        const Eigen::Vector3i& tri = patch.triangles[t];
+        const Eigen::Vector3d& a = patch.start_mm[static_cast<std::size_t>(tri[0])];
+        area[t] = 0.5 * (patch.start_mm[static_cast<std::size_t>(tri[1])] - a).cross(patch.start_mm[static_cast<std::size_t>(tri[2])] - a).norm();
+        start[t] = triangle_normal(patch, patch.start_mm, tri);
+        end[t] = triangle_normal(patch, patch.end_mm, tri);
+        rest[t] = triangle_normal(patch, patch.rest_mm, tri);
+        needle[t] = is_needle(patch, tri);
+    }
+    return {std::move(start), std::move(end), std::move(rest), std::move(area), std::move(needle), triangle_grid(patch, 2.0 * max_depth_mm)};
+}
+
+/// The two phases on measured triangles (contact/piece_contact.cpp, contact/piece_edge_contact.cpp);
+/// `turned_near` as surface_contacts says.
+std::vector<FaceContact> find_faces(const SurfacePatch& patch, const PieceContactParameters& parameters, const MeasuredTriangles& triangles,
+                                    std::vector<unsigned char>* turned_near);
+std::vector<EdgeContact> find_edges(const SurfacePatch& patch, const PieceContactParameters& parameters, const MeasuredTriangles& triangles,
+                                    const std::vector<unsigned char>* turned_near);
+
 } // namespace vox::contact::patch_geometry

@@ -10,31 +10,28 @@
 
 namespace vox::contact {
 
-std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters, std::vector<unsigned char>* turned_near)
+namespace patch_geometry {
+
+std::vector<FaceContact> find_faces(const SurfacePatch& patch, const PieceContactParameters& parameters, const MeasuredTriangles& triangles,
+                                    std::vector<unsigned char>* turned_near)
 {
-    using namespace patch_geometry;
-    check(patch, "face_contacts");
     const std::size_t n = patch.start_mm.size();
     std::vector<FaceContact> out;
     if (turned_near) turned_near->assign(n, 0);
     if (patch.triangles.empty()) return out;
     const double depth = parameters.max_depth_mm;
-    const BoxGrid grid = triangle_grid(patch, 2.0 * depth); // cells about as wide as a vertex's reach: few lookups a vertex
+    const BoxGrid& grid = triangles.grid; // cells about as wide as a vertex's reach: few lookups a vertex
     const double k_per_mm2 = parameters.stiffness_n_per_mm / 100.0;
     const std::size_t triangle_count = patch.triangles.size();
-    std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count), rest_normal(triangle_count);
-    std::vector<double> area(triangle_count);
-    std::vector<unsigned char> needle(triangle_count, 0);
+    const std::vector<Eigen::Vector3d>& start_normal = triangles.start_normal;
+    const std::vector<Eigen::Vector3d>& end_normal = triangles.end_normal;
+    const std::vector<Eigen::Vector3d>& rest_normal = triangles.rest_normal;
+    const std::vector<double>& area = triangles.area;
+    const std::vector<unsigned char>& needle = triangles.needle;
     std::vector<Eigen::Vector3d> vertex_normal(n, Eigen::Vector3d::Zero());
     std::vector<std::uint32_t> first(n + 1, 0), around(3 * triangle_count); // each vertex's triangles
     for (std::size_t t = 0; t < triangle_count; ++t) {
         const Eigen::Vector3i& tri = patch.triangles[t];
-        const Eigen::Vector3d& a = patch.start_mm[static_cast<std::size_t>(tri[0])];
-        area[t] = 0.5 * (patch.start_mm[static_cast<std::size_t>(tri[1])] - a).cross(patch.start_mm[static_cast<std::size_t>(tri[2])] - a).norm();
-        start_normal[t] = triangle_normal(patch, patch.start_mm, tri);
-        end_normal[t] = triangle_normal(patch, patch.end_mm, tri);
-        rest_normal[t] = triangle_normal(patch, patch.rest_mm, tri);
-        needle[t] = is_needle(patch, tri);
         for (int c = 0; c < 3; ++c) {
             vertex_normal[static_cast<std::size_t>(tri[c])] += area[t] * start_normal[t];
             ++first[static_cast<std::size_t>(tri[c]) + 1];
@@ -106,6 +103,25 @@ std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceCon
         });
         if (found) out.push_back(best);
     }
+    return out;
+}
+
+} // namespace patch_geometry
+
+std::vector<FaceContact> face_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters)
+{
+    patch_geometry::check(patch, "face_contacts");
+    return patch_geometry::find_faces(patch, parameters, patch_geometry::measure(patch, parameters.max_depth_mm), nullptr);
+}
+
+SurfaceContacts surface_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters)
+{
+    patch_geometry::check(patch, "surface_contacts");
+    const patch_geometry::MeasuredTriangles triangles = patch_geometry::measure(patch, parameters.max_depth_mm);
+    std::vector<unsigned char> turned_near;
+    SurfaceContacts out;
+    out.faces = patch_geometry::find_faces(patch, parameters, triangles, &turned_near);
+    out.edges = patch_geometry::find_edges(patch, parameters, triangles, &turned_near);
     return out;
 }
 

@@ -101,36 +101,29 @@ Eigen::Vector3d cross_normal(const Eigen::Vector3d& p0, const Eigen::Vector3d& p
 
 } // namespace
 
-std::vector<EdgeContact> edge_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters, const std::vector<unsigned char>* turned_near)
+namespace patch_geometry {
+
+std::vector<EdgeContact> find_edges(const SurfacePatch& patch, const PieceContactParameters& parameters, const MeasuredTriangles& triangles,
+                                    const std::vector<unsigned char>* turned_near)
 {
-    using namespace patch_geometry;
-    check(patch, "edge_contacts");
-    if (turned_near && turned_near->size() != patch.start_mm.size())
-        throw std::invalid_argument("contact::edge_contacts: turned_near is not one flag per vertex of the patch");
     std::vector<EdgeContact> out;
     if (patch.triangles.empty()) return out;
     std::vector<std::uint32_t> side_edge;
     const std::vector<Edge> edges = two_sided_edges(patch, side_edge);
     const std::size_t triangle_count = patch.triangles.size();
-    std::vector<Eigen::Vector3d> start_normal(triangle_count), end_normal(triangle_count);
-    std::vector<double> vertex_area(patch.start_mm.size(), 0.0);
-    std::vector<unsigned char> needle(triangle_count);
-    for (std::size_t t = 0; t < triangle_count; ++t) {
-        const Eigen::Vector3i& tri = patch.triangles[t];
-        start_normal[t] = triangle_normal(patch, patch.start_mm, tri);
-        end_normal[t] = triangle_normal(patch, patch.end_mm, tri);
-        needle[t] = is_needle(patch, tri);
-        auto at = [&](int c) -> const Eigen::Vector3d& { return patch.start_mm[static_cast<std::size_t>(tri[c])]; };
-        const double third = (at(1) - at(0)).cross(at(2) - at(0)).norm() / 6.0;
-        for (int c = 0; c < 3; ++c) vertex_area[static_cast<std::size_t>(tri[c])] += third;
-    }
+    const std::vector<Eigen::Vector3d>& start_normal = triangles.start_normal;
+    const std::vector<Eigen::Vector3d>& end_normal = triangles.end_normal;
+    const std::vector<unsigned char>& needle = triangles.needle;
+    std::vector<double> vertex_area(patch.start_mm.size(), 0.0); // a third of each of its triangles'
+    for (std::size_t t = 0; t < triangle_count; ++t)
+        for (int c = 0; c < 3; ++c) vertex_area[static_cast<std::size_t>(patch.triangles[t][c])] += triangles.area[t] / 3.0;
     auto edge_normal = [&](const Edge& e, const std::vector<Eigen::Vector3d>& x) -> Eigen::Vector3d {
         const Eigen::Vector3d n = triangle_normal(patch, x, patch.triangles[e.left]) + triangle_normal(patch, x, patch.triangles[e.right]);
         return n.norm() > 0.0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
     };
     const double depth_limit = parameters.max_depth_mm;
     const double k_per_mm2 = parameters.stiffness_n_per_mm / 100.0;
-    const BoxGrid grid = triangle_grid(patch, depth_limit);
+    const BoxGrid& grid = triangles.grid;
     struct Crossing {
         std::uint32_t triangle;
         double at;
@@ -226,6 +219,14 @@ std::vector<EdgeContact> edge_contacts(const SurfacePatch& patch, const PieceCon
     for (std::size_t i = 0; i < found.size(); ++i)
         if (i == 0 || found[i].first != found[i - 1].first) out.push_back(found[i].second);
     return out;
+}
+
+} // namespace patch_geometry
+
+std::vector<EdgeContact> edge_contacts(const SurfacePatch& patch, const PieceContactParameters& parameters)
+{
+    patch_geometry::check(patch, "edge_contacts");
+    return patch_geometry::find_edges(patch, parameters, patch_geometry::measure(patch, parameters.max_depth_mm), nullptr);
 }
 
 } // namespace vox::contact

@@ -149,9 +149,9 @@ PieceContact touch_pieces(const ModelSurface& surface, const std::vector<Eigen::
             }
             if (all && static_cast<std::uint32_t>(corners.minCoeff()) == i) patch.triangles.push_back(corners);
         }
-    std::vector<unsigned char> turned_near;
-    out.faces = contact::face_contacts(patch, parameters, &turned_near);
-    out.edges = contact::edge_contacts(patch, parameters, &turned_near);
+    contact::SurfaceContacts found = contact::surface_contacts(patch, parameters);
+    out.faces = std::move(found.faces);
+    out.edges = std::move(found.edges);
     // On the nodes: the pressing point's weights on its vertices times their elements', minus the
     // pressed point's.
     auto on_nodes = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_vertex_terms(surface, out.slots[i], w, terms); };

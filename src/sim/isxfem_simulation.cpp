@@ -529,10 +529,9 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
         if (kept[groups.of_vertex[v]]) add(v, true);
     const std::size_t pressing = slots.size();
     for (const Eigen::Vector3i& t : m_closed_triangles) {
-        const bool touches = (index[static_cast<std::size_t>(t[0])] != none && index[static_cast<std::size_t>(t[0])] < pressing) ||
-                             (index[static_cast<std::size_t>(t[1])] != none && index[static_cast<std::size_t>(t[1])] < pressing) ||
-                             (index[static_cast<std::size_t>(t[2])] != none && index[static_cast<std::size_t>(t[2])] < pressing);
-        if (!touches) continue;
+        // The pressing vertices came first (none is larger than any place).
+        auto presses = [&](int v) { return index[static_cast<std::size_t>(v)] < pressing; };
+        if (!presses(t[0]) && !presses(t[1]) && !presses(t[2])) continue;
         for (int c = 0; c < 3; ++c) add(static_cast<std::uint32_t>(t[c]), false);
         patch.triangles.emplace_back(index[static_cast<std::size_t>(t[0])], index[static_cast<std::size_t>(t[1])], index[static_cast<std::size_t>(t[2])]);
     }
@@ -543,9 +542,9 @@ IsxfemSimulation::PieceTouch IsxfemSimulation::touch_pieces(double dt_s, const c
     }
     PieceTouch out;
     out.vertices = pressing;
-    std::vector<unsigned char> turned_near;
-    out.faces = contact::face_contacts(patch, parameters, &turned_near);
-    out.edges = contact::edge_contacts(patch, parameters, &turned_near);
+    contact::SurfaceContacts found = contact::surface_contacts(patch, parameters);
+    out.faces = std::move(found.faces);
+    out.edges = std::move(found.edges);
     auto on_blocks = [&](std::uint32_t i, double w, std::vector<fem::BlockWeight>& terms) { add_point_terms(vertices[slots[i]], w, terms); };
     for (const contact::FaceContact& f : out.faces) out.pairs.push_back(cut::face_pair(f, patch, parameters.skin_mm, on_blocks));
     for (const contact::EdgeContact& e : out.edges) out.pairs.push_back(cut::edge_pair(e, parameters.skin_mm, on_blocks));
