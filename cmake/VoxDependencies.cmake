@@ -26,6 +26,14 @@ target_include_directories(vox_nifti2 SYSTEM INTERFACE ${NIFTI2_INCLUDE_DIR})
 target_link_libraries(vox_nifti2 INTERFACE ${NIFTI2_LIBRARY} ${ZNZ_LIBRARY} ZLIB::ZLIB m)
 add_library(vox::nifti2 ALIAS vox_nifti2)
 
+# DICOM series (io/dicom_reader.cpp only): GDCM's image library, with its JPEG, JPEG-LS (CharLS)
+# and JPEG 2000 (OpenJPEG) decoders.
+find_package(GDCM 3 REQUIRED)
+add_library(vox_gdcm INTERFACE)
+target_include_directories(vox_gdcm SYSTEM INTERFACE ${GDCM_INCLUDE_DIRS})
+target_link_libraries(vox_gdcm INTERFACE gdcmMSFF)
+add_library(vox::gdcm ALIAS vox_gdcm)
+
 # CHOLMOD (SuiteSparse) for the supernodal Cholesky preconditioner; Debian ships no CMake package
 # for SuiteSparse 5, so find it by hand. BLAS comes with it (OpenBLAS, serial, when installed).
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)

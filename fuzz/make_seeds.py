@@ -105,6 +105,41 @@ TET_V = [(0, 0, 0), (10, 0, 0), (0, 10, 0), (0, 0, 10)]
 TET_F = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
 
 
+def dicom(implicit=False, big_endian=False):
+    """One 4 x 4 CT slice of int16 with a rescale: preamble, "DICM", the file meta group (always
+    explicit VR little endian), then the data set in the transfer syntax named."""
+    syntax = "1.2.840.10008.1.2" if implicit else "1.2.840.10008.1.2.2" if big_endian else "1.2.840.10008.1.2.1"
+
+    def element(group, number, vr, value, implicit_vr, endian):
+        if isinstance(value, str):
+            value = value.encode("ascii")
+            value += b"\0" if vr == "UI" and len(value) % 2 else b" " if len(value) % 2 else b""
+        head = struct.pack(endian + "HH", group, number)
+        if implicit_vr:
+            return head + struct.pack(endian + "I", len(value)) + value
+        if vr in ("OB", "OW", "UN", "SQ", "UT"):
+            return head + vr.encode() + b"\0\0" + struct.pack(endian + "I", len(value)) + value
+        return head + vr.encode() + struct.pack(endian + "H", len(value)) + value
+
+    endian = ">" if big_endian else "<"
+    meta = b"".join(element(2, n, vr, v, False, "<") for n, vr, v in [
+        (1, "OB", b"\0\1"), (2, "UI", "1.2.840.10008.5.1.4.1.1.2"), (3, "UI", "1.2.3.4.5.6.7"), (0x10, "UI", syntax)])
+    meta = element(2, 0, "UL", struct.pack("<I", len(meta)), False, "<") + meta
+    pixels = struct.pack(endian + "16h", *[v * 10 - 1000 for v in range(16)])
+    data = b"".join(element(g, n, vr, v, implicit, endian) for g, n, vr, v in [
+        (0x0008, 0x0016, "UI", "1.2.840.10008.5.1.4.1.1.2"), (0x0008, 0x0018, "UI", "1.2.3.4.5.6.7"),
+        (0x0008, 0x0060, "CS", "CT"), (0x0008, 0x103E, "LO", "seed"), (0x0018, 0x0050, "DS", "1.5"),
+        (0x0020, 0x000E, "UI", "1.2.3.4.5.6.8"), (0x0020, 0x0011, "IS", "1"),
+        (0x0020, 0x0032, "DS", "-10\\20.5\\3"), (0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0"),
+        (0x0028, 0x0002, "US", struct.pack(endian + "H", 1)), (0x0028, 0x0004, "CS", "MONOCHROME2"),
+        (0x0028, 0x0010, "US", struct.pack(endian + "H", 4)), (0x0028, 0x0011, "US", struct.pack(endian + "H", 4)),
+        (0x0028, 0x0030, "DS", "0.5\\0.75"), (0x0028, 0x0100, "US", struct.pack(endian + "H", 16)),
+        (0x0028, 0x0101, "US", struct.pack(endian + "H", 16)), (0x0028, 0x0102, "US", struct.pack(endian + "H", 15)),
+        (0x0028, 0x0103, "US", struct.pack(endian + "H", 1)), (0x0028, 0x1052, "DS", "-1024"),
+        (0x0028, 0x1053, "DS", "1"), (0x7FE0, 0x0010, "OW", pixels)])
+    return b"\0" * 128 + b"DICM" + meta + data
+
+
 def triangles(faces):
     return [(f[0], f[i], f[i + 1]) for f in faces for i in range(1, len(f) - 1)]
 
@@ -201,6 +236,9 @@ def main():
     for kind in ("u8", "i16", "f32"):
         seed("inr", f"{kind}.inr", inr(kind))
     seed("inr", "u8.inr.gz", gzip.compress(inr("u8")))
+    seed("dicom", "ct_explicit.dcm", dicom())
+    seed("dicom", "ct_implicit.dcm", dicom(implicit=True))
+    seed("dicom", "ct_big_endian.dcm", dicom(big_endian=True))
     obj_files()
     ply_files()
     stl_files()

@@ -12,6 +12,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev libnifti2-dev libspdlog-dev zlib1g-dev libstb-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri libgl-dev xvfb xauth
   libsuitesparse-dev libopenblas0-serial
+  libgdcm-dev
+  # the tests' independent readers and writers (run with /usr/bin/python3, Debian's)
+  python3 python3-pydicom python3-numpy python3-nibabel
 )
 packages+=("$@") # extra packages a caller needs (fuzz/run.sh: clang)
 

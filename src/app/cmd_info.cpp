@@ -3,6 +3,7 @@
 
 #include "app/commands.hpp"
 #include "core/error.hpp"
+#include "io/dicom_reader.hpp"
 #include "io/file_bytes.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
@@ -49,9 +50,8 @@ json world_bbox(const Eigen::Matrix4d& t, const Eigen::Vector3d& lo, const Eigen
     return {{"min", vec(mn)}, {"max", vec(mx)}};
 }
 
-json volume_info(const std::string& path)
+json volume_info(const io::Volume& v, const std::string& path)
 {
-    const io::Volume v = io::read_volume(path);
     std::map<double, std::uint64_t> counts;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     std::uint64_t nonzero = 0;
@@ -81,6 +81,26 @@ json volume_info(const std::string& path)
         for (const auto& [value, n] : counts)
             if (value != 0.0) hist[std::to_string(static_cast<std::int64_t>(value))] = n;
         j["labels"] = hist;
+    }
+    return j;
+}
+
+/// The series of a DICOM folder (numbered as --series picks them, no patient identifiers), and the
+/// volume of the one picked, or of the only one.
+json dicom_info(const std::string& path, const std::string& pick)
+{
+    const std::vector<io::DicomSeries> all = io::list_dicom_series(path);
+    json list = json::array();
+    for (const io::DicomSeries& s : all)
+        list.push_back({{"number", s.number},
+                        {"uid", s.uid},
+                        {"description", s.description},
+                        {"modality", s.modality},
+                        {"size", {s.size[0], s.size[1], s.size[2]}}});
+    json j{{"file", path}, {"kind", "DICOM"}, {"series", list}};
+    if (!pick.empty() || all.size() == 1) {
+        j["volume"] = volume_info(io::read_dicom(path, pick), path);
+        j["volume"].erase("file");
     }
     return j;
 }
@@ -156,6 +176,16 @@ void print_text(const json& j)
         if (key == "labels") {
             std::printf("labels (label: voxels):\n");
             for (const auto& [label, n] : value.items()) std::printf("  %s: %s\n", label.c_str(), n.dump().c_str());
+        } else if (key == "series") {
+            std::printf("series (number: modality columns x rows x slices, description, UID):\n");
+            for (const json& one : value)
+                std::printf("  %s: %s %sx%sx%s \"%s\" %s\n", one["number"].dump().c_str(),
+                            one["modality"].get<std::string>().c_str(), one["size"][0].dump().c_str(),
+                            one["size"][1].dump().c_str(), one["size"][2].dump().c_str(),
+                            one["description"].get<std::string>().c_str(), one["uid"].get<std::string>().c_str());
+        } else if (key == "volume") {
+            std::printf("volume of the series read:\n");
+            print_text(value);
         } else if (key == "index_to_world") {
             std::printf("index_to_world:\n");
             for (const auto& row : value) std::printf("  %s\n", human(row).c_str());
@@ -175,13 +205,15 @@ void add_info_command(CLI::App& app)
         std::string input;
         bool as_json = false;
         double mm_per_unit = 1.0;
+        std::string series;
     };
     auto args = std::make_shared<Args>();
-    CLI::App* cmd = app.add_subcommand("info", "Describe a volume, .vdb label grid or mesh file");
+    CLI::App* cmd = app.add_subcommand("info", "Describe a volume, DICOM folder, .vdb label grid or mesh file");
     cmd->add_option("file", args->input, "The file to describe")->required();
     cmd->add_flag("--json", args->as_json, "Print JSON instead of text");
     cmd->add_option("--scale", args->mm_per_unit, "Meshes: millimetres per file unit (default 1)")
         ->check(CLI::PositiveNumber);
+    cmd->add_option("--series", args->series, "DICOM folders: also describe this series' volume (its number or UID)");
     cmd->callback([args] {
         const std::string& p = args->input;
         json j;
@@ -189,8 +221,14 @@ void add_info_command(CLI::App& app)
             j = mesh_info_json(p, args->mm_per_unit);
         else if (p.size() > 4 && p.compare(p.size() - 4, 4, ".vdb") == 0)
             j = vdb_info(p);
+        else if (io::is_volume_path(p))
+            j = volume_info(io::read_volume(p), p);
+        else if (io::is_dicom_path(p))
+            j = dicom_info(p, args->series);
         else
-            j = volume_info(p);
+            j = volume_info(io::read_volume(p), p); // names what it expected
+        if (!args->series.empty() && j["kind"] != "DICOM")
+            throw file_error(p, "--series picks a series of a DICOM folder; this is not one");
         if (args->as_json)
             std::cout << j.dump(2) << '\n';
         else

@@ -54,6 +54,8 @@ io::Selection SelectionOptions::to_selection() const
 
 void add_selection_options(CLI::App& cmd, SelectionOptions& options)
 {
+    cmd.add_option("--series", options.series,
+                   "DICOM folders holding several series: the one to read, by its number in `info` or its UID");
     cmd.add_option("--label", options.labels, "Keep voxels with these stored labels (comma-separated)")
         ->delimiter(',');
     cmd.add_option("--threshold", options.threshold,
@@ -79,6 +81,7 @@ io::ImportOptions import_options(const SelectionOptions& selection, const MeshOp
     o.selection = selection.to_selection();
     o.voxel_mm = mesh.voxel_mm;
     o.mm_per_unit = mesh.mm_per_unit;
+    o.series = selection.series;
     return o;
 }
 

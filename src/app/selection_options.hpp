@@ -1,6 +1,6 @@
 #pragma once
-// The --label / --threshold options shared by the subcommands that read volumes, and the piece
-// options (--components, --min-voxels, --seed-mm) that apply to volumes and meshes alike.
+// The --series, --label and --threshold options shared by the subcommands that read volumes, and
+// the piece options (--components, --min-voxels, --seed-mm) that apply to volumes and meshes alike.
 
 #include "io/object_import.hpp"
 #include "io/selection.hpp"
@@ -22,6 +22,7 @@ struct SelectionOptions {
     std::string components; ///< "largest" or N
     std::uint64_t min_voxels = 0;
     std::vector<std::string> seeds_mm; ///< "X,Y,Z" each
+    std::string series;                ///< DICOM folders: --series N|UID
     /// Throws InputError when both are given, the threshold text is malformed, or a piece option
     /// is.
     [[nodiscard]] io::Selection to_selection() const;

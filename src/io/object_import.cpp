@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/dicom_reader.hpp"
 #include "io/file_bytes.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
@@ -22,6 +23,11 @@ bool is_mesh_path(const std::string& path)
 
 grid::LabelGrid import_object(const std::string& path, const ImportOptions& options)
 {
+    const bool dicom = !is_mesh_path(path) && !is_volume_path(path) && detail::lower_extension(path) != ".vdb" &&
+                       is_dicom_path(path);
+    if (!options.series.empty() && !dicom)
+        throw file_error(path, "--series picks a series of a DICOM folder; this is not one");
+    if (dicom) return select_voxels(read_dicom(path, options.series), options.selection);
     if (is_mesh_path(path)) {
         if (!options.selection.empty())
             throw file_error(path, "--label and --threshold select voxels of volumes; a mesh is voxelised whole");
@@ -43,7 +49,7 @@ grid::LabelGrid import_object(const std::string& path, const ImportOptions& opti
     }
     if (is_volume_path(path)) return select_voxels(read_volume(path), options.selection);
     throw file_error(path, "unknown file type (expected a volume .inr[.gz] .nii[.gz] .mhd .mha .nrrd .nhdr .vdb, "
-                           "or a mesh .obj .ply .stl .off)");
+                           "a DICOM folder or file, or a mesh .obj .ply .stl .off)");
 }
 
 } // namespace vox::io

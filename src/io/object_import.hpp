@@ -1,5 +1,5 @@
 #pragma once
-// One entry point from any input file (scan volume, .vdb label grid, or surface mesh) to the
+// One entry point from any input (scan volume, DICOM folder, .vdb label grid, or surface mesh) to the
 // labelled voxels of an object.
 
 #include "grid/label_grid.hpp"
@@ -14,6 +14,7 @@ struct ImportOptions {
     Selection selection;             ///< volumes and .vdb files
     std::optional<double> voxel_mm;  ///< meshes: voxel edge (default: longest side / 128)
     double mm_per_unit = 1.0;        ///< meshes: file units to millimetres
+    std::string series;              ///< DICOM folders: the series' number or UID ("": the only one)
 };
 
 /// True for the mesh extensions read by read_mesh (.obj .ply .stl .off).

@@ -298,7 +298,18 @@ SceneObject read_object(JsonReader r)
     const std::string_view kind = r.exactly_one_of({"volume", "phantom", "mesh"});
     if (kind == "volume") {
         o.kind = ObjectKind::volume;
-        o.file = existing_file(r.required_node("volume"));
+        const JsonNode volume = r.required_node("volume");
+        o.file = resolved_path(volume);
+        std::error_code error;
+        if (!std::filesystem::is_directory(o.file, error)) o.file = existing_file(volume); // a DICOM export is a folder
+        if (const std::optional<JsonNode> series = r.optional_node("series")) {
+            if (series->value().is_number_integer())
+                o.series = std::to_string(as<int>(*series, closed_range(1, 1 << 30)));
+            else if (series->value().is_string() && !as<std::string>(*series).empty())
+                o.series = as<std::string>(*series);
+            else
+                series->fail("expected a series number (1, 2, ... as `voxsculpt info` lists them) or a SeriesInstanceUID");
+        }
         if (const std::optional<JsonNode> select = r.optional_node("select")) {
             o.select = read_selection(JsonReader(*select));
         }

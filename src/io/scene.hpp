@@ -45,8 +45,10 @@ enum class UnheldPieces {
 struct SceneObject {
     ObjectKind kind = ObjectKind::phantom;
     /// volume, mesh: the file, absolute (resolved against the scene's folder); it existed when
-    /// the scene was read.
+    /// the scene was read. A volume may be a DICOM folder.
     std::filesystem::path file;
+    /// volume: key "series", the DICOM series read (its number in `info`, or its UID); "": the only one.
+    std::string series;
     /// volume: the voxels kept (labels keep their value, a threshold window gives label 1); empty
     /// when the scene has no "select": every non-zero voxel, keeping its value as label.
     Selection select;

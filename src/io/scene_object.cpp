@@ -63,6 +63,7 @@ grid::LabelGrid build_object_voxels(const Scene& scene)
     case ObjectKind::volume: {
         ImportOptions options;
         options.selection = o.select;
+        options.series = o.series;
         return import_object(o.file.string(), options);
     }
     }

@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
@@ -234,4 +236,43 @@ TEST(Cli, QuietPrintsNothingOnSuccess)
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_EQ(r.err, "");
     EXPECT_EQ(r.out, "");
+}
+
+TEST(Cli, ADicomFolderIsListedReadInASceneAndNoPatientIdentifierIsWritten)
+{
+    // pydicom writes 60 slices of the liver for patient "Test^Liver", ID VOX-TEST-0001
+    // (tests/io/write_dicom_series.py); neither may reach what the program prints or writes.
+    const fs::path d = fresh_dir("cli_dicom");
+    const std::string dir = (d / "export").string();
+    const std::string write = "/usr/bin/python3 " + quote(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py") + " " +
+                              quote(VOX_SOURCE_DIR "/data/liver.inr.gz") + " " + quote(dir) + " --slices 60 --shuffle";
+    ASSERT_EQ(std::system(write.c_str()), 0) << write;
+    const auto no_identifier = [](const std::string& text, const std::string& what) {
+        EXPECT_EQ(text.find("Test^Liver"), std::string::npos) << what;
+        EXPECT_EQ(text.find("VOX-TEST"), std::string::npos) << what;
+    };
+
+    const auto info = run_voxsculpt("info " + quote(dir));
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("1: CT 438x353x60 \"liver labels\""), std::string::npos) << info.out;
+    no_identifier(info.out + info.err, "info");
+    const auto j = info_json(dir);
+    EXPECT_EQ(j["series"].size(), 1u);
+    EXPECT_EQ(j["volume"]["dimensions"][2], 60);
+
+    const auto import = run_voxsculpt("import " + quote(dir) + " --series 1 --label 255 -o " + quote((d / "l.vdb").string()));
+    ASSERT_EQ(import.exit_code, 0) << import.err;
+    no_identifier(import.out + import.err, "import");
+    std::ifstream vdb(d / "l.vdb", std::ios::binary);
+    no_identifier(std::string(std::istreambuf_iterator<char>(vdb), std::istreambuf_iterator<char>()), "the .vdb");
+
+    std::ofstream(d / "scene.json") << R"({"object": {"volume": "export", "series": 1, "select": {"label": [255]}, "levels": 4},
+        "constraints": [{"type": "fixed", "box_mm": [[0, 100, 0], [270, 220, 220]]}]})";
+    const auto check = run_voxsculpt("check " + quote((d / "scene.json").string()));
+    EXPECT_EQ(check.exit_code, 0) << check.err;
+    no_identifier(check.out + check.err, "check");
+    std::ofstream(d / "wrong.json") << R"({"object": {"volume": "export", "series": 2}})";
+    const auto wrong = run_voxsculpt("check " + quote((d / "wrong.json").string()));
+    EXPECT_EQ(wrong.exit_code, 2);
+    EXPECT_NE(wrong.err.find("has no series 2"), std::string::npos) << wrong.err;
 }

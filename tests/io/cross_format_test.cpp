@@ -232,6 +232,10 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
     // What each file of ours must be refused for (tests/data/bad/README.md says why), imported as
     // `voxsculpt import FILE` does: read, then every non-zero voxel kept as its label.
     const std::map<std::string, std::string> expected = {
+        {"dicom_bad_orientation.dcm", "ImageOrientationPatient 1\\0\\0\\1\\0\\0 is not two orthogonal unit vectors"},
+        {"dicom_colour.dcm", "has 3 samples a pixel (a colour image)"},
+        {"dicom_empty.dcm", ": is empty"},
+        {"dicom_truncated.dcm", "GDCM's reader crashed on it (SIGABRT; the file is corrupt or truncated)"},
         {"mha_bad_element_type.mha", "unsupported ElementType"},
         {"mha_compressed_corrupt.mha", "corrupt compressed data"},
         {"mha_empty.mha", ": is empty"},
@@ -278,7 +282,7 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
     for (const auto& entry : fs::directory_iterator(bad)) {
         const std::string name = entry.path().filename().string();
         const std::string prefix = name.substr(0, name.find('_') + 1);
-        if (prefix != "mha_" && prefix != "mhd_" && prefix != "nrrd_" && prefix != "nii_") continue;
+        if (prefix != "dicom_" && prefix != "mha_" && prefix != "mhd_" && prefix != "nrrd_" && prefix != "nii_") continue;
         SCOPED_TRACE(name);
         ++seen;
         const auto it = expected.find(name);

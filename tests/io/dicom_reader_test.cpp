@@ -1,0 +1,207 @@
+// The DICOM reader against series written by another implementation: pydicom (Debian's
+// python3-pydicom) writes the bundled liver as CT slices (tests/io/write_dicom_series.py), and
+// pydicom's own sample files give the compressed transfer syntaxes of one MR slice, encoded by
+// other toolkits. GDCM itself only writes the JPEG lossless copy, which pydicom cannot encode.
+
+#include "io/dicom_reader.hpp"
+#include "io/object_import.hpp"
+#include "io/volume_reader.hpp"
+
+#include "test_support.hpp"
+
+#include <gdcmImageChangeTransferSyntax.h>
+#include <gdcmImageReader.h>
+#include <gdcmImageWriter.h>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+using namespace vox::io;
+using vox::test::expect_refused;
+using vox::test::ScratchDir;
+
+namespace {
+
+const std::string k_liver = VOX_SOURCE_DIR "/data/liver.inr.gz";
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+/// Runs the writer into `dir` with extra options; a failure to run it fails the test.
+void write_series(const std::string& dir, const std::string& options)
+{
+    const std::string command = "/usr/bin/python3 " + quoted(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py") + " " +
+                                quoted(k_liver) + " " + quoted(dir) + " " + options;
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+}
+
+/// The folder of pydicom's sample files, as the installed package reports it.
+std::string pydicom_samples()
+{
+    std::FILE* pipe = ::popen("/usr/bin/python3 -c \"import os, pydicom.data; "
+                              "print(os.path.dirname(pydicom.data.get_testdata_file('MR_small.dcm')))\"",
+                              "r");
+    if (pipe == nullptr) return {};
+    std::array<char, 4096> line{};
+    const bool got = std::fgets(line.data(), static_cast<int>(line.size()), pipe) != nullptr;
+    ::pclose(pipe);
+    std::string dir = got ? std::string(line.data()) : std::string();
+    while (!dir.empty() && (dir.back() == '\n' || dir.back() == '\r')) dir.pop_back();
+    return dir;
+}
+
+/// Every voxel's scaled value equal, slices [0, slices) of `expected` against `got`.
+void expect_same_values(const Volume& expected, const Volume& got, std::int64_t slices)
+{
+    const std::int64_t n = expected.dims[0] * expected.dims[1] * slices;
+    std::int64_t different = 0;
+    for (std::int64_t i = 0; i < n; ++i)
+        if (expected.scaled(i) != got.scaled(i)) ++different;
+    EXPECT_EQ(different, 0) << "of " << n << " voxels";
+}
+
+} // namespace
+
+TEST(DicomReader, TheLiverWrittenOutOfOrderImportsAsTheInrFileDoes)
+{
+    // File names shuffled and instance numbers reversed: only the positions order the slices.
+    const ScratchDir scratch;
+    const std::string dir = scratch.path("liver");
+    write_series(dir, "--shuffle");
+    const Volume inr = read_volume(k_liver);
+    const Volume dicom = read_dicom(dir);
+    ASSERT_EQ(dicom.dims, inr.dims);
+    EXPECT_TRUE(dicom.index_to_world.isApprox(inr.index_to_world, 1e-9)) << dicom.index_to_world;
+    EXPECT_EQ(dicom.type, ScalarType::i16);
+    expect_same_values(inr, dicom, inr.dims[2]);
+
+    // Through the one import entry: the same labelled voxels at the same world points.
+    ImportOptions liver;
+    liver.selection.labels = {255};
+    const vox::grid::LabelGrid a = import_object(k_liver, liver), b = import_object(dir, liver);
+    EXPECT_EQ(b.active_voxel_count(), 3160496u);
+    EXPECT_EQ(b.index_bounds().min, a.index_bounds().min);
+    EXPECT_EQ(b.index_bounds().max, a.index_bounds().max);
+    EXPECT_TRUE(b.index_to_world().isApprox(a.index_to_world(), 1e-9));
+    EXPECT_EQ(import_object(dir, {}).label_histogram(), import_object(k_liver, {}).label_histogram());
+}
+
+TEST(DicomReader, AnObliqueSeriesKeepsItsOrientationInWorldMillimetres)
+{
+    const ScratchDir scratch;
+    const std::string dir = scratch.path("oblique");
+    write_series(dir, "--rotate-deg 30 --shuffle --slices 24 --rescale");
+    const Volume inr = read_volume(k_liver);
+    const Volume dicom = read_dicom(dir);
+    ASSERT_EQ(dicom.dims, (std::array<std::int64_t, 3>{inr.dims[0], inr.dims[1], 24}));
+    // The writer's rotation: 30 degrees about (1, 2, 3); columns of the index-to-world map are the
+    // rotated axes times the spacings, the origin the INR's.
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    Eigen::Matrix4d expected = Eigen::Matrix4d::Identity();
+    expected.topLeftCorner<3, 3>() = r * inr.index_to_world.topLeftCorner<3, 3>();
+    expected.topRightCorner<3, 1>() = inr.index_to_world.topRightCorner<3, 1>();
+    EXPECT_TRUE(dicom.index_to_world.isApprox(expected, 1e-8)) << dicom.index_to_world << "\nexpected\n" << expected;
+    // Stored 2 v + 1000: only the rescale (slope 0.5, intercept -500) gives the values back.
+    EXPECT_EQ(dicom.scale_slope, 0.5);
+    EXPECT_EQ(dicom.scale_intercept, -500.0);
+    expect_same_values(inr, dicom, 24);
+}
+
+TEST(DicomReader, RleCompressedSlicesDecodeToTheSameValues)
+{
+    const ScratchDir scratch;
+    const std::string dir = scratch.path("rle");
+    write_series(dir, "--rle --slices 12");
+    const Volume inr = read_volume(k_liver);
+    const Volume dicom = read_dicom(dir);
+    ASSERT_EQ(dicom.dims[2], 12);
+    expect_same_values(inr, dicom, 12);
+}
+
+TEST(DicomReader, CompressedTransferSyntaxesOfPacsExportsDecodeAlike)
+{
+    // pydicom's samples: one MR slice, uncompressed and as other toolkits encoded it.
+    const std::string samples = pydicom_samples();
+    ASSERT_FALSE(samples.empty()) << "python3-pydicom is not installed (scripts/install-deps.sh installs it)";
+    const Volume reference = read_dicom(samples + "/MR_small.dcm");
+    ASSERT_EQ(reference.dims, (std::array<std::int64_t, 3>{64, 64, 1}));
+    for (const char* name : {"MR_small_RLE.dcm", "MR_small_jp2klossless.dcm", "MR_small_jpeg_ls_lossless.dcm",
+                             "MR_small_bigendian.dcm", "MR_small_implicit.dcm"}) {
+        SCOPED_TRACE(name);
+        const Volume v = read_dicom(samples + "/" + name);
+        ASSERT_EQ(v.dims, reference.dims);
+        EXPECT_TRUE(v.index_to_world.isApprox(reference.index_to_world, 1e-12));
+        expect_same_values(reference, v, 1);
+    }
+
+    // JPEG lossless (process 14, selection value 1), which pydicom cannot write: GDCM transcodes.
+    const ScratchDir scratch;
+    gdcm::ImageReader reader;
+    reader.SetFileName((samples + "/MR_small.dcm").c_str());
+    ASSERT_TRUE(reader.Read());
+    gdcm::ImageChangeTransferSyntax change;
+    change.SetTransferSyntax(gdcm::TransferSyntax::JPEGLosslessProcess14_1);
+    change.SetInput(reader.GetImage());
+    ASSERT_TRUE(change.Change());
+    gdcm::ImageWriter writer;
+    writer.SetFileName(scratch.path("jpeg_lossless.dcm").c_str());
+    writer.SetFile(reader.GetFile());
+    writer.SetImage(change.GetOutput());
+    ASSERT_TRUE(writer.Write());
+    expect_same_values(reference, read_dicom(scratch.path("jpeg_lossless.dcm")), 1);
+}
+
+TEST(DicomReader, AFolderOfSeveralSeriesIsListedAndOneIsPickedByNumberOrUid)
+{
+    const ScratchDir scratch;
+    write_series(scratch.path("two/a"), "--slices 60 --series-number 7 --description arterial");
+    write_series(scratch.path("two/b"), "--slices 6 --series-number 2 --description venous --shuffle");
+    std::ofstream(scratch.path("two/notes.txt")) << "not a DICOM file\n"; // skipped, as a DICOMDIR or notes would be
+    const std::string dir = scratch.path("two");
+    const std::vector<DicomSeries> all = list_dicom_series(dir);
+    ASSERT_EQ(all.size(), 2u);
+    EXPECT_EQ(all[0].number, 1);
+    EXPECT_EQ(all[0].description, "venous"); // ordered by SeriesNumber
+    EXPECT_EQ(all[0].size, (std::array<std::int64_t, 3>{438, 353, 6}));
+    EXPECT_EQ(all[1].description, "arterial");
+    EXPECT_EQ(all[1].modality, "CT");
+
+    expect_refused([&] { (void)read_dicom(dir); }, dir, "holds 2 series");
+    EXPECT_EQ(read_dicom(dir, "2").dims[2], 60);
+    EXPECT_EQ(read_dicom(dir, all[0].uid).dims[2], 6);
+    expect_refused([&] { (void)read_dicom(dir, "3"); }, dir, "has no series 3");
+    ImportOptions pick;
+    pick.series = "2";
+    pick.selection.labels = {255};
+    const Volume inr = read_volume(k_liver);
+    std::uint64_t liver_in_60 = 0;
+    for (std::int64_t n = 0; n < inr.dims[0] * inr.dims[1] * 60; ++n) liver_in_60 += inr.stored(n) == 255.0;
+    ASSERT_GT(liver_in_60, 0u);
+    EXPECT_EQ(import_object(dir, pick).active_voxel_count(), liver_in_60);
+    pick.series = "1";
+    expect_refused([&] { (void)import_object(k_liver, pick); }, k_liver, "--series picks a series of a DICOM folder");
+}
+
+TEST(DicomReader, IrregularSeriesAreRefusedWithWhatWasFound)
+{
+    const ScratchDir scratch;
+    write_series(scratch.path("missing"), "--slices 20 --drop-slice 8");
+    expect_refused([&] { (void)read_dicom(scratch.path("missing")); }, scratch.path("missing"),
+                   "uneven slice spacing: 2.66666 mm between");
+    write_series(scratch.path("twice"), "--slices 20 --duplicate-slice 5");
+    expect_refused([&] { (void)read_dicom(scratch.path("twice")); }, scratch.path("twice"), "has two slices at");
+    write_series(scratch.path("tilted"), "--slices 20 --tilt-deg 12");
+    expect_refused([&] { (void)read_dicom(scratch.path("tilted")); }, scratch.path("tilted"),
+                   "stacked 12 degrees off their normal (gantry tilt)");
+    std::filesystem::create_directories(scratch.path("empty"));
+    expect_refused([&] { (void)read_dicom(scratch.path("empty")); }, scratch.path("empty"), "is an empty folder");
+    std::filesystem::create_directories(scratch.path("plain"));
+    (void)scratch.write("plain/readme.txt", "nothing here\n");
+    expect_refused([&] { (void)read_dicom(scratch.path("plain")); }, scratch.path("plain"), "holds no DICOM image");
+    expect_refused([&] { (void)read_dicom(scratch.path("nowhere")); }, scratch.path("nowhere"), "no such file or folder");
+}
