@@ -45,6 +45,7 @@
 #include <fstream>
 #include <map>
 #include <numeric>
+#include <set>
 #include <sstream>
 
 #include <sys/mman.h>
@@ -128,28 +129,33 @@ public:
     ~Note() { ::munmap(m_page, k_bytes); }
     Note(const Note&) = delete;
     Note& operator=(const Note&) = delete;
-    void set(const std::string& file)
+    /// `header`: GDCM reads the file's header to list it (a file that fails there can be skipped).
+    void set(const std::string& file, bool header)
     {
-        const std::size_t n = std::min(file.size(), k_bytes - 1);
-        std::memcpy(m_page, file.data(), n);
-        static_cast<char*>(m_page)[n] = 0;
+        char* page = static_cast<char*>(m_page);
+        const std::size_t n = std::min(file.size(), k_bytes - 2);
+        page[0] = header ? 'h' : 'p';
+        std::memcpy(page + 1, file.data(), n);
+        page[n + 1] = 0;
     }
-    [[nodiscard]] std::string get() const { return static_cast<const char*>(m_page); }
+    [[nodiscard]] std::string file() const { return static_cast<const char*>(m_page) + (m_page_empty() ? 0 : 1); }
+    [[nodiscard]] bool header() const { return static_cast<const char*>(m_page)[0] == 'h'; }
 
 private:
+    [[nodiscard]] bool m_page_empty() const { return static_cast<const char*>(m_page)[0] == 0; }
     static constexpr std::size_t k_bytes = 4096;
     void* m_page;
 };
 
-/// The files under `path` (a folder, searched recursively, or one file), scanned for the tags
-/// above. With a note (in the child), each file is first scanned alone, noted, so that a crash
-/// names it.
+/// The files under `path` (a folder, searched recursively, or one file) but those in `skip`,
+/// scanned for the tags above. With a note (in the child), each file is first scanned alone,
+/// noted, so that a crash names it.
 struct Scan {
     gdcm::Scanner scanner;
     std::vector<std::string> files;
     std::uint64_t bytes = 0; ///< of all the files
 
-    Scan(const std::string& path, Note* note)
+    Scan(const std::string& path, const std::set<std::string>& skip, Note* note)
     {
         quiet_gdcm();
         std::error_code error;
@@ -157,7 +163,8 @@ struct Scan {
         if (std::filesystem::is_directory(path, error)) {
             gdcm::Directory d;
             d.Load(path, true);
-            files = d.GetFilenames();
+            for (const std::string& f : d.GetFilenames())
+                if (skip.count(f) == 0) files.push_back(f);
             std::sort(files.begin(), files.end());
         } else {
             check_input_file(path); // "is empty" and the rest, as every reader says them
@@ -168,12 +175,12 @@ struct Scan {
         add_tags(scanner);
         if (note != nullptr) {
             for (const std::string& f : files) {
-                note->set(f);
+                note->set(f, true);
                 gdcm::Scanner alone;
                 add_tags(alone);
                 (void)alone.Scan({f});
             }
-            note->set("");
+            note->set(path, false);
         }
         if (!scanner.Scan(files)) throw file_error(path, "cannot be scanned for DICOM files");
     }
@@ -386,15 +393,15 @@ bool is_dicom_path(const std::string& path)
 
 namespace {
 
-std::vector<DicomSeries> list_series(const std::string& path, Note* note)
+std::vector<DicomSeries> list_series(const std::string& path, const std::set<std::string>& skip, Note* note)
 {
-    const Scan scan(path, note);
+    const Scan scan(path, skip, note);
     return series_of(scan, path);
 }
 
-Volume read_series(const std::string& path, const std::string& series, Note* note)
+Volume read_series(const std::string& path, const std::string& series, const std::set<std::string>& skip, Note* note)
 {
-    const Scan scan(path, note);
+    const Scan scan(path, skip, note);
     const std::vector<DicomSeries> all = series_of(scan, path);
     const DicomSeries& s = pick(all, series, path);
     const Stack geometry = stack(scan, s, path);
@@ -410,7 +417,7 @@ Volume read_series(const std::string& path, const std::string& series, Note* not
     std::vector<char> pixels;
     for (std::size_t k = 0; k < geometry.slices.size(); ++k) {
         const std::string& file = geometry.slices[k].file;
-        if (note != nullptr) note->set(file);
+        if (note != nullptr) note->set(file, false);
         gdcm::ImageReader reader;
         reader.SetFileName(file.c_str());
         if (!reader.Read()) throw file_error(file, "cannot be read as a DICOM image");
@@ -469,43 +476,56 @@ Volume read_series(const std::string& path, const std::string& series, Note* not
 
 /// Runs `work` in a child first (see the header comment) and says how GDCM failed, on which file.
 /// What the child refused is refused here with the child's message: the run here must not be
-/// trusted to refuse it the same way (GDCM may throw in one code path and abort in another).
-template <class Work> void check_in_child(const std::string& path, Work&& work)
+/// trusted to refuse it the same way (GDCM may throw in one code path and abort in another). A
+/// file of a folder that GDCM cannot even list (a damaged DICOMDIR beside the images) is skipped
+/// with a warning, and the child runs again without it. Returns the files skipped.
+template <class Work> std::set<std::string> checked_in_child(const std::string& path, Work&& work)
 {
-    Note note;
     std::error_code error;
+    const bool folder = std::filesystem::is_directory(path, error);
     std::uint64_t bytes = 0;
-    if (std::filesystem::is_directory(path, error)) {
+    if (folder) {
         for (const auto& entry : std::filesystem::recursive_directory_iterator(path, error))
             if (entry.is_regular_file(error)) bytes += entry.file_size(error);
     } else {
         bytes = std::filesystem::file_size(path, error);
     }
     const ChildLimits limits{memory_limit_bytes(), 10.0 + 0.2 * static_cast<double>(bytes >> 20), true};
-    const ChildOutcome outcome = run_in_child(
-        [&] {
-            try {
-                work(&note);
-            } catch (const InputError&) {
-                throw;
-            } catch (const std::exception& e) {
-                throw file_error(note.get().empty() ? path : note.get(), std::string("GDCM failed on it: ") + e.what());
-            }
-        },
-        limits);
-    const std::string where = note.get().empty() ? path : note.get();
-    switch (outcome.kind) {
-    case ChildOutcome::Kind::ok: return;
-    case ChildOutcome::Kind::failed: throw InputError(outcome.message);
-    case ChildOutcome::Kind::out_of_memory:
-        throw file_error(where, "reading it needs more than the memory limit of " + std::to_string(memory_limit_bytes() >> 20) +
-                                    " MiB (corrupt, or set --max-memory-mb to raise it)");
-    case ChildOutcome::Kind::timed_out:
-        throw file_error(where, "GDCM did not finish reading it within " + std::to_string(static_cast<int>(limits.seconds)) +
-                                    " s (a corrupt file?)");
-    case ChildOutcome::Kind::crashed:
-        throw file_error(where, "not a readable DICOM file: GDCM's reader crashed on it (" + signal_name(outcome.signal) +
-                                    "; the file is corrupt or truncated)");
+    std::set<std::string> skip;
+    for (;;) {
+        Note note;
+        const ChildOutcome outcome = run_in_child(
+            [&] {
+                try {
+                    work(skip, &note);
+                } catch (const InputError&) {
+                    throw;
+                } catch (const std::exception& e) {
+                    throw file_error(note.file().empty() ? path : note.file(), std::string("GDCM failed on it: ") + e.what());
+                }
+            },
+            limits);
+        const std::string where = note.file().empty() ? path : note.file();
+        std::string problem;
+        switch (outcome.kind) {
+        case ChildOutcome::Kind::ok: return skip;
+        case ChildOutcome::Kind::failed: throw InputError(outcome.message);
+        case ChildOutcome::Kind::out_of_memory:
+            problem = "reading it needs more than the memory limit of " + std::to_string(memory_limit_bytes() >> 20) +
+                      " MiB (corrupt, or set --max-memory-mb to raise it)";
+            break;
+        case ChildOutcome::Kind::timed_out:
+            problem = "GDCM did not finish reading it within " + std::to_string(static_cast<int>(limits.seconds)) +
+                      " s (a corrupt file?)";
+            break;
+        case ChildOutcome::Kind::crashed:
+            problem = "not a readable DICOM file: GDCM's reader crashed on it (" + signal_name(outcome.signal) +
+                      "; the file is corrupt or truncated)";
+            break;
+        }
+        if (!folder || !note.header() || where == path || skip.size() >= 1000) throw file_error(where, problem);
+        log::warn("{}: skipped: {}", where, problem);
+        skip.insert(where);
     }
 }
 
@@ -513,14 +533,16 @@ template <class Work> void check_in_child(const std::string& path, Work&& work)
 
 std::vector<DicomSeries> list_dicom_series(const std::string& path)
 {
-    check_in_child(path, [&](Note* note) { (void)list_series(path, note); });
-    return list_series(path, nullptr);
+    const std::set<std::string> skip = checked_in_child(
+        path, [&](const std::set<std::string>& s, Note* note) { (void)list_series(path, s, note); });
+    return list_series(path, skip, nullptr);
 }
 
 Volume read_dicom(const std::string& path, const std::string& series)
 {
-    check_in_child(path, [&](Note* note) { (void)read_series(path, series, note); });
-    return read_series(path, series, nullptr);
+    const std::set<std::string> skip = checked_in_child(
+        path, [&](const std::set<std::string>& s, Note* note) { (void)read_series(path, series, s, note); });
+    return read_series(path, series, skip, nullptr);
 }
 
 } // namespace vox::io
