@@ -140,6 +140,31 @@ def dicom(implicit=False, big_endian=False):
     return b"\0" * 128 + b"DICM" + meta + data
 
 
+def segmentation(layers=2, extra=""):
+    """A 3D Slicer segmentation of the 4 x 4 x 4 volume: "block" (label 1) and "spot" (label 2) in
+    layer 0, and with two layers an overlapping "core" in layer 1."""
+    pairs = ["Segmentation_MasterRepresentation:=Binary labelmap",
+             "Segmentation_ContainedRepresentationNames:=Binary labelmap|",
+             "Segmentation_ReferenceImageExtentOffset:=0 0 0"]
+    segments = [("block", 1, 0, "0.9 0.5 0.4"), ("spot", 2, 0, "0.2 0.6 0.8")] + ([("core", 1, 1, "0.5 0.9 0.5")] if layers == 2 else [])
+    for n, (name, value, layer, color) in enumerate(segments):
+        pairs += [f"Segment{n}_ID:=Segment_{n + 1}", f"Segment{n}_Name:={name}", f"Segment{n}_Color:={color}",
+                  f"Segment{n}_LabelValue:={value}", f"Segment{n}_Layer:={layer}", f"Segment{n}_Extent:=0 3 0 3 0 3",
+                  f"Segment{n}_Tags:=|"]
+    data = bytearray()
+    for v in VOXELS:
+        data.append(v)
+        if layers == 2:
+            data.append(1 if v == 1 else 0)
+    sizes = f"{layers} 4 4 4" if layers == 2 else "4 4 4"
+    directions = ("none " if layers == 2 else "") + "(1.5,0,0) (0,1.5,0) (0,0,2)"
+    kinds = ("list " if layers == 2 else "") + "domain domain domain"
+    head = (f"NRRD0004\ntype: uint8\ndimension: {3 + (layers == 2)}\nspace: left-posterior-superior\nsizes: {sizes}\n"
+            f"space directions: {directions}\nkinds: {kinds}\nencoding: gzip\nspace origin: (10,-20,5)\n"
+            + "\n".join(pairs) + "\n" + extra + "\n")
+    return head.encode("ascii") + gzip.compress(bytes(data))
+
+
 def triangles(faces):
     return [(f[0], f[i], f[i + 1]) for f in faces for i in range(1, len(f) - 1)]
 
@@ -236,6 +261,8 @@ def main():
     for kind in ("u8", "i16", "f32"):
         seed("inr", f"{kind}.inr", inr(kind))
     seed("inr", "u8.inr.gz", gzip.compress(inr("u8")))
+    seed("segmentation", "two_layers.seg.nrrd", segmentation(2))
+    seed("segmentation", "one_layer.seg.nrrd", segmentation(1))
     seed("dicom", "ct_explicit.dcm", dicom())
     seed("dicom", "ct_implicit.dcm", dicom(implicit=True))
     seed("dicom", "ct_big_endian.dcm", dicom(big_endian=True))

@@ -27,7 +27,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-all=(nifti metaimage nrrd inr dicom vdb obj ply stl off scene recording ccd_queries)
+all=(nifti metaimage nrrd inr dicom segmentation vdb obj ply stl off scene recording ccd_queries)
 [ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 for t in "${targets[@]}"; do
   [ -d "$root/fuzz/corpus/$t" ] || { echo "fuzz/run.sh: unknown target '$t' (targets: ${all[*]})" >&2; exit 2; }

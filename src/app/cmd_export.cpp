@@ -1,4 +1,5 @@
-// voxsculpt export: the object's marching-cubes surface as a mesh file in world millimetres.
+// voxsculpt export: the object's marching-cubes surface as a mesh file in world millimetres, or
+// its voxels as a label map on the scan's grid (.seg.nrrd, .nrrd, .nii.gz).
 
 #include "app/commands.hpp"
 #include "app/selection_options.hpp"
@@ -6,6 +7,7 @@
 #include "core/log.hpp"
 #include "grid/branched_grid.hpp"
 #include "io/mesh_info.hpp"
+#include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/object_import.hpp"
 #include "io/scene_object.hpp"
@@ -25,9 +27,13 @@ void add_export_command(CLI::App& app)
         int level = 1;
     };
     auto args = std::make_shared<Args>();
-    CLI::App* cmd = app.add_subcommand("export", "Write the object's surface (marching cubes on voxel centres) as a mesh");
-    cmd->add_option("input", args->input, "Volume, .vdb or mesh file")->required();
-    cmd->add_option("-o,--output", args->output, "Mesh file: .obj, .ply (with per-vertex labels), .stl or .off")->required();
+    CLI::App* cmd = app.add_subcommand(
+        "export", "Write the object's surface (marching cubes on voxel centres) as a mesh, or its voxels as a label map");
+    cmd->add_option("input", args->input, "Volume, DICOM folder, segmentation, .vdb or mesh file")->required();
+    cmd->add_option("-o,--output", args->output,
+                    "Mesh file (.obj, .ply with per-vertex labels, .stl, .off) or label map on the scan's grid "
+                    "(.seg.nrrd with segment names and colours, .nrrd, .nii, .nii.gz)")
+        ->required();
     add_selection_options(*cmd, args->selection);
     add_mesh_options(*cmd, args->mesh);
     cmd->add_option("--smooth", args->smooth, "Taubin smoothing iterations in rest space (default 0)")
@@ -35,9 +41,16 @@ void add_export_command(CLI::App& app)
     cmd->add_option("--level", args->level, "Level of the elements the surface is embedded in (default 1)")
         ->check(CLI::Range(1, 6));
     cmd->callback([args] {
-        if (!io::is_writable_mesh_path(args->output))
-            throw InputError(args->output + ": the output must end in .obj, .ply, .stl or .off");
+        const bool label_map = io::is_label_map_path(args->output);
+        if (!io::is_writable_mesh_path(args->output) && !label_map)
+            throw InputError(args->output + ": the output must end in .obj, .ply, .stl, .off (a surface) or .seg.nrrd, "
+                                            ".nrrd, .nii, .nii.gz (a label map)");
         const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, args->mesh));
+        if (label_map) {
+            io::write_label_map(labels, args->output);
+            log::info("wrote {}: {} voxels", args->output, labels.active_voxel_count());
+            return;
+        }
         const io::MaterialTable table = io::default_material_table();
         const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }),
                                    table.materials, args->level);

@@ -5,6 +5,8 @@
 #include "core/error.hpp"
 #include "io/dicom_reader.hpp"
 #include "io/file_bytes.hpp"
+#include "io/nrrd_image.hpp"
+#include "io/segmentation.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
 #include "io/object_import.hpp"
@@ -83,6 +85,38 @@ json volume_info(const io::Volume& v, const std::string& path)
         j["labels"] = hist;
     }
     return j;
+}
+
+/// A 3D Slicer segmentation: its grid and its segments (name, ID, colour, layer, label value and
+/// voxels), numbered in file order.
+json segmentation_info(const std::string& path)
+{
+    const std::vector<io::Segment> segments = io::read_segments(path);
+    const io::NrrdImage image = io::read_nrrd_image(path, true);
+    const io::Volume& v = image.layers.front();
+    json list = json::array();
+    for (const io::Segment& s : segments) {
+        std::uint64_t voxels = 0;
+        if (s.layer < static_cast<int>(image.layers.size())) {
+            const io::Volume& layer = image.layers[static_cast<std::size_t>(s.layer)];
+            for (std::int64_t n = 0; n < layer.voxel_count(); ++n) voxels += layer.stored(n) == s.label_value;
+        }
+        list.push_back({{"name", s.name},
+                        {"id", s.id},
+                        {"color", vec(s.color)},
+                        {"layer", s.layer},
+                        {"label_value", s.label_value},
+                        {"voxels", voxels}});
+    }
+    return {{"file", path},
+            {"kind", "segmentation"},
+            {"dimensions", {v.dims[0], v.dims[1], v.dims[2]}},
+            {"spacing_mm", vec(v.spacing())},
+            {"index_to_world", matrix(v.index_to_world)},
+            {"world_bbox_mm", world_bbox(v.index_to_world, Eigen::Vector3d::Zero(),
+                                         Eigen::Vector3d(v.dims[0] - 1, v.dims[1] - 1, v.dims[2] - 1))},
+            {"layers", image.layers.size()},
+            {"segments", list}};
 }
 
 /// The series of a DICOM folder (numbered as --series picks them, no patient identifiers), and the
@@ -183,6 +217,12 @@ void print_text(const json& j)
                             one["modality"].get<std::string>().c_str(), one["size"][0].dump().c_str(),
                             one["size"][1].dump().c_str(), one["size"][2].dump().c_str(),
                             one["description"].get<std::string>().c_str(), one["uid"].get<std::string>().c_str());
+        } else if (key == "segments") {
+            std::printf("segments (name, ID, layer, label value, voxels, colour):\n");
+            for (const json& one : value)
+                std::printf("  %s, %s, layer %s, value %s, %s voxels, colour %s\n", one["name"].get<std::string>().c_str(),
+                            one["id"].get<std::string>().c_str(), one["layer"].dump().c_str(), one["label_value"].dump().c_str(),
+                            one["voxels"].dump().c_str(), human(one["color"]).c_str());
         } else if (key == "volume") {
             std::printf("volume of the series read:\n");
             print_text(value);
@@ -208,7 +248,7 @@ void add_info_command(CLI::App& app)
         std::string series;
     };
     auto args = std::make_shared<Args>();
-    CLI::App* cmd = app.add_subcommand("info", "Describe a volume, DICOM folder, .vdb label grid or mesh file");
+    CLI::App* cmd = app.add_subcommand("info", "Describe a volume, DICOM folder, Slicer segmentation, .vdb label grid or mesh file");
     cmd->add_option("file", args->input, "The file to describe")->required();
     cmd->add_flag("--json", args->as_json, "Print JSON instead of text");
     cmd->add_option("--scale", args->mm_per_unit, "Meshes: millimetres per file unit (default 1)")
@@ -221,6 +261,8 @@ void add_info_command(CLI::App& app)
             j = mesh_info_json(p, args->mm_per_unit);
         else if (p.size() > 4 && p.compare(p.size() - 4, 4, ".vdb") == 0)
             j = vdb_info(p);
+        else if (io::is_segmentation_path(p))
+            j = segmentation_info(p);
         else if (io::is_volume_path(p))
             j = volume_info(io::read_volume(p), p);
         else if (io::is_dicom_path(p))

@@ -12,6 +12,7 @@
 #include "core/log.hpp"
 #include "io/mesh.hpp"
 #include "io/object_import.hpp"
+#include "io/segmentation.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 #include "io/tool_script.hpp"
@@ -66,7 +67,7 @@ void add_render_command(CLI::App& app)
             options.camera.up = scene_up(scene);
             // The scene's object as its method starts it: the same picture as a run's first.
             const sim::OpenedMethod opened = sim::open_method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene)));
-            meshes.push_back(surface_picture(*opened.method, options.smooth));
+            meshes.push_back(surface_picture(*opened.method, options.smooth, scene.object.label_colors));
             const sim::ToolPolicy tools(scene);
             for (std::size_t k = 0; k < scene.tools.size(); ++k) {
                 const io::ToolPose pose = io::tool_pose(scene, k, 0.0);
@@ -80,7 +81,9 @@ void add_render_command(CLI::App& app)
             const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, MeshOptions{}));
             const io::MaterialTable table = io::default_material_table();
             const grid::BranchedGrid g(grid::FineVoxels(labels, [&](std::int32_t l) { return table.index_of(l); }), table.materials, 1);
-            meshes.push_back(surface_drawing(surface::EmbeddedSurface(g, 1).mesh(g), options.smooth));
+            view::LabelColors colors; // a segmentation's own
+            for (const auto& [label, segment] : io::segments_of(labels)) colors[label] = segment.color;
+            meshes.push_back(surface_drawing(surface::EmbeddedSurface(g, 1).mesh(g), options.smooth, colors));
         }
         ScenePictures pictures(options);
         pictures.write(args->out, meshes);

@@ -13,6 +13,7 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/staging_dir.hpp"
+#include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -194,6 +195,16 @@ void add_run_command(CLI::App& app)
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
         write_surface(dir / "final.obj", method);
+        if (!scene.output.volumes.empty()) {
+            const grid::LabelGrid voxels = method.rest_voxels();
+            for (const std::string& format : scene.output.volumes) {
+                const std::filesystem::path file = dir / ("final." + format);
+                if (format == "vdb")
+                    voxels.save(file);
+                else
+                    io::write_label_map(voxels, file);
+            }
+        }
         if (pictures) pictures->write(dir / "final.png", method, tools, scene);
         if (device) {
             sim::write_forces(dir, device->forces(), "force on the device, " + scene.tools[device->tool()].name);

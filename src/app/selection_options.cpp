@@ -48,6 +48,9 @@ io::Selection SelectionOptions::to_selection() const
     io::Selection s;
     if (!threshold.empty()) s = io::parse_threshold(threshold);
     s.labels = labels;
+    s.segments = segments;
+    if (!segments.empty() && (!labels.empty() || !threshold.empty()))
+        throw InputError("--segment cannot be combined with --label or --threshold (a segmentation is selected by segment)");
     s.pieces = piece_selection(*this);
     return s;
 }
@@ -56,6 +59,10 @@ void add_selection_options(CLI::App& cmd, SelectionOptions& options)
 {
     cmd.add_option("--series", options.series,
                    "DICOM folders holding several series: the one to read, by its number in `info` or its UID");
+    cmd.add_option("--segment", options.segments,
+                   "3D Slicer segmentations (.seg.nrrd): keep these segments, by name or ID (comma-separated; labels "
+                   "1, 2, ... in this order, the later winning where they overlap)")
+        ->delimiter(',');
     cmd.add_option("--label", options.labels, "Keep voxels with these stored labels (comma-separated)")
         ->delimiter(',');
     cmd.add_option("--threshold", options.threshold,

@@ -23,6 +23,7 @@ struct SelectionOptions {
     std::uint64_t min_voxels = 0;
     std::vector<std::string> seeds_mm; ///< "X,Y,Z" each
     std::string series;                ///< DICOM folders: --series N|UID
+    std::vector<std::string> segments; ///< 3D Slicer segmentations: --segment NAME,...
     /// Throws InputError when both are given, the threshold text is malformed, or a piece option
     /// is.
     [[nodiscard]] io::Selection to_selection() const;

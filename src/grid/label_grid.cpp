@@ -128,6 +128,13 @@ void LabelGrid::set_metadata(const std::string& key, const std::string& value)
     m_impl->grid->insertMeta(key, openvdb::StringMetadata(value));
 }
 
+void LabelGrid::copy_metadata(const LabelGrid& from)
+{
+    for (auto it = from.m_impl->grid->beginMeta(); it != from.m_impl->grid->endMeta(); ++it)
+        if (it->second && it->second->typeName() == openvdb::StringMetadata::staticTypeName())
+            m_impl->grid->insertMeta(it->first, *it->second);
+}
+
 std::string LabelGrid::metadata(const std::string& key) const
 {
     const auto meta = m_impl->grid->getMetadata<openvdb::StringMetadata>(key);

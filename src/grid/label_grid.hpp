@@ -59,6 +59,8 @@ public:
     /// Free-form metadata kept in the .vdb file (e.g. "source" = the scan it came from).
     void set_metadata(const std::string& key, const std::string& value);
     [[nodiscard]] std::string metadata(const std::string& key) const;
+    /// Takes every string metadata of `from` (its source, scan size, segments) for a grid derived from it.
+    void copy_metadata(const LabelGrid& from);
 
     /// Writes an OpenVDB file holding this one grid (named "labels"), atomically.
     void save(const std::filesystem::path& path) const;

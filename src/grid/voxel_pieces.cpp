@@ -100,7 +100,7 @@ std::uint32_t VoxelPieces::piece_at(const Coord& ijk) const
 LabelGrid keep_pieces(const LabelGrid& labels, const VoxelPieces& pieces, const std::vector<bool>& keep)
 {
     LabelGrid out(labels.index_to_world());
-    out.set_metadata("source", labels.metadata("source"));
+    out.copy_metadata(labels);
     const auto& coords = pieces.voxels();
     const auto& which = pieces.voxel_pieces();
     for (std::size_t v = 0; v < coords.size(); ++v)

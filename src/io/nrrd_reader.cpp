@@ -1,7 +1,8 @@
 // NRRD reader (.nrrd with attached data, .nhdr with a detached data file), after teem's format
 // definition (http://teem.sourceforge.net/nrrd/format.html, magics NRRD0001 to NRRD0005):
 //
-// - The header is the magic line, then "<field>: <desc>" lines, "<key>:=<value>" pairs (ignored) and
+// - The header is the magic line, then "<field>: <desc>" lines, "<key>:=<value>" pairs (kept for
+//   the segmentation reader, io/segmentation.hpp; a repeated key keeps its last value) and
 //   "#" comments, up to the first empty line; attached data starts on the byte after it. Field
 //   names are matched ignoring case and spaces, as teem does ("data file" = "datafile"). Unknown
 //   and repeated fields are refused: a misspelt "space directions" must not silently lose the
@@ -28,6 +29,7 @@
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
 #include "io/text_parsing.hpp"
+#include "io/nrrd_image.hpp"
 #include "io/volume_reader.hpp"
 
 #include <Eigen/Geometry>
@@ -183,7 +185,10 @@ HeaderFields read_header(const std::string& path)
         if (colon == std::string_view::npos)
             throw file_error(path, "header line " + std::to_string(line_no) + " is not '<field>: <value>' ('" +
                                        printable(line) + "')");
-        if (kv == colon) continue;
+        if (kv == colon) {
+            h.pairs[std::string(line.substr(0, kv))] = std::string(line.substr(kv + 2));
+            continue;
+        }
         std::string name;
         for (const char c : line.substr(0, colon))
             if (c != ' ' && c != '\t') name += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -403,7 +408,11 @@ void parse_ascii(const std::string& what, std::string_view text, Volume& v)
 
 } // namespace
 
-Volume read_nrrd(const std::string& path)
+std::map<std::string, std::string> read_nrrd_pairs(const std::string& path) { return read_header(path).pairs; }
+
+Volume read_nrrd(const std::string& path) { return std::move(read_nrrd_image(path, false).layers.front()); }
+
+NrrdImage read_nrrd_image(const std::string& path, bool layered)
 {
     const HeaderFields h = read_header(path);
     auto required = [&](std::string_view field, const char* label) -> const std::string& {
@@ -473,6 +482,7 @@ Volume read_nrrd(const std::string& path)
     if (has_space && directions.empty()) throw file_error(path, "header has a space but no 'space directions'");
     std::vector<std::size_t> spatial;
     std::vector<Eigen::Vector3d> steps;
+    std::int64_t layers = 1;
     for (std::size_t a = 0; a < dim; ++a) {
         bool is_spatial = kinds.empty() || is_domain_kind(kinds[a]);
         Eigen::Vector3d step = Eigen::Vector3d::Zero();
@@ -499,6 +509,8 @@ Volume read_nrrd(const std::string& path)
         if (is_spatial) {
             spatial.push_back(a);
             steps.push_back(step);
+        } else if (layered && a == 0 && sizes[a] > 1) {
+            layers = sizes[a]; // a segmentation's layers: the fastest axis, each sample one layer's label
         } else if (sizes[a] > 1) {
             throw file_error(path, "axis " + std::to_string(a) + " (" + std::to_string(sizes[a]) +
                                        " samples) is not spatial: only scalar volumes are supported, not vector, "
@@ -549,6 +561,9 @@ Volume read_nrrd(const std::string& path)
 
     check_allocation(path, count, scalar_size(v.type));
     const std::uint64_t bytes = count * scalar_size(v.type);
+    // The data's checks count voxels by v.dims: while it is read, layers count as voxels of axis 0.
+    const std::int64_t columns = v.dims[0];
+    v.dims[0] *= layers;
     const std::uint64_t size = file_size(src);
     const std::uint64_t start = line_skip > 0 ? skip_lines(src, src.offset, line_skip) : src.offset;
     const std::uint64_t after = size > start ? size - start : 0;
@@ -577,8 +592,33 @@ Volume read_nrrd(const std::string& path)
     }
     }
     if (encoding != Encoding::ascii && big_endian != (std::endian::native == std::endian::big)) swap_bytes(v);
-    validate(v);
-    return v;
+    v.dims[0] = columns;
+    NrrdImage image;
+    image.pairs = h.pairs;
+    if (layers == 1) {
+        validate(v);
+        image.layers.push_back(std::move(v));
+        return image;
+    }
+    // De-interleave the layers (the fastest axis) into one volume each.
+    const std::size_t width = scalar_size(v.type);
+    const auto voxels = static_cast<std::size_t>(v.voxel_count());
+    for (std::int64_t l = 0; l < layers; ++l) {
+        Volume layer;
+        layer.dims = v.dims;
+        layer.index_to_world = v.index_to_world;
+        layer.type = v.type;
+        layer.scale_slope = v.scale_slope;
+        layer.scale_intercept = v.scale_intercept;
+        layer.source = v.source;
+        layer.data.resize(voxels * width);
+        for (std::size_t n = 0; n < voxels; ++n)
+            std::memcpy(layer.data.data() + n * width,
+                        v.data.data() + (n * static_cast<std::size_t>(layers) + static_cast<std::size_t>(l)) * width, width);
+        image.layers.push_back(std::move(layer));
+    }
+    for (const Volume& layer : image.layers) validate(layer);
+    return image;
 }
 
 } // namespace vox::io

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/dicom_reader.hpp"
+#include "io/segmentation.hpp"
 #include "io/file_bytes.hpp"
 #include "io/mesh.hpp"
 #include "io/mesh_info.hpp"
@@ -25,6 +26,15 @@ grid::LabelGrid import_object(const std::string& path, const ImportOptions& opti
 {
     const bool dicom = !is_mesh_path(path) && !is_volume_path(path) && detail::lower_extension(path) != ".vdb" &&
                        is_dicom_path(path);
+    if (is_segmentation_path(path)) {
+        const Selection& s = options.selection;
+        if (!s.labels.empty() || s.threshold_min || !s.bands.empty())
+            throw file_error(path, "a 3D Slicer segmentation is selected by segment (--segment NAME), not by label or threshold");
+        grid::LabelGrid picked = read_segmentation(path, s.segments);
+        return s.pieces.empty() ? std::move(picked) : select_pieces(picked, s.pieces, path);
+    }
+    if (!options.selection.segments.empty())
+        throw file_error(path, "--segment picks segments of a 3D Slicer segmentation (.seg.nrrd); this is not one");
     if (!options.series.empty() && !dicom)
         throw file_error(path, "--series picks a series of a DICOM folder; this is not one");
     if (dicom) return select_voxels(read_dicom(path, options.series), options.selection);

@@ -1,6 +1,7 @@
 // The scene schema (docs/scene-format.md), walked with the strict JSON reader (io/json_reader.hpp).
 
 #include "io/scene.hpp"
+#include "io/segmentation.hpp"
 
 #include "io/json_reader.hpp"
 #include "io/text_parsing.hpp"
@@ -153,6 +154,20 @@ Selection read_selection(JsonReader r)
 {
     Selection s;
     s.pieces = read_piece_selection(r);
+    if (const std::optional<JsonNode> node = r.optional_node("segment")) {
+        if (r.has("label") || r.has("threshold") || r.has("threshold_bands"))
+            r.node().fail("takes only one of \"segment\", \"label\", \"threshold\", \"threshold_bands\"");
+        const std::vector<JsonNode> items = node->value().is_string() ? std::vector<JsonNode>{*node} : node->elements();
+        if (items.empty()) node->fail("must name at least one segment");
+        for (const JsonNode& item : items) {
+            const auto name = as<std::string>(item);
+            if (std::find(s.segments.begin(), s.segments.end(), name) != s.segments.end())
+                item.fail("segment '" + name + "' is listed twice");
+            s.segments.push_back(name);
+        }
+        r.finish();
+        return s;
+    }
     if (const std::optional<JsonNode> node = r.optional_node("threshold_bands")) {
         if (r.has("label") || r.has("threshold")) r.node().fail("takes only one of \"label\", \"threshold\", \"threshold_bands\"");
         const std::vector<JsonNode> items = node->elements();
@@ -312,6 +327,20 @@ SceneObject read_object(JsonReader r)
         }
         if (const std::optional<JsonNode> select = r.optional_node("select")) {
             o.select = read_selection(JsonReader(*select));
+        }
+        if (is_segmentation_path(o.file.string())) {
+            // Named segments are checked now, before any work; their colours are the pictures'.
+            if (!o.select.labels.empty() || o.select.threshold_min || !o.select.bands.empty())
+                r.required_node("select").fail("a 3D Slicer segmentation is selected by \"segment\" (names), not by label or threshold");
+            const std::vector<Segment> all = read_segments(o.file.string());
+            try {
+                const std::vector<Segment> picked = pick_segments(all, o.select.segments, o.file.string());
+                for (std::size_t k = 0; k < picked.size(); ++k) o.label_colors[static_cast<std::int32_t>(k + 1)] = picked[k].color;
+            } catch (const InputError& e) {
+                r.required_node("select").fail(e.what());
+            }
+        } else if (!o.select.segments.empty()) {
+            r.required_node("select").fail("\"segment\" picks segments of a 3D Slicer segmentation (.seg.nrrd)");
         }
     } else if (kind == "phantom") {
         o.kind = ObjectKind::phantom;
@@ -656,6 +685,14 @@ OutputSettings read_output(JsonReader r, OutputSettings o)
         o.dir = resolved_path(*dir);
     }
     o.mesh_every_n_frames = r.optional("mesh_every_n_frames", o.mesh_every_n_frames, at_least(1));
+    if (const std::optional<JsonNode> volumes = r.optional_node("volumes")) {
+        o.volumes.clear();
+        for (const JsonNode& item : volumes->elements()) {
+            const std::string format(choose(item, {"vdb", "nii.gz", "nii", "nrrd", "seg.nrrd"}));
+            if (std::find(o.volumes.begin(), o.volumes.end(), format) != o.volumes.end()) item.fail("\"" + format + "\" is listed twice");
+            o.volumes.push_back(format);
+        }
+    }
     r.finish();
     return o;
 }

@@ -47,6 +47,9 @@ struct SceneObject {
     /// volume, mesh: the file, absolute (resolved against the scene's folder); it existed when
     /// the scene was read. A volume may be a DICOM folder.
     std::filesystem::path file;
+    /// volume, a 3D Slicer segmentation: the picked segments' colours by label (their colours in
+    /// pictures); empty otherwise.
+    std::map<std::int32_t, Eigen::Vector3d> label_colors;
     /// volume: key "series", the DICOM series read (its number in `info`, or its UID); "": the only one.
     std::string series;
     /// volume: the voxels kept (labels keep their value, a threshold window gives label 1); empty
@@ -342,6 +345,9 @@ struct OutputSettings {
     std::filesystem::path dir;
     /// A surface mesh is written every this many frames (>= 1).
     int mesh_every_n_frames = 10;
+    /// Key "volumes": the formats the final voxels are written in, as final.<format> in rest space
+    /// on the scan's grid: "vdb", "nii.gz", "nii", "nrrd", "seg.nrrd".
+    std::vector<std::string> volumes;
 };
 
 /// A whole scene file, validated; paths absolute.

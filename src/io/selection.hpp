@@ -31,6 +31,9 @@ struct Selection {
     /// Several tissues from one scan (a CT's bone and soft tissue): each band its own label; where
     /// bands overlap the first listed wins. Exclusive with labels and the threshold.
     std::vector<ThresholdBand> bands;
+    /// 3D Slicer segmentations (.seg.nrrd) only, instead of the three above: the segments kept,
+    /// by name or ID, labelled 1, 2, ... in this order (empty: every segment). io/segmentation.hpp.
+    std::vector<std::string> segments;
     PieceSelection pieces;
 
     /// No label, threshold or band: every non-zero voxel, keeping its value (pieces aside).

@@ -61,6 +61,7 @@ inline constexpr std::string_view k_white_space = " \t\r\n\v\f";
 /// The fields of a text header by key, and the byte offset just past the header in its file.
 struct HeaderFields {
     std::map<std::string, std::string, std::less<>> fields;
+    std::map<std::string, std::string> pairs; ///< NRRD's free-form "key:=value" lines, as written
     std::uint64_t end = 0;
 
     /// The value of `key`; nullptr when the header does not have it.

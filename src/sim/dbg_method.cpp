@@ -362,6 +362,16 @@ StepFigures DbgMethod::step()
 
 surface::SurfaceMesh DbgMethod::surface_mesh() const { return m_sim->surface().mesh(m_sim->solver().positions()); }
 
+grid::LabelGrid DbgMethod::rest_voxels() const
+{
+    const grid::FineVoxels& voxels = grid().voxels(); // coordinates in the source's index space
+    grid::LabelGrid out(voxels.index_to_world());
+    out.copy_metadata(*m_labels);
+    for (std::uint32_t v = 0; v < voxels.slots(); ++v)
+        if (voxels.alive(v)) out.set(voxels.coord(v), voxels.label(v));
+    return out;
+}
+
 std::vector<SurfaceMark> DbgMethod::surface_marks() const
 {
     std::vector<SurfaceMark> out;

@@ -16,6 +16,7 @@
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
+#include "grid/label_grid.hpp"
 #include "io/scene.hpp"
 #include "io/tool_script.hpp"
 #include "surface/embedded_surface.hpp"
@@ -128,6 +129,10 @@ public:
 
     /// The deformed surface, world mm, closed along the cuts.
     [[nodiscard]] virtual surface::SurfaceMesh surface_mesh() const = 0;
+    /// The object's voxels in rest space as sculpting left them (removed voxels gone), on the grid
+    /// and with the metadata (source, scan size, segments) of the voxels it was built from: what
+    /// is written back for the scan's own tools (io/label_map_writer.hpp).
+    [[nodiscard]] virtual grid::LabelGrid rest_voxels() const = 0;
     /// Per vertex of surface_mesh(): what it is, and its water content (0..1).
     [[nodiscard]] virtual std::vector<SurfaceMark> surface_marks() const = 0;
     [[nodiscard]] virtual std::vector<float> surface_wetness() const = 0;

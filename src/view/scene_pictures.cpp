@@ -30,13 +30,17 @@ std::pair<int, int> parse_size(const std::string& size)
     throw InputError("--size \"" + size + "\": expected WIDTHxHEIGHT in pixels, each 1 to 8192 (for example 960x720)");
 }
 
-render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth)
+render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth, const LabelColors& colors)
 {
     render::DrawMesh d;
     d.positions.reserve(mesh.positions.size());
     for (const Eigen::Vector3d& p : mesh.positions) d.positions.push_back(p.cast<float>());
     d.colors.reserve(mesh.positions.size());
-    for (std::size_t v = 0; v < mesh.positions.size(); ++v) d.colors.push_back(render::label_color(v < mesh.labels.size() ? mesh.labels[v] : 0));
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+        const std::int32_t label = v < mesh.labels.size() ? mesh.labels[v] : 0;
+        const auto own = colors.find(label);
+        d.colors.push_back(own != colors.end() ? Eigen::Vector3f(own->second.cast<float>()) : render::label_color(label));
+    }
     d.indices.reserve(3 * mesh.triangles.size());
     for (const Eigen::Vector3i& t : mesh.triangles)
         for (int c = 0; c < 3; ++c) d.indices.push_back(static_cast<std::uint32_t>(t[c]));
@@ -97,15 +101,15 @@ void ScenePictures::write(const std::filesystem::path& path, const std::vector<r
 
 void ScenePictures::write(const std::filesystem::path& path, const sim::Method& method, const sim::ToolPolicy& tools, const io::Scene& scene)
 {
-    std::vector<render::DrawMesh> meshes{surface_picture(method, m_options.smooth)};
+    std::vector<render::DrawMesh> meshes{surface_picture(method, m_options.smooth, scene.object.label_colors)};
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
     add_obstacle_drawings(method.obstacles(), meshes.front(), meshes);
     write(path, meshes);
 }
 
-render::DrawMesh surface_picture(const sim::Method& method, int smooth)
+render::DrawMesh surface_picture(const sim::Method& method, int smooth, const LabelColors& colors)
 {
-    render::DrawMesh d = surface_drawing(method.surface_mesh(), smooth);
+    render::DrawMesh d = surface_drawing(method.surface_mesh(), smooth, colors);
     // Cut surfaces lighter, as freshly cut tissue or clay looks; wet material darker and cooler,
     // by its water content (what a sculptor sees on soaked clay).
     const std::vector<sim::SurfaceMark> marks = method.surface_marks();

@@ -12,6 +12,7 @@
 #include "surface/embedded_surface.hpp"
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -30,13 +31,16 @@ struct PictureOptions {
 /// Parses "WxH" (each 1 to 8192); throws InputError naming the value.
 [[nodiscard]] std::pair<int, int> parse_size(const std::string& size);
 
+/// Colours by label that replace the palette's (a segmentation's own colours), RGB 0..1.
+using LabelColors = std::map<std::int32_t, Eigen::Vector3d>;
+
 /// The surface mesh (world mm, labels per vertex) as a drawable mesh, smoothed for display by
-/// `smooth` Taubin iterations.
-[[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth);
+/// `smooth` Taubin iterations; coloured by `colors`, else by the label palette.
+[[nodiscard]] render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth, const LabelColors& colors = {});
 /// A method's deformed surface as drawn: label colours, wet material darker, the surface cuts
 /// made in a lighter, pinker tone, and where the cuts could not separate all pieces of an
 /// element (sim::SurfaceMark::coupled) in orange.
-[[nodiscard]] render::DrawMesh surface_picture(const sim::Method& method, int smooth);
+[[nodiscard]] render::DrawMesh surface_picture(const sim::Method& method, int smooth, const LabelColors& colors = {});
 /// The fine voxels as boxes where the model has moved them: every face of a voxel not joined to a
 /// neighbour (the object's outside, removed neighbours, faces a cut opened), each corner carried
 /// by its element's trilinear map; coloured by label.

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "sim/dbg_method.hpp"
 #include "view/scene_pictures.hpp"
@@ -167,14 +168,12 @@ void ViewSimulation::save() const
         for (const char* name : {"view_surface.obj", "view_surface.ply", "view_surface.stl"})
             io::write_mesh((dir / name).string(), m.positions, m.triangles, m.labels);
         log::info("saved the deformed surface to {}.obj, .ply and .stl ({} triangles)", (dir / "view_surface").string(), m.triangles.size());
-        if (const auto* dbg = dynamic_cast<const sim::DbgMethod*>(m_method.get())) { // the voxels left, as the branched grid has them
-            const grid::FineVoxels& voxels = dbg->grid().voxels();
-            grid::LabelGrid kept(voxels.index_to_world());
-            for (std::uint32_t v = 0; v < voxels.slots(); ++v)
-                if (voxels.alive(v)) kept.set(voxels.coord(v), voxels.label(v));
-            kept.save(dir / "view_object.vdb");
-            log::info("saved the object's {} voxels to {}", voxels.alive_count(), (dir / "view_object.vdb").string());
-        }
+        // The voxels left, in rest space on the scan's grid: for OpenVDB, and for 3D Slicer and ITK.
+        const grid::LabelGrid kept = m_method->rest_voxels();
+        kept.save(dir / "view_object.vdb");
+        io::write_label_map(kept, dir / "view_object.seg.nrrd");
+        io::write_label_map(kept, dir / "view_object.nii.gz");
+        log::info("saved the object's {} voxels to {}.vdb, .seg.nrrd and .nii.gz", kept.active_voxel_count(), (dir / "view_object").string());
     } catch (const std::exception& e) {
         log::warn("not saved: {}", e.what()); // the session goes on
     }
@@ -190,7 +189,7 @@ void ViewSimulation::make_picture()
         r.meshes.push_back(voxel_boxes(dbg->simulation()));
         r.smooth = 0;
     } else {
-        r.meshes.push_back(surface_picture(*m_method, 0)); // smoothed by the window's thread
+        r.meshes.push_back(surface_picture(*m_method, 0, m_scene.object.label_colors)); // smoothed by the window's thread
         r.smooth = m_options.smooth;
     }
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) add_tool_drawings(m_tools.placed(k), m_scene.tools[k].push_margin_mm, r.meshes);

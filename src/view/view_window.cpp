@@ -40,7 +40,7 @@ const char* const key_map = "mouse left: move the tool (a stroke)   wheel: neare
                             "SPACE: pause / run   N: one step while paused\n"
                             "+ / -: coarser / finer level (deformation restarts)\n"
                             "C: element cage   V: the fine voxels   L: level of detail\n"
-                            "S: save (.obj, .vdb)   P: screenshot   H, ?: help   Q, ESC: quit";
+                            "S: save (.obj, .vdb, .seg.nrrd, .nii.gz)   P: screenshot   H, ?: help   Q, ESC: quit";
 
 } // namespace
 

@@ -276,13 +276,18 @@ TEST(CrossFormatMalformed, EveryBadVolumeFileIsRefusedNamingIt)
         {"nrrd_vector_axis.nrrd", "not spatial"},
         {"nrrd_wrong_magic.nrrd", "not a NRRD file"},
         {"nrrd_zero_direction.nrrd", "zero length"},
+        {"seg_bad_color.seg.nrrd", "Segment0_Color '230 128 100' is not three numbers from 0 to 1"},
+        {"seg_layers_last.seg.nrrd", "axis 3 (2 samples) is not spatial"},
+        {"seg_missing_layer.seg.nrrd", "segment 'spot' is in layer 3, but the file has 1 layer(s)"},
+        {"seg_no_segments.seg.nrrd", "names no segment (no Segment0_ID key)"},
     };
     const fs::path bad = fs::path(VOX_TEST_DATA_DIR) / "bad";
     std::size_t seen = 0;
     for (const auto& entry : fs::directory_iterator(bad)) {
         const std::string name = entry.path().filename().string();
         const std::string prefix = name.substr(0, name.find('_') + 1);
-        if (prefix != "dicom_" && prefix != "mha_" && prefix != "mhd_" && prefix != "nrrd_" && prefix != "nii_") continue;
+        if (prefix != "dicom_" && prefix != "mha_" && prefix != "mhd_" && prefix != "nrrd_" && prefix != "nii_" && prefix != "seg_")
+            continue;
         SCOPED_TRACE(name);
         ++seen;
         const auto it = expected.find(name);

@@ -1,0 +1,97 @@
+// Round trips with the tools medical users already have: a 3D Slicer segmentation in, selected
+// by segment name, sculpted in a run, and the result out again on the scan's grid, read back by
+// nibabel (Debian's python3-nibabel) for the NIfTI label map.
+
+#include "app/run_command.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace fs = std::filesystem;
+using vox::test::fresh_dir;
+using vox::test::quote;
+using vox::test::run_voxsculpt;
+
+namespace {
+
+std::string head_of(const fs::path& file, std::size_t bytes)
+{
+    std::ifstream in(file, std::ios::binary);
+    std::string text(bytes, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(bytes));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    return text.substr(0, text.find("\n\n"));
+}
+
+} // namespace
+
+TEST(RoundTrip, ASlicerSegmentationSculptedInARunIsWrittenBackOnItsGridWithItsNamesAndColours)
+{
+    const fs::path d = fresh_dir("round_trip_seg");
+    const std::string seg = (d / "liver3.seg.nrrd").string();
+    const std::string write = "/usr/bin/python3 " + quote(VOX_SOURCE_DIR "/tests/io/write_segmentation.py") + " " +
+                              quote(VOX_SOURCE_DIR "/data/liver.inr.gz") + " " + quote(seg);
+    ASSERT_EQ(std::system(write.c_str()), 0) << write;
+    const nlohmann::json counts = nlohmann::json::parse(std::ifstream(seg + ".counts.json"));
+
+    // info lists the three segments with their voxels.
+    const auto info = run_voxsculpt("info " + quote(seg));
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("tumor, Segment_3, layer 1, value 1, " + counts["tumor"].dump() + " voxels"), std::string::npos) << info.out;
+
+    // A sphere carves into the liver's front for 0.3 s; the back is held.
+    std::ofstream(d / "scene.json") << R"({
+        "object": {"volume": "liver3.seg.nrrd", "select": {"segment": ["liver", "tumor"]}, "levels": 3},
+        "materials": {"default": {"youngs_modulus_pa": 3e4, "poisson_ratio": 0.45, "density_kg_m3": 1060}},
+        "solver": {"type": "dbg", "dt_s": 0.01, "preconditioner": "jacobi"},
+        "constraints": [{"type": "fixed", "box_mm": [[0, 100, 80], [270, 220, 190]]}],
+        "tools": [{"name": "loop", "shape": "sphere", "radius_mm": 6, "action": "cut", "cut_mode": "remove"}],
+        "script": [{"t_s": 0.0, "tool": "loop", "position_mm": [120, -10, 120]},
+                   {"t_s": 0.3, "tool": "loop", "position_mm": [120, 40, 120]}],
+        "output": {"dir": "out", "mesh_every_n_frames": 100, "volumes": ["seg.nrrd", "nii.gz", "vdb"]}})";
+    const auto run = run_voxsculpt("run " + quote((d / "scene.json").string()) + " --frames 30");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    for (const char* name : {"final.seg.nrrd", "final.nii.gz", "final.vdb"}) EXPECT_TRUE(fs::exists(d / "out" / name)) << name;
+
+    // The segmentation written back: the input's grid (without its layer axis), the two segments
+    // picked with their names, IDs and colours.
+    const std::string in = head_of(seg, 8192), back = head_of(d / "out" / "final.seg.nrrd", 8192);
+    const auto line = [](const std::string& header, const std::string& key) {
+        const std::size_t at = header.find("\n" + key);
+        return at == std::string::npos ? std::string("(none)") : header.substr(at + 1, header.find('\n', at + 1) - at - 1);
+    };
+    EXPECT_EQ(line(back, "sizes:"), "sizes: 219 177 80");
+    EXPECT_EQ(line(back, "space:"), "space: left-posterior-superior");
+    EXPECT_EQ(line(back, "Segment0_Name"), "Segment0_Name:=liver");
+    EXPECT_EQ(line(back, "Segment1_Name"), "Segment1_Name:=tumor");
+    EXPECT_EQ(line(back, "Segment1_ID"), "Segment1_ID:=Segment_3");
+    EXPECT_EQ(line(back, "Segment1_Color"), "Segment1_Color:=0.56 0.93 0.56");
+
+    // nibabel reads the NIfTI label map: the same grid (RAS: x and y negated), and the carving shows
+    // as fewer liver voxels than selected, the tumor untouched.
+    const std::string check =
+        "import sys, json, numpy as np, nibabel as nib\n"
+        "img = nib.load(sys.argv[1])\n"
+        "a = np.asarray(img.dataobj)\n"
+        "print(json.dumps({'shape': list(a.shape), 'affine': img.affine.tolist(),\n"
+        "                  'liver': int((a == 1).sum()), 'tumor': int((a == 2).sum())}))\n";
+    std::ofstream(d / "check.py") << check;
+    const std::string command = "/usr/bin/python3 " + quote((d / "check.py").string()) + " " +
+                                quote((d / "out" / "final.nii.gz").string()) + " > " + quote((d / "nib.json").string());
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    const nlohmann::json nib = nlohmann::json::parse(std::ifstream(d / "nib.json"));
+    EXPECT_EQ(nib["shape"], nlohmann::json({219, 177, 80}));
+    EXPECT_NEAR(nib["affine"][0][0].get<double>(), -1.234376, 1e-6);
+    EXPECT_NEAR(nib["affine"][1][1].get<double>(), -1.234376, 1e-6);
+    EXPECT_NEAR(nib["affine"][2][2].get<double>(), 1.33333, 1e-6);
+    EXPECT_NEAR(nib["affine"][2][3].get<double>(), 79.9998, 1e-4);
+    EXPECT_EQ(nib["tumor"].get<std::uint64_t>(), counts["tumor"].get<std::uint64_t>());
+    EXPECT_LT(nib["liver"].get<std::uint64_t>(), counts["liver_outside_tumor"].get<std::uint64_t>());
+    EXPECT_GT(nib["liver"].get<std::uint64_t>(), counts["liver_outside_tumor"].get<std::uint64_t>() - 20000);
+}
