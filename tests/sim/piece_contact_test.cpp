@@ -48,6 +48,7 @@ fs::path boxes_obj(const std::string& name, const std::vector<std::pair<Eigen::V
 }
 
 struct Session {
+    std::unique_ptr<const io::Scene> scene; ///< first: the method, tools and loop keep references to it
     std::unique_ptr<Method> method;
     std::unique_ptr<ToolPolicy> tools;
     std::unique_ptr<FrameLoop> loop;
@@ -56,9 +57,10 @@ struct Session {
 
 Session open(const nlohmann::json& doc)
 {
-    const io::Scene s = io::parse_scene(doc, ::testing::TempDir(), "pieces.json");
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(s));
     Session r;
+    r.scene = std::make_unique<const io::Scene>(io::parse_scene(doc, ::testing::TempDir(), "pieces.json"));
+    const io::Scene& s = *r.scene;
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(s));
     r.voxel_mass_kg = labels->voxel_size().prod() * 1e-9 * s.default_material.density_kg_m3;
     r.method = open_method(s, labels).method;
     r.tools = std::make_unique<ToolPolicy>(s);
