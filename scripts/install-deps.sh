@@ -14,7 +14,7 @@ packages=(
   libsuitesparse-dev libopenblas0-serial
   libgdcm-dev
   # the tests' independent readers and writers (run with /usr/bin/python3, Debian's)
-  python3 python3-pydicom python3-numpy python3-nibabel
+  python3 python3-pydicom python3-numpy python3-nibabel python3-meshio
 )
 packages+=("$@") # extra packages a caller needs (fuzz/run.sh: clang)
 

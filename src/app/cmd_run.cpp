@@ -15,6 +15,7 @@
 #include "core/staging_dir.hpp"
 #include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
+#include "io/vtu_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 #include "sim/device_run.hpp"
@@ -28,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <optional>
 
@@ -172,6 +174,20 @@ void add_run_command(CLI::App& app)
                           device->replaying() ? " (a replay follows the recording's levels)" : "");
                 loop.govern_levels(std::move(*governor));
             }
+        const int vtu_every = scene.output.vtu_every_n_frames;
+        if (vtu_every > 0 && !method.fem_mesh())
+            throw scene.error("output.vtu_every_n_frames",
+                              std::string("the ") + method.name() +
+                                  " method does not write its finite-element mesh yet (the sub-tetrahedra of its cut tetrahedra); "
+                                  "run the scene with --solver dbg, or leave the key out");
+        std::vector<std::pair<double, std::string>> vtu_frames;
+        const auto write_fem_mesh = [&](int f, double t) {
+            char name[32];
+            std::snprintf(name, sizeof name, "mesh_%05d.vtu", f);
+            io::write_vtu(*method.fem_mesh(), dir / name);
+            vtu_frames.emplace_back(t, name);
+        };
+        if (vtu_every > 0 && first_frame == 1) write_fem_mesh(0, 0.0);
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
         for (int f = first_frame; f <= frames; ++f) {
             const sim::FrameStats frame = loop.next();
@@ -188,6 +204,7 @@ void add_run_command(CLI::App& app)
                     }
             if (pictures && f % args->render_every == 0) pictures->write(dir / sim::frame_file_name(f, "png"), method, tools, scene);
             if (f % scene.output.mesh_every_n_frames == 0) write_surface(dir / sim::frame_file_name(f, "obj"), method);
+            if (vtu_every > 0 && f % vtu_every == 0) write_fem_mesh(f, frame.t_s);
             progress.update(static_cast<std::uint64_t>(f));
         }
         progress.finish();
@@ -195,6 +212,7 @@ void add_run_command(CLI::App& app)
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
         write_surface(dir / "final.obj", method);
+        if (!vtu_frames.empty()) io::write_pvd(vtu_frames, dir / "mesh.pvd");
         if (!scene.output.volumes.empty()) {
             const grid::LabelGrid voxels = method.rest_voxels();
             for (const std::string& format : scene.output.volumes) {

@@ -150,6 +150,12 @@ public:
     /// Water content of an element in [0, 1] (clamped); softens it by its material's law.
     void set_water(std::uint32_t element, double water);
     [[nodiscard]] double water(std::uint32_t element) const { return m_water.empty() ? 0.0 : m_water[element]; }
+    /// The stiffness scale of an element now: its material's wet law at its water content (1 dry).
+    [[nodiscard]] double stiffness_scale(std::uint32_t element, std::int32_t material) const
+    {
+        if (m_behaviour.empty() || static_cast<std::size_t>(material) >= m_behaviour.size()) return 1.0;
+        return 1.0 - (1.0 - m_behaviour[static_cast<std::size_t>(material)].wet_stiffness_ratio) * water(element);
+    }
     /// Plastic strain of an element (index-aligned frame); zero without plasticity.
     [[nodiscard]] Eigen::Matrix3d plastic_strain(std::uint32_t element) const
     {

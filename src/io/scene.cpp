@@ -685,6 +685,7 @@ OutputSettings read_output(JsonReader r, OutputSettings o)
         o.dir = resolved_path(*dir);
     }
     o.mesh_every_n_frames = r.optional("mesh_every_n_frames", o.mesh_every_n_frames, at_least(1));
+    o.vtu_every_n_frames = r.optional("vtu_every_n_frames", o.vtu_every_n_frames, at_least(1));
     if (const std::optional<JsonNode> volumes = r.optional_node("volumes")) {
         o.volumes.clear();
         for (const JsonNode& item : volumes->elements()) {

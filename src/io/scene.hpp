@@ -348,6 +348,9 @@ struct OutputSettings {
     /// Key "volumes": the formats the final voxels are written in, as final.<format> in rest space
     /// on the scan's grid: "vdb", "nii.gz", "nii", "nrrd", "seg.nrrd".
     std::vector<std::string> volumes;
+    /// Key "vtu_every_n_frames": the finite-element mesh is written as mesh_NNNNN.vtu every this
+    /// many frames, with mesh.pvd listing them for ParaView; 0: never.
+    int vtu_every_n_frames = 0;
 };
 
 /// A whole scene file, validated; paths absolute.

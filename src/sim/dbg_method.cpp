@@ -1,5 +1,7 @@
 #include "sim/dbg_method.hpp"
 
+#include "sim/dbg_fem_mesh.hpp"
+
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/stopwatch.hpp"
@@ -361,6 +363,8 @@ StepFigures DbgMethod::step()
 }
 
 surface::SurfaceMesh DbgMethod::surface_mesh() const { return m_sim->surface().mesh(m_sim->solver().positions()); }
+
+std::optional<io::VtuMesh> DbgMethod::fem_mesh() const { return dbg_fem_mesh(*m_sim); }
 
 grid::LabelGrid DbgMethod::rest_voxels() const
 {

@@ -58,6 +58,7 @@ public:
 
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const override;
     [[nodiscard]] grid::LabelGrid rest_voxels() const override;
+    [[nodiscard]] std::optional<io::VtuMesh> fem_mesh() const override;
     [[nodiscard]] std::vector<SurfaceMark> surface_marks() const override;
     [[nodiscard]] std::vector<float> surface_wetness() const override;
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements_mm() const override;

@@ -19,6 +19,7 @@
 #include "grid/label_grid.hpp"
 #include "io/scene.hpp"
 #include "io/tool_script.hpp"
+#include "io/vtu_writer.hpp"
 #include "surface/embedded_surface.hpp"
 
 #include <nlohmann/json.hpp>
@@ -133,6 +134,9 @@ public:
     /// and with the metadata (source, scan size, segments) of the voxels it was built from: what
     /// is written back for the scan's own tools (io/label_map_writer.hpp).
     [[nodiscard]] virtual grid::LabelGrid rest_voxels() const = 0;
+    /// The finite-element mesh for ParaView (io/vtu_writer.hpp), or nothing when the method cannot
+    /// write it yet.
+    [[nodiscard]] virtual std::optional<io::VtuMesh> fem_mesh() const { return std::nullopt; }
     /// Per vertex of surface_mesh(): what it is, and its water content (0..1).
     [[nodiscard]] virtual std::vector<SurfaceMark> surface_marks() const = 0;
     [[nodiscard]] virtual std::vector<float> surface_wetness() const = 0;

@@ -95,3 +95,50 @@ TEST(RoundTrip, ASlicerSegmentationSculptedInARunIsWrittenBackOnItsGridWithItsNa
     EXPECT_LT(nib["liver"].get<std::uint64_t>(), counts["liver_outside_tumor"].get<std::uint64_t>());
     EXPECT_GT(nib["liver"].get<std::uint64_t>(), counts["liver_outside_tumor"].get<std::uint64_t>() - 20000);
 }
+
+TEST(RoundTrip, TheFiniteElementMeshOfARunReadsInMeshioAndABarStretchedByAKnownForceShowsFOverA)
+{
+    // A 40 x 10 x 10 mm bar (1 mm voxels, 2 mm elements) held at x = 0 and pulled along x by 1 N
+    // at its far end, solved to equilibrium: away from its ends the stress is uniaxial, F / A =
+    // 1 N / 100 mm^2 = 10 kPa, and so is its von Mises stress.
+    const fs::path d = fresh_dir("round_trip_vtu");
+    std::ofstream(d / "bar.json") << R"({
+        "object": {"phantom": {"shape": "beam", "size_mm": [40, 10, 10], "voxel_mm": 1}, "levels": 1},
+        "materials": {"default": {"youngs_modulus_pa": 1e6, "poisson_ratio": 0.3, "density_kg_m3": 1000}},
+        "solver": {"type": "dbg", "mode": "static", "cg_tolerance": 1e-10},
+        "gravity_m_s2": [0, 0, 0],
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [0.6, 11, 11]]}],
+        "loads": [{"box_mm": [[38.6, -1, -1], [41, 11, 11]], "force_n": [1, 0, 0]}],
+        "output": {"dir": "out", "vtu_every_n_frames": 1}})";
+    const auto run = run_voxsculpt("run " + quote((d / "bar.json").string()) + " --frames 2");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    ASSERT_TRUE(fs::exists(d / "out" / "mesh.pvd"));
+
+    const std::string read =
+        "import sys, json, numpy as np, meshio\n"
+        "m = meshio.read(sys.argv[1])\n"
+        "c = m.cells[0]\n"
+        "centre = m.points[c.data].mean(axis=1)\n"
+        "vm = m.cell_data['von_mises_pa'][0]\n"
+        "mid = (centre[:, 0] > 14) & (centre[:, 0] < 26)\n"
+        "print(json.dumps({'type': c.type, 'cells': len(c.data), 'points': len(m.points),\n"
+        "    'fields': sorted(m.cell_data.keys()), 'point_fields': sorted(m.point_data.keys()),\n"
+        "    'mid_min': float(vm[mid].min()), 'mid_max': float(vm[mid].max()),\n"
+        "    'stretch_10_30': float(np.mean(m.point_data['displacement_mm'][np.abs(m.points[:, 0] - 29.5 - m.point_data['displacement_mm'][:, 0]) < 0.01, 0])\n"
+        "                       - np.mean(m.point_data['displacement_mm'][np.abs(m.points[:, 0] - 9.5 - m.point_data['displacement_mm'][:, 0]) < 0.01, 0]))}))\n";
+    std::ofstream(d / "read.py") << read;
+    const std::string command = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " +
+                                quote((d / "out" / "mesh_00002.vtu").string()) + " > " + quote((d / "vtu.json").string());
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    const nlohmann::json m = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
+    EXPECT_EQ(m["type"], "hexahedron");
+    EXPECT_EQ(m["cells"], 20 * 5 * 5);
+    for (const char* field : {"dominant_label", "level", "piece", "plastic_strain", "von_mises_pa", "water", "fraction_label_1"})
+        EXPECT_NE(std::find(m["fields"].begin(), m["fields"].end(), field), m["fields"].end()) << field;
+    EXPECT_EQ(m["point_fields"], nlohmann::json({"displacement_mm", "velocity_mm_s"}));
+    EXPECT_NEAR(m["mid_min"].get<double>(), 1e4, 0.02 * 1e4);
+    EXPECT_NEAR(m["mid_max"].get<double>(), 1e4, 0.02 * 1e4);
+    // Between the node planes at x = 9.5 and 29.5 mm (at rest) the bar stretches by F L / (E A) =
+    // 1 * 0.02 / (1e6 * 1e-4) m = 0.2 mm.
+    EXPECT_NEAR(m["stretch_10_30"].get<double>(), 0.2, 0.01);
+}
