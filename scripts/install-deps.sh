@@ -15,8 +15,11 @@ packages=(
   libgdcm-dev
   # the tests' independent readers and writers (run with /usr/bin/python3, Debian's)
   python3 python3-pydicom python3-numpy python3-nibabel python3-meshio
+  nodejs # npm's gltf-validator checks the .glb files (tests/tools/gltf)
 )
 packages+=("$@") # extra packages a caller needs (fuzz/run.sh: clang)
+# Debian's nodejs comes without npm (NodeSource's includes it).
+command -v npm >/dev/null || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do

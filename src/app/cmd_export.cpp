@@ -7,7 +7,10 @@
 #include "core/log.hpp"
 #include "grid/branched_grid.hpp"
 #include "io/mesh_info.hpp"
+#include "io/glb_writer.hpp"
 #include "io/label_map_writer.hpp"
+#include "io/segmentation.hpp"
+#include "render/draw_mesh.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/object_import.hpp"
 #include "io/scene_object.hpp"
@@ -31,7 +34,7 @@ void add_export_command(CLI::App& app)
         "export", "Write the object's surface (marching cubes on voxel centres) as a mesh, or its voxels as a label map");
     cmd->add_option("input", args->input, "Volume, DICOM folder, segmentation, .vdb or mesh file")->required();
     cmd->add_option("-o,--output", args->output,
-                    "Mesh file (.obj, .ply with per-vertex labels, .stl, .off) or label map on the scan's grid "
+                    "Mesh file (.obj, .ply with per-vertex labels, .stl, .off, .glb coloured per label) or label map on the scan's grid "
                     "(.seg.nrrd with segment names and colours, .nrrd, .nii, .nii.gz)")
         ->required();
     add_selection_options(*cmd, args->selection);
@@ -42,8 +45,9 @@ void add_export_command(CLI::App& app)
         ->check(CLI::Range(1, 6));
     cmd->callback([args] {
         const bool label_map = io::is_label_map_path(args->output);
-        if (!io::is_writable_mesh_path(args->output) && !label_map)
-            throw InputError(args->output + ": the output must end in .obj, .ply, .stl, .off (a surface) or .seg.nrrd, "
+        const bool glb = args->output.size() > 4 && args->output.compare(args->output.size() - 4, 4, ".glb") == 0;
+        if (!io::is_writable_mesh_path(args->output) && !label_map && !glb)
+            throw InputError(args->output + ": the output must end in .obj, .ply, .stl, .off, .glb (a surface) or .seg.nrrd, "
                                             ".nrrd, .nii, .nii.gz (a label map)");
         const grid::LabelGrid labels = io::import_object(args->input, import_options(args->selection, args->mesh));
         if (label_map) {
@@ -57,7 +61,16 @@ void add_export_command(CLI::App& app)
         surface::EmbeddedSurface s(g, args->level);
         if (args->smooth > 0) s.smooth(g, args->smooth);
         const surface::SurfaceMesh m = s.mesh(g);
-        io::write_mesh(args->output, m.positions, m.triangles, m.labels);
+        if (glb) {
+            std::map<std::int32_t, io::Segment> segments; // a segmentation's own colours and names
+            for (auto& [label, segment] : io::segments_of(labels)) segments[label] = segment;
+            io::write_glb(
+                args->output, m.positions, m.triangles, m.labels,
+                [&](std::int32_t l) { return segments.count(l) ? segments[l].color : Eigen::Vector3d(render::label_color(l).cast<double>()); },
+                [&](std::int32_t l) { return segments.count(l) ? segments[l].name : "label " + std::to_string(l); });
+        } else {
+            io::write_mesh(args->output, m.positions, m.triangles, m.labels);
+        }
         io::TriangleMesh t{m.positions, m.triangles};
         const io::MeshInfo info = io::mesh_info(t);
         log::info("wrote {}: {} triangles, {} vertices, {}, enclosed volume {:.6g} mm^3", args->output,

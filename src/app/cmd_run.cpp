@@ -7,12 +7,14 @@
 // a run that fails leaves nothing behind.
 
 #include "app/commands.hpp"
+#include "render/draw_mesh.hpp"
 #include "view/scene_pictures.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "core/staging_dir.hpp"
+#include "io/glb_writer.hpp"
 #include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/vtu_writer.hpp"
@@ -212,6 +214,18 @@ void add_run_command(CLI::App& app)
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
         write_surface(dir / "final.obj", method);
+        {
+            const surface::SurfaceMesh m = method.surface_mesh();
+            const auto color_of = [&](std::int32_t label) {
+                const auto own = scene.object.label_colors.find(label);
+                return own != scene.object.label_colors.end() ? own->second : Eigen::Vector3d(render::label_color(label).cast<double>());
+            };
+            const auto name_of = [&](std::int32_t label) {
+                const auto own = scene.object.label_names.find(label);
+                return own != scene.object.label_names.end() ? own->second : "label " + std::to_string(label);
+            };
+            io::write_glb(dir / "final.glb", m.positions, m.triangles, m.labels, color_of, name_of);
+        }
         if (!vtu_frames.empty()) io::write_pvd(vtu_frames, dir / "mesh.pvd");
         if (!scene.output.volumes.empty()) {
             const grid::LabelGrid voxels = method.rest_voxels();
@@ -232,7 +246,7 @@ void add_run_command(CLI::App& app)
         }
         write_atomically(dir / "stats.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << record.document().dump(1) << '\n'; });
         staging.commit();
-        log::info("wrote {}: stats.json, final.obj and {} frame meshes; mean step {:.2f} ms, max displacement {:.3f} mm", out.string(),
+        log::info("wrote {}: stats.json, final.obj, final.glb and {} frame meshes; mean step {:.2f} ms, max displacement {:.3f} mm", out.string(),
                   frames / scene.output.mesh_every_n_frames - (first_frame - 1) / scene.output.mesh_every_n_frames,
                   record.total_step_ms() / std::max(frames - first_frame + 1, 1),
                   record.last_step().max_displacement_mm);

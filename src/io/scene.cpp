@@ -335,7 +335,10 @@ SceneObject read_object(JsonReader r)
             const std::vector<Segment> all = read_segments(o.file.string());
             try {
                 const std::vector<Segment> picked = pick_segments(all, o.select.segments, o.file.string());
-                for (std::size_t k = 0; k < picked.size(); ++k) o.label_colors[static_cast<std::int32_t>(k + 1)] = picked[k].color;
+                for (std::size_t k = 0; k < picked.size(); ++k) {
+                    o.label_colors[static_cast<std::int32_t>(k + 1)] = picked[k].color;
+                    o.label_names[static_cast<std::int32_t>(k + 1)] = picked[k].name;
+                }
             } catch (const InputError& e) {
                 r.required_node("select").fail(e.what());
             }

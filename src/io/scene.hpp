@@ -50,6 +50,7 @@ struct SceneObject {
     /// volume, a 3D Slicer segmentation: the picked segments' colours by label (their colours in
     /// pictures); empty otherwise.
     std::map<std::int32_t, Eigen::Vector3d> label_colors;
+    std::map<std::int32_t, std::string> label_names; ///< the picked segments' names, by label
     /// volume: key "series", the DICOM series read (its number in `info`, or its UID); "": the only one.
     std::string series;
     /// volume: the voxels kept (labels keep their value, a threshold window gives label 1); empty

@@ -5,13 +5,16 @@
 #include "app/run_command.hpp"
 #include "test_support.hpp"
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cstring>
 #include <iterator>
+#include <sstream>
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
@@ -141,4 +144,68 @@ TEST(RoundTrip, TheFiniteElementMeshOfARunReadsInMeshioAndABarStretchedByAKnownF
     // Between the node planes at x = 9.5 and 29.5 mm (at rest) the bar stretches by F L / (E A) =
     // 1 * 0.02 / (1e6 * 1e-4) m = 0.2 mm.
     EXPECT_NEAR(m["stretch_10_30"].get<double>(), 0.2, 0.01);
+}
+
+namespace {
+
+/// The Khronos glTF validator from the npm registry (tests/tools/gltf, its version locked),
+/// installed once into the temporary folder; the command that runs it on a file.
+std::string gltf_validator()
+{
+    const fs::path dir = fs::temp_directory_path() / "voxsculpt-gltf-validator";
+    const fs::path source = VOX_SOURCE_DIR "/tests/tools/gltf";
+    fs::create_directories(dir);
+    for (const char* file : {"package.json", "package-lock.json", "validate.mjs"})
+        fs::copy_file(source / file, dir / file, fs::copy_options::overwrite_existing);
+    if (!fs::exists(dir / "node_modules" / "gltf-validator")) {
+        const std::string install = "cd " + quote(dir.string()) + " && npm ci --no-audit --no-fund --silent > /dev/null 2>&1";
+        EXPECT_EQ(std::system(install.c_str()), 0) << install << " (needs node and npm, and the npm registry)";
+    }
+    return "node " + quote((dir / "validate.mjs").string());
+}
+
+} // namespace
+
+TEST(RoundTrip, TheLiverIncisionsSurfaceIsAValidGlbInMetresWithGltfsAxes)
+{
+    // The bundled incision for 40 frames: final.glb is checked by the Khronos validator, and its
+    // bounds against the surface's own (final.obj) under +X = x, +Y = z, +Z = -y, metres.
+    const fs::path d = fresh_dir("round_trip_glb");
+    std::ifstream in(VOX_SOURCE_DIR "/data/scenes/liver_incision.json");
+    std::string scene{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string volume = "\"../liver.inr.gz\"";
+    scene.replace(scene.find(volume), volume.size(), "\"" VOX_SOURCE_DIR "/data/liver.inr.gz\"");
+    std::ofstream(d / "incision.json") << scene;
+    const auto run = run_voxsculpt("run " + quote((d / "incision.json").string()) + " --frames 40 --out " + quote((d / "out").string()));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+
+    const std::string command = gltf_validator() + " " + quote((d / "out" / "final.glb").string()) + " > " + quote((d / "report.json").string());
+    const int validated = std::system(command.c_str());
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(d / "report.json"));
+    EXPECT_EQ(validated, 0) << report.dump(1);
+    EXPECT_EQ(report["errors"], 0) << report.dump(1);
+    EXPECT_EQ(report["warnings"], 0) << report.dump(1);
+
+    // The POSITION accessor's bounds against final.obj's vertices (mm, LPS).
+    std::ifstream glb(d / "out" / "final.glb", std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(glb), std::istreambuf_iterator<char>()};
+    std::uint32_t json_length = 0;
+    std::memcpy(&json_length, bytes.data() + 12, 4);
+    const nlohmann::json gltf = nlohmann::json::parse(bytes.substr(20, json_length));
+    const nlohmann::json& position = gltf["accessors"][0];
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+    std::ifstream obj(d / "out" / "final.obj");
+    for (std::string line; std::getline(obj, line);)
+        if (line.rfind("v ", 0) == 0) {
+            std::istringstream s(line.substr(2));
+            Eigen::Vector3d p;
+            s >> p.x() >> p.y() >> p.z();
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+        }
+    EXPECT_NEAR(position["min"][0].get<double>(), 1e-3 * lo.x(), 1e-6);
+    EXPECT_NEAR(position["max"][1].get<double>(), 1e-3 * hi.z(), 1e-6);
+    EXPECT_NEAR(position["min"][2].get<double>(), -1e-3 * hi.y(), 1e-6);
+    EXPECT_NEAR(position["max"][2].get<double>(), -1e-3 * lo.y(), 1e-6);
+    EXPECT_EQ(gltf["materials"][0]["name"], "label 255");
 }
