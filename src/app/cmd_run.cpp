@@ -177,11 +177,6 @@ void add_run_command(CLI::App& app)
                 loop.govern_levels(std::move(*governor));
             }
         const int vtu_every = scene.output.vtu_every_n_frames;
-        if (vtu_every > 0 && !method.fem_mesh())
-            throw scene.error("output.vtu_every_n_frames",
-                              std::string("the ") + method.name() +
-                                  " method does not write its finite-element mesh yet (the sub-tetrahedra of its cut tetrahedra); "
-                                  "run the scene with --solver dbg, or leave the key out");
         std::vector<std::pair<double, std::string>> vtu_frames;
         const auto write_fem_mesh = [&](int f, double t) {
             char name[32];

@@ -1,5 +1,7 @@
 #include "sim/isxfem_method.hpp"
 
+#include "sim/isxfem_fem_mesh.hpp"
+
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/stopwatch.hpp"
@@ -414,5 +416,7 @@ void IsxfemMethod::restore(const Checkpoint& checkpoint)
     m_loads.clear();
     m_cuts_known.clear();
 }
+
+std::optional<io::VtuMesh> IsxfemMethod::fem_mesh() const { return isxfem_fem_mesh(*m_sim, *m_labels, m_level); }
 
 } // namespace vox::sim

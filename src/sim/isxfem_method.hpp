@@ -52,6 +52,7 @@ public:
     [[nodiscard]] surface::SurfaceMesh surface_mesh() const override { return m_sim->surface_mesh(); }
     /// Is-XFEM's cuts separate material and remove none: the voxels it was built from.
     [[nodiscard]] grid::LabelGrid rest_voxels() const override { return m_labels->clone(); }
+    [[nodiscard]] std::optional<io::VtuMesh> fem_mesh() const override;
     [[nodiscard]] std::vector<SurfaceMark> surface_marks() const override;
     [[nodiscard]] std::vector<float> surface_wetness() const override;
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements_mm() const override;

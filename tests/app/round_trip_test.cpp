@@ -209,3 +209,41 @@ TEST(RoundTrip, TheLiverIncisionsSurfaceIsAValidGlbInMetresWithGltfsAxes)
     EXPECT_NEAR(position["max"][2].get<double>(), -1e-3 * lo.y(), 1e-6);
     EXPECT_EQ(gltf["materials"][0]["name"], "label 255");
 }
+
+TEST(RoundTrip, IsXfemsMeshShowsTheCrackAsSubTetrahedraThatPartitionEachCutTetrahedron)
+{
+    // The bundled Is-XFEM bar cut through: after the cut the mesh is two pieces, the cut
+    // tetrahedra written as their sides' sub-tetrahedra; at rest those fill each cut tetrahedron
+    // exactly, so the mesh's rest volume is the uncut one's.
+    const fs::path d = fresh_dir("round_trip_vtu_isxfem");
+    std::ifstream in(VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json");
+    std::string scene{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string output = "\"mesh_every_n_frames\": 10}";
+    scene.replace(scene.find(output), output.size(), "\"mesh_every_n_frames\": 100, \"vtu_every_n_frames\": 30}");
+    std::ofstream(d / "bar.json") << scene;
+    const auto run = run_voxsculpt("run " + quote((d / "bar.json").string()) + " --frames 30 --out " + quote((d / "out").string()));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const std::string read =
+        "import sys, json, numpy as np, meshio\n"
+        "out = {}\n"
+        "for name in ('mesh_00000.vtu', 'mesh_00030.vtu'):\n"
+        "    m = meshio.read(sys.argv[1] + '/' + name)\n"
+        "    c = m.cells[0].data\n"
+        "    rest = m.points - m.point_data['displacement_mm']\n"
+        "    e = rest[c[:, 1:]] - rest[c[:, :1]]\n"
+        "    out[name] = {'type': m.cells[0].type, 'cells': len(c), 'rest_volume': float(np.abs(np.linalg.det(e)).sum() / 6),\n"
+        "                 'pieces': len(set(m.cell_data['piece'][0])), 'cut_cells': int((m.cell_data['region'][0] >= 0).sum())}\n"
+        "print(json.dumps(out))\n";
+    std::ofstream(d / "read.py") << read;
+    const std::string command = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " + quote((d / "out").string()) + " > " +
+                                quote((d / "vtu.json").string());
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    const nlohmann::json m = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
+    const nlohmann::json &before = m["mesh_00000.vtu"], &after = m["mesh_00030.vtu"];
+    EXPECT_EQ(before["type"], "tetra");
+    EXPECT_EQ(before["pieces"], 1);
+    EXPECT_EQ(before["cut_cells"], 0);
+    EXPECT_EQ(after["pieces"], 2);
+    EXPECT_GT(after["cut_cells"].get<int>(), 0);
+    EXPECT_NEAR(after["rest_volume"].get<double>(), before["rest_volume"].get<double>(), 1e-6 * before["rest_volume"].get<double>());
+}
