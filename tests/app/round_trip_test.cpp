@@ -166,15 +166,18 @@ std::string gltf_validator()
 
 } // namespace
 
-TEST(RoundTrip, TheLiverIncisionsSurfaceIsAValidGlbInMetresWithGltfsAxes)
+TEST(RoundTrip, TheLiverIncisionWritesAValidGlbInMetresWithGltfsAxesAndItsMeshForParaView)
 {
     // The bundled incision for 40 frames: final.glb is checked by the Khronos validator, and its
-    // bounds against the surface's own (final.obj) under +X = x, +Y = z, +Z = -y, metres.
+    // bounds against the surface's own (final.obj) under +X = x, +Y = z, +Z = -y, metres; the
+    // finite-element mesh every 20 frames is read by meshio through mesh.pvd.
     const fs::path d = fresh_dir("round_trip_glb");
     std::ifstream in(VOX_SOURCE_DIR "/data/scenes/liver_incision.json");
     std::string scene{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     const std::string volume = "\"../liver.inr.gz\"";
     scene.replace(scene.find(volume), volume.size(), "\"" VOX_SOURCE_DIR "/data/liver.inr.gz\"");
+    const std::string output = "\"mesh_every_n_frames\": 25}";
+    scene.replace(scene.find(output), output.size(), "\"mesh_every_n_frames\": 25, \"vtu_every_n_frames\": 20}");
     std::ofstream(d / "incision.json") << scene;
     const auto run = run_voxsculpt("run " + quote((d / "incision.json").string()) + " --frames 40 --out " + quote((d / "out").string()));
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -208,6 +211,31 @@ TEST(RoundTrip, TheLiverIncisionsSurfaceIsAValidGlbInMetresWithGltfsAxes)
     EXPECT_NEAR(position["min"][2].get<double>(), -1e-3 * hi.y(), 1e-6);
     EXPECT_NEAR(position["max"][2].get<double>(), -1e-3 * lo.y(), 1e-6);
     EXPECT_EQ(gltf["materials"][0]["name"], "label 255");
+
+    // Every mesh mesh.pvd lists, read by meshio: the liver's level-4 hexahedra with all fields.
+    const std::string read =
+        "import sys, os, json, re, meshio\n"
+        "folder = os.path.dirname(sys.argv[1])\n"
+        "files = re.findall(r'file=\"([^\"]+)\"', open(sys.argv[1]).read())\n"
+        "out = []\n"
+        "for f in files:\n"
+        "    m = meshio.read(os.path.join(folder, f))\n"
+        "    out.append({'file': f, 'type': m.cells[0].type, 'cells': len(m.cells[0].data), 'fields': len(m.cell_data),\n"
+        "                'max_von_mises': float(m.cell_data['von_mises_pa'][0].max())})\n"
+        "print(json.dumps(out))\n";
+    std::ofstream(d / "read.py") << read;
+    const std::string meshio = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " + quote((d / "out" / "mesh.pvd").string()) +
+                               " > " + quote((d / "vtu.json").string());
+    ASSERT_EQ(std::system(meshio.c_str()), 0) << meshio;
+    const nlohmann::json meshes = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
+    ASSERT_EQ(meshes.size(), 3u); // frames 0, 20 and 40
+    for (const nlohmann::json& m : meshes) {
+        EXPECT_EQ(m["type"], "hexahedron");
+        EXPECT_GT(m["cells"].get<int>(), 1200);
+        EXPECT_EQ(m["fields"], 7); // level, piece, dominant label, fraction of label 255, plastic strain, water, von Mises
+    }
+    EXPECT_LT(meshes[0]["max_von_mises"].get<double>(), 1e-6); // at rest: rounding only
+    EXPECT_GT(meshes[2]["max_von_mises"].get<double>(), 0.0);
 }
 
 TEST(RoundTrip, IsXfemsMeshShowsTheCrackAsSubTetrahedraThatPartitionEachCutTetrahedron)
