@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
 
 namespace vox::test {
@@ -57,6 +58,23 @@ void expect_refused(const std::function<void()>& f, const std::string& file, con
     const std::string message = error_of(f);
     EXPECT_EQ(message.rfind(file, 0), 0u) << "message does not start with the file: " << message;
     EXPECT_NE(message.find(problem), std::string::npos) << "message lacks '" << problem << "': " << message;
+}
+
+std::string quote(const std::string& s)
+{
+    std::string out = "'";
+    for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+int run_python(const std::string& script, const std::vector<std::string>& args, const std::string& output)
+{
+    std::string command = "/usr/bin/python3 " + quote(script);
+    for (const std::string& a : args) command += " " + quote(a);
+    if (!output.empty()) command += " > " + quote(output);
+    const int status = std::system(command.c_str());
+    if (status != 0) ADD_FAILURE() << command << " exited with status " << status;
+    return status;
 }
 
 } // namespace vox::test

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace vox::test {
 
@@ -32,6 +33,14 @@ public:
 private:
     std::filesystem::path m_root;
 };
+
+/// Single-quotes `s` for the shell.
+[[nodiscard]] std::string quote(const std::string& s);
+
+/// Runs Debian's /usr/bin/python3 (the tests' independent readers and writers come from its
+/// packages: pydicom, nibabel, meshio) on `script` with `args`, each quoted; its standard output
+/// goes to `output` when given. Returns the exit status (0: it ran and succeeded).
+int run_python(const std::string& script, const std::vector<std::string>& args, const std::string& output = "");
 
 /// The message of the InputError `f` throws; adds a test failure and returns "" when it throws
 /// none.

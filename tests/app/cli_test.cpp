@@ -244,9 +244,9 @@ TEST(Cli, ADicomFolderIsListedReadInASceneAndNoPatientIdentifierIsWritten)
     // (tests/io/write_dicom_series.py); neither may reach what the program prints or writes.
     const fs::path d = fresh_dir("cli_dicom");
     const std::string dir = (d / "export").string();
-    const std::string write = "/usr/bin/python3 " + quote(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py") + " " +
-                              quote(VOX_SOURCE_DIR "/data/liver.inr.gz") + " " + quote(dir) + " --slices 60 --shuffle";
-    ASSERT_EQ(std::system(write.c_str()), 0) << write;
+    ASSERT_EQ(vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py",
+                                    {VOX_SOURCE_DIR "/data/liver.inr.gz", dir, "--slices", "60", "--shuffle"}),
+              0);
     const auto no_identifier = [](const std::string& text, const std::string& what) {
         EXPECT_EQ(text.find("Test^Liver"), std::string::npos) << what;
         EXPECT_EQ(text.find("VOX-TEST"), std::string::npos) << what;

@@ -38,9 +38,7 @@ TEST(RoundTrip, ASlicerSegmentationSculptedInARunIsWrittenBackOnItsGridWithItsNa
 {
     const fs::path d = fresh_dir("round_trip_seg");
     const std::string seg = (d / "liver3.seg.nrrd").string();
-    const std::string write = "/usr/bin/python3 " + quote(VOX_SOURCE_DIR "/tests/io/write_segmentation.py") + " " +
-                              quote(VOX_SOURCE_DIR "/data/liver.inr.gz") + " " + quote(seg);
-    ASSERT_EQ(std::system(write.c_str()), 0) << write;
+    ASSERT_EQ(vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_segmentation.py", {VOX_SOURCE_DIR "/data/liver.inr.gz", seg}), 0);
     const nlohmann::json counts = nlohmann::json::parse(std::ifstream(seg + ".counts.json"));
 
     // info lists the three segments with their voxels.
@@ -85,9 +83,7 @@ TEST(RoundTrip, ASlicerSegmentationSculptedInARunIsWrittenBackOnItsGridWithItsNa
         "print(json.dumps({'shape': list(a.shape), 'affine': img.affine.tolist(),\n"
         "                  'liver': int((a == 1).sum()), 'tumor': int((a == 2).sum())}))\n";
     std::ofstream(d / "check.py") << check;
-    const std::string command = "/usr/bin/python3 " + quote((d / "check.py").string()) + " " +
-                                quote((d / "out" / "final.nii.gz").string()) + " > " + quote((d / "nib.json").string());
-    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    ASSERT_EQ(vox::test::run_python((d / "check.py").string(), {(d / "out" / "final.nii.gz").string()}, (d / "nib.json").string()), 0);
     const nlohmann::json nib = nlohmann::json::parse(std::ifstream(d / "nib.json"));
     EXPECT_EQ(nib["shape"], nlohmann::json({219, 177, 80}));
     EXPECT_NEAR(nib["affine"][0][0].get<double>(), -1.234376, 1e-6);
@@ -130,9 +126,7 @@ TEST(RoundTrip, TheFiniteElementMeshOfARunReadsInMeshioAndABarStretchedByAKnownF
         "    'stretch_10_30': float(np.mean(m.point_data['displacement_mm'][np.abs(m.points[:, 0] - 29.5 - m.point_data['displacement_mm'][:, 0]) < 0.01, 0])\n"
         "                       - np.mean(m.point_data['displacement_mm'][np.abs(m.points[:, 0] - 9.5 - m.point_data['displacement_mm'][:, 0]) < 0.01, 0]))}))\n";
     std::ofstream(d / "read.py") << read;
-    const std::string command = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " +
-                                quote((d / "out" / "mesh_00002.vtu").string()) + " > " + quote((d / "vtu.json").string());
-    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    ASSERT_EQ(vox::test::run_python((d / "read.py").string(), {(d / "out" / "mesh_00002.vtu").string()}, (d / "vtu.json").string()), 0);
     const nlohmann::json m = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
     EXPECT_EQ(m["type"], "hexahedron");
     EXPECT_EQ(m["cells"], 20 * 5 * 5);
@@ -224,9 +218,7 @@ TEST(RoundTrip, TheLiverIncisionWritesAValidGlbInMetresWithGltfsAxesAndItsMeshFo
         "                'max_von_mises': float(m.cell_data['von_mises_pa'][0].max())})\n"
         "print(json.dumps(out))\n";
     std::ofstream(d / "read.py") << read;
-    const std::string meshio = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " + quote((d / "out" / "mesh.pvd").string()) +
-                               " > " + quote((d / "vtu.json").string());
-    ASSERT_EQ(std::system(meshio.c_str()), 0) << meshio;
+    ASSERT_EQ(vox::test::run_python((d / "read.py").string(), {(d / "out" / "mesh.pvd").string()}, (d / "vtu.json").string()), 0);
     const nlohmann::json meshes = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
     ASSERT_EQ(meshes.size(), 3u); // frames 0, 20 and 40
     for (const nlohmann::json& m : meshes) {
@@ -263,9 +255,7 @@ TEST(RoundTrip, IsXfemsMeshShowsTheCrackAsSubTetrahedraThatPartitionEachCutTetra
         "                 'pieces': len(set(m.cell_data['piece'][0])), 'cut_cells': int((m.cell_data['region'][0] >= 0).sum())}\n"
         "print(json.dumps(out))\n";
     std::ofstream(d / "read.py") << read;
-    const std::string command = "/usr/bin/python3 " + quote((d / "read.py").string()) + " " + quote((d / "out").string()) + " > " +
-                                quote((d / "vtu.json").string());
-    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    ASSERT_EQ(vox::test::run_python((d / "read.py").string(), {(d / "out").string()}, (d / "vtu.json").string()), 0);
     const nlohmann::json m = nlohmann::json::parse(std::ifstream(d / "vtu.json"));
     const nlohmann::json &before = m["mesh_00000.vtu"], &after = m["mesh_00030.vtu"];
     EXPECT_EQ(before["type"], "tetra");

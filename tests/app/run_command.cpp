@@ -20,13 +20,6 @@ std::string slurp(const std::filesystem::path& p)
 }
 } // namespace
 
-std::string quote(const std::string& s)
-{
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
 CommandResult run_voxsculpt(const std::string& args)
 {
     static std::atomic<int> counter{0};

@@ -1,6 +1,8 @@
 #pragma once
 // Runs the voxsculpt program the way a user does and captures what it printed.
 
+#include "test_support.hpp" // quote()
+
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -16,9 +18,6 @@ struct CommandResult {
 
 /// Runs `voxsculpt ARGS` (ARGS is shell-quoted by the caller) with stdin from /dev/null.
 CommandResult run_voxsculpt(const std::string& args);
-
-/// Single-quotes `s` for the shell.
-std::string quote(const std::string& s);
 
 /// What `voxsculpt info --json FILE` reports (a failed run is a test failure).
 nlohmann::json info_json(const std::filesystem::path& file);

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 using namespace vox::io;
 using vox::test::expect_refused;
@@ -30,14 +31,13 @@ namespace {
 
 const std::string k_liver = VOX_SOURCE_DIR "/data/liver.inr.gz";
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
-
-/// Runs the writer into `dir` with extra options; a failure to run it fails the test.
+/// Runs the writer into `dir` with extra options (space-separated); a failure fails the test.
 void write_series(const std::string& dir, const std::string& options)
 {
-    const std::string command = "/usr/bin/python3 " + quoted(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py") + " " +
-                                quoted(k_liver) + " " + quoted(dir) + " " + options;
-    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    std::vector<std::string> args{k_liver, dir};
+    std::istringstream words(options);
+    for (std::string w; words >> w;) args.push_back(w);
+    vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py", args);
 }
 
 /// The folder of pydicom's sample files, as the installed package reports it.
@@ -239,9 +239,7 @@ TEST(DicomReader, AScannerExportBesideOtherSeriesAndADamagedDicomdirReadsAsPydic
         "        hu = d.pixel_array * float(d.RescaleSlope) + float(d.RescaleIntercept)\n"
         "        f.write(' '.join(str(float(x)) for x in hu.ravel()) + '\\n')\n";
     (void)scratch.write("read.py", script);
-    const std::string command = "/usr/bin/python3 " + quoted(scratch.path("read.py")) + " " + quoted(dir) + " " +
-                                quoted(uid) + " " + quoted(out) + " 2>/dev/null";
-    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    ASSERT_EQ(vox::test::run_python(scratch.path("read.py"), {dir, uid, out}), 0);
     std::ifstream in(out);
     Eigen::Vector3d origin;
     in >> origin.x() >> origin.y() >> origin.z();

@@ -29,15 +29,11 @@ namespace {
 
 const std::string k_liver = VOX_SOURCE_DIR "/data/liver.inr.gz";
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
-
 /// Writes the test segmentation into `dir` and returns its path; its counts are beside it.
 std::string write_segmentation(const ScratchDir& dir)
 {
     const std::string out = dir.path("liver3.seg.nrrd");
-    const std::string command = "/usr/bin/python3 " + quoted(VOX_SOURCE_DIR "/tests/io/write_segmentation.py") + " " +
-                                quoted(k_liver) + " " + quoted(out);
-    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_segmentation.py", {k_liver, out});
     return out;
 }
 
