@@ -272,7 +272,7 @@ void add_info_command(CLI::App& app)
         if (!args->series.empty() && j["kind"] != "DICOM")
             throw file_error(p, "--series picks a series of a DICOM folder; this is not one");
         if (args->as_json)
-            std::cout << j.dump(2) << '\n';
+            std::cout << j.dump(2, ' ', false, json::error_handler_t::replace) << '\n'; // a DICOM description may be Latin-1
         else
             print_text(j);
     });

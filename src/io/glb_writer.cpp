@@ -109,7 +109,7 @@ void write_glb(const std::filesystem::path& path, const std::vector<Eigen::Vecto
                            {"accessors", accessors},
                            {"bufferViews", buffer_views},
                            {"buffers", {{{"byteLength", bin.size()}}}}};
-    std::string text = document.dump();
+    std::string text = document.dump(-1, ' ', false, json::error_handler_t::replace); // segment names may not be UTF-8
     pad(text, ' ');
     std::string glb;
     put_u32(glb, 0x46546C67); // "glTF"

@@ -136,7 +136,8 @@ std::string segment_metadata(const std::vector<Segment>& picked)
                         {"color", {s.color.x(), s.color.y(), s.color.z()}},
                         {"tags", s.tags}});
     }
-    return list.dump();
+    // A name in another encoding than UTF-8 (found by fuzzing) keeps its readable part.
+    return list.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::vector<std::pair<std::int32_t, Segment>> segments_of(const grid::LabelGrid& labels)
