@@ -153,7 +153,6 @@ private:
 struct Scan {
     gdcm::Scanner scanner;
     std::vector<std::string> files;
-    std::uint64_t bytes = 0; ///< of all the files
 
     Scan(const std::string& path, const std::set<std::string>& skip, Note* note)
     {
@@ -171,7 +170,6 @@ struct Scan {
             files = {path};
         }
         if (files.empty()) throw file_error(path, "is an empty folder (expected the files of a DICOM series)");
-        for (const std::string& f : files) bytes += std::filesystem::file_size(f, error);
         add_tags(scanner);
         if (note != nullptr) {
             for (const std::string& f : files) {
