@@ -1,8 +1,7 @@
 #include "sim/dbg_fem_mesh.hpp"
 
 #include "sim/dbg_simulation.hpp"
-
-#include <Eigen/SVD>
+#include "sim/von_mises.hpp"
 
 #include <map>
 #include <numeric>
@@ -86,18 +85,8 @@ io::VtuMesh dbg_fem_mesh(const DbgSimulation& sim)
         // Deformation gradient at the centroid, in the index-aligned frame of the element's data.
         Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
         for (int c = 0; c < 8; ++c) f += (frame.transpose() * x[e.dof_node[static_cast<std::size_t>(c)]]) * e.gradient.row(c);
-        const Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-        Eigen::Matrix3d u = svd.matrixU();
-        const Eigen::Matrix3d w = svd.matrixV();
-        if ((u * w.transpose()).determinant() < 0.0) u.col(2) *= -1.0; // a proper rotation
-        const Eigen::Matrix3d rotation = u * w.transpose();
-        const Eigen::Matrix3d stretch = rotation.transpose() * f;
-        const Eigen::Matrix3d strain = 0.5 * (stretch + stretch.transpose()) - Eigen::Matrix3d::Identity() - plastic_strain;
-        const grid::Lame lame = model.materials()[static_cast<std::size_t>(e.material)].lame;
-        const double scale = solver.stiffness_scale(element, e.material);
-        const Eigen::Matrix3d stress = scale * (lame.lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2.0 * lame.mu * strain);
-        const Eigen::Matrix3d deviator = stress - stress.trace() / 3.0 * Eigen::Matrix3d::Identity();
-        von_mises[i] = std::sqrt(1.5 * deviator.squaredNorm());
+        von_mises[i] = von_mises_pa(f, model.materials()[static_cast<std::size_t>(e.material)].lame, plastic_strain,
+                                    solver.stiffness_scale(element, e.material));
     }
     mesh.cell_scalars = {{"level", std::move(level)},        {"piece", std::move(piece)},
                          {"dominant_label", std::move(dominant)}, {"plastic_strain", std::move(plastic)},

@@ -3,9 +3,9 @@
 #include "grid/label_grid.hpp"
 #include "isxfem/cut_tetrahedron.hpp"
 #include "sim/isxfem_simulation.hpp"
+#include "sim/von_mises.hpp"
 
 #include <Eigen/LU>
-#include <Eigen/SVD>
 
 #include <map>
 #include <numeric>
@@ -44,19 +44,6 @@ std::vector<isxfem::Piece> split_by_cuts(const isxfem::XfemElement& e)
         pieces = std::move(next);
     }
     return pieces;
-}
-
-double von_mises(const Eigen::Matrix3d& f, const grid::Lame& lame)
-{
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d u = svd.matrixU();
-    const Eigen::Matrix3d w = svd.matrixV();
-    if ((u * w.transpose()).determinant() < 0.0) u.col(2) *= -1.0;
-    const Eigen::Matrix3d stretch = (u * w.transpose()).transpose() * f;
-    const Eigen::Matrix3d strain = 0.5 * (stretch + stretch.transpose()) - Eigen::Matrix3d::Identity();
-    const Eigen::Matrix3d stress = lame.lambda * strain.trace() * Eigen::Matrix3d::Identity() + 2.0 * lame.mu * strain;
-    const Eigen::Matrix3d deviator = stress - stress.trace() / 3.0 * Eigen::Matrix3d::Identity();
-    return std::sqrt(1.5 * deviator.squaredNorm());
 }
 
 } // namespace
@@ -103,7 +90,7 @@ io::VtuMesh isxfem_fem_mesh(const IsxfemSimulation& sim, const grid::LabelGrid& 
             }
             cell_root.push_back(e.node[0]);
             region.push_back(-1.0);
-            stress.push_back(von_mises(now * rest_inverse, lame));
+            stress.push_back(von_mises_pa(now * rest_inverse, lame));
             label.push_back(label_at(rest_centroid));
             continue;
         }
@@ -139,7 +126,7 @@ io::VtuMesh isxfem_fem_mesh(const IsxfemSimulation& sim, const grid::LabelGrid& 
                 now.col(k) = e.region_node(static_cast<std::size_t>(k + 1), pattern, x) - e.region_node(0, pattern, x);
             cell_root.push_back(side_entry[pattern]);
             region.push_back(pattern);
-            stress.push_back(von_mises(now * rest_inverse, lame));
+            stress.push_back(von_mises_pa(now * rest_inverse, lame));
             label.push_back(label_at(piece_rest));
         }
     }
