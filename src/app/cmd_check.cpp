@@ -105,7 +105,7 @@ void add_check_command(CLI::App& app)
                         1 << level);
         }
         std::printf("solver: %s, dt %g s, CG tolerance %g, at most %d iterations\n",
-                    scene.solver.type == io::SolverType::dbg ? "dbg" : "isxfem", scene.solver.dt_s,
+                    io::solver_type_name(scene.solver.type).data(), scene.solver.dt_s,
                     scene.solver.cg_tolerance, scene.solver.cg_max_iterations);
         std::printf("constraints: %zu, obstacles: %zu, tools: %zu, script: %zu key frames", scene.constraints.size(),
                     scene.obstacles.size(), scene.tools.size(), scene.script.size());

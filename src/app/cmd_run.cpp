@@ -93,8 +93,8 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--tool", args->tool, "The tool the device drives (default: the scene's first tool)");
     cmd->add_option("--resume", args->resume,
                     "Start from the last stroke of this session journal (a device run writes OUT.journal; docs/journal.md)");
-    cmd->add_option("--solver", args->solver, "Simulate with this method instead of the scene's solver.type: dbg or isxfem")
-        ->check(CLI::IsMember({"dbg", "isxfem"}));
+    cmd->add_option("--solver", args->solver, "Simulate with this method instead of the scene's solver.type: dbg, isxfem or shape_matching")
+        ->check(CLI::IsMember({"dbg", "isxfem", "shape_matching"}));
     cmd->add_option("--render-every", args->render_every,
                     "Also draw DIR/frame_NNNNN.png every N frames and DIR/final.png, headless (offscreen OpenGL)")
         ->check(CLI::PositiveNumber);
@@ -102,7 +102,7 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--size", args->size, "Size of the pictures, WIDTHxHEIGHT (default 960x720)");
     cmd->callback([args] {
         io::Scene scene = io::load_scene(args->scene);
-        if (!args->solver.empty()) io::use_method(scene, args->solver == "isxfem" ? io::SolverType::isxfem : io::SolverType::dbg);
+        if (!args->solver.empty()) io::use_method(scene, io::solver_type_named(args->solver));
         // Options checked up front; pictures only when asked for (no OpenGL context otherwise).
         PictureOptions picture_options;
         picture_options.camera = render::parse_camera(args->camera);

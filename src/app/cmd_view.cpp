@@ -33,8 +33,8 @@ void add_view_command(CLI::App& app)
     cmd->add_option("--device", args->options.device,
                     "What drives the tool: auto (a 6-DoF controller if one can be opened, else the mouse; default), mouse, hid")
         ->check(CLI::IsMember({"auto", "mouse", "hid"}));
-    cmd->add_option("--solver", args->options.solver, "Simulate with this method instead of the scene's solver.type: dbg or isxfem")
-        ->check(CLI::IsMember({"dbg", "isxfem"}));
+    cmd->add_option("--solver", args->options.solver, "Simulate with this method instead of the scene's solver.type: dbg, isxfem or shape_matching")
+        ->check(CLI::IsMember({"dbg", "isxfem", "shape_matching"}));
     cmd->add_option("--out", args->options.out_dir,
                     "Folder for screenshots (P), saved surfaces (S) and the session journal SCENE.journal (default: the current folder)");
     cmd->add_option("--resume", args->options.resume,

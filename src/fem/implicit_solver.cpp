@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "fem/corotation.hpp"
 #include "fem/element_kernel.hpp"
+#include "fem/node_integrator.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -222,6 +223,29 @@ void ImplicitSolver::adopt_preconditioner(ImplicitSolver& previous, const std::v
     set_preconditioner(std::move(previous.m_preconditioner));
     m_last_dt = previous.m_last_dt; // a new dt would invalidate it
     m_preconditioner->blocks_changed(changed_nodes);
+}
+
+ImplicitSolver::~ImplicitSolver() = default;
+ImplicitSolver::ImplicitSolver(ImplicitSolver&&) noexcept = default;
+
+void ImplicitSolver::set_integrator(std::unique_ptr<NodeIntegrator> integrator) { m_integrator = std::move(integrator); }
+
+void ImplicitSolver::add_contact_forces(const std::vector<Eigen::Vector3d>& at, Eigen::VectorXd& f) const
+{
+    for (std::size_t c = 0; c < m_contact.size(); ++c) {
+        const NodeContact& k = m_contact[c];
+        f.segment<3>(static_cast<Eigen::Index>(3 * k.node)) += k.force_n - k.stiffness_n_per_m * (at[k.node] - m_contact_x0[c]);
+    }
+    m_pairs.add_forces(at, f);
+}
+
+std::vector<Eigen::Matrix3d> ImplicitSolver::contact_node_stiffness() const
+{
+    std::vector<Eigen::Matrix3d> k(m_x.size(), Eigen::Matrix3d::Zero());
+    for (const NodeContact& c : m_contact) k[c.node] += c.stiffness_n_per_m;
+    for (const PairContact& p : m_pairs.pairs()) // the node's own block of k c c^T
+        for (const BlockWeight& t : p.terms) k[t.block] += p.stiffness_n_per_m * t.weight * t.weight * p.normal * p.normal.transpose();
+    return k;
 }
 
 void ImplicitSolver::set_preconditioner(std::unique_ptr<Preconditioner> p)
@@ -878,7 +902,11 @@ StepStats ImplicitSolver::step()
 {
     const auto start = std::chrono::steady_clock::now();
     StepStats s;
-    if (!m_options.quasi_static) {
+    if (m_integrator) {
+        s = m_integrator->step(*this);
+        m_element_pass_current = false;
+        m_pairs.settle(m_x); // a contact only pushes
+    } else if (!m_options.quasi_static) {
         m_projected_this_step = false;
         advance(m_options.dt_s, 0, s);
     } else {
@@ -919,7 +947,7 @@ StepStats ImplicitSolver::step()
         }
     }
     s.step_ms = ms_since(start);
-    if (m_options.quasi_static) // dynamic steps measured their end state for the energy check
+    if (m_options.quasi_static && !m_integrator) // dynamic steps measured their end state for the energy check
         s.elastic_energy_j = elastic_energy();
     for (std::size_t i = 0; i < m_x.size(); ++i)
         s.max_displacement_m = std::max(s.max_displacement_m, (m_x[i] - m_model.rest_positions()[i]).norm());

@@ -19,6 +19,8 @@
 
 namespace vox::fem {
 
+class NodeIntegrator;
+
 struct SolverOptions {
     double dt_s = 0.01;
     double cg_tolerance = 1e-6;       ///< relative to the right-hand side's norm
@@ -82,6 +84,8 @@ public:
     /// `same_mesh`: a solver of a model that may have the same elements on the same nodes (the
     /// model before a cut); when it has, its incidence and matrix pattern are reused.
     ImplicitSolver(const HexModel& model, const SolverOptions& options, const ImplicitSolver* same_mesh = nullptr);
+    ~ImplicitSolver();
+    ImplicitSolver(ImplicitSolver&&) noexcept;
 
     /// Holds node `node` (dense index) along the axes whose bits are set in `axes` (1 x, 2 y, 4 z).
     void fix(std::uint32_t node, unsigned axes);
@@ -130,6 +134,22 @@ public:
     void adopt_preconditioner(ImplicitSolver& previous, const std::vector<std::uint32_t>& changed_nodes);
     /// Set when the given preconditioner could not be built and Jacobi took over; empty otherwise.
     [[nodiscard]] const std::string& fallback_note() const { return m_fallback_note; }
+    /// Steps the nodes by `integrator` instead of the corotational FEM (null: back to the FEM).
+    void set_integrator(std::unique_ptr<NodeIntegrator> integrator);
+    [[nodiscard]] const NodeIntegrator* integrator() const { return m_integrator.get(); }
+
+    // What an integrator reads (fem/node_integrator.hpp).
+    [[nodiscard]] const HexModel& model() const { return m_model; }
+    [[nodiscard]] const SolverOptions& options() const { return m_options; }
+    /// Per dof: held by fix() or asleep.
+    [[nodiscard]] const std::vector<unsigned char>& fixed_dofs() const { return m_fixed; }
+    [[nodiscard]] const Eigen::Vector3d& gravity() const { return m_gravity; }
+    /// Adds the tools' and pairs' contact forces at positions `at` to `f` (per dof), each the
+    /// linearised penalty it was set with.
+    void add_contact_forces(const std::vector<Eigen::Vector3d>& at, Eigen::VectorXd& f) const;
+    /// Per node, the contacts' stiffness on it alone (N/m, 3 x 3: the tool's, plus the node's own
+    /// block of each pair's): what an iteration over single nodes takes implicitly.
+    [[nodiscard]] std::vector<Eigen::Matrix3d> contact_node_stiffness() const;
 
     StepStats step();
 
@@ -266,6 +286,7 @@ private:
     std::vector<double> m_element_energy;
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
     std::unique_ptr<Preconditioner> m_preconditioner;
+    std::unique_ptr<NodeIntegrator> m_integrator;
     std::string m_fallback_note;
     std::vector<MaterialBehaviour> m_behaviour;
     std::vector<double> m_water;            ///< per element; empty while everything is dry

@@ -27,7 +27,8 @@ using detail::number_text;
 
 namespace {
 
-constexpr NameTable<SolverType, 2> solver_types{{{"dbg", SolverType::dbg}, {"isxfem", SolverType::isxfem}}};
+constexpr NameTable<SolverType, 3> solver_types{
+    {{"dbg", SolverType::dbg}, {"isxfem", SolverType::isxfem}, {"shape_matching", SolverType::shape_matching}}};
 constexpr NameTable<SolverMode, 2> solver_modes{
     {{"dynamic", SolverMode::dynamic}, {"static", SolverMode::static_equilibrium}}};
 constexpr NameTable<PreconditionerChoice, 4> preconditioners{{{"auto", PreconditionerChoice::automatic},
@@ -489,6 +490,11 @@ SolverSettings read_solver(JsonReader r)
     s.isxfem_k = r.optional("k", s.isxfem_k, closed_range(0.0, 1.0));
     s.isxfem_regularisation_lambda = r.optional("regularisation_lambda", s.isxfem_regularisation_lambda, at_least(0.0));
     s.isxfem_regularisation_threshold = r.optional("regularisation_threshold", s.isxfem_regularisation_threshold, closed_range(0.0, 1.0));
+    s.sm_cluster_levels = r.optional("cluster_levels", s.sm_cluster_levels, closed_range(0, 5));
+    s.sm_adaptive = r.optional("adaptive", s.sm_adaptive);
+    s.sm_max_iterations = r.optional("max_iterations", s.sm_max_iterations, closed_range(1, 100000));
+    s.sm_termination_rate = r.optional("termination_rate", s.sm_termination_rate, open_range(0.0, 1.0));
+    s.sm_subdivision_strain = r.optional("subdivision_strain", s.sm_subdivision_strain, closed_range(0.0, 1.0));
     r.finish();
     return s;
 }
@@ -796,6 +802,20 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
         scene.output = read_output(JsonReader(*output), scene.output);
     }
     return scene;
+}
+
+std::string_view solver_type_name(SolverType type)
+{
+    for (const auto& [name, value] : solver_types)
+        if (value == type) return name;
+    return "dbg";
+}
+
+SolverType solver_type_named(std::string_view name)
+{
+    for (const auto& [text, value] : solver_types)
+        if (text == name) return value;
+    throw InputError("--solver: \"" + std::string(name) + "\" is not a method (dbg, isxfem or shape_matching)");
 }
 
 std::string_view preconditioner_name(PreconditionerChoice p)

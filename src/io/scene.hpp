@@ -126,8 +126,14 @@ enum class PreconditionerChoice { automatic, jacobi, cholesky, multigrid };
 /// "auto", "jacobi", "cholesky" or "multigrid", as scene files write it.
 [[nodiscard]] std::string_view preconditioner_name(PreconditionerChoice p);
 
-/// The cutting approach (see DESIGN.md): dynamic branched grid, or tetrahedra with Is-XFEM.
-enum class SolverType { dbg, isxfem };
+/// The method (see DESIGN.md): dynamic branched grid, tetrahedra with Is-XFEM, or adaptive
+/// hierarchical shape matching on the branched grid's levels.
+enum class SolverType { dbg, isxfem, shape_matching };
+
+/// "dbg", "isxfem" or "shape_matching", as scene files write it.
+[[nodiscard]] std::string_view solver_type_name(SolverType type);
+/// The method a name from that list means (a command line's --solver); throws InputError otherwise.
+[[nodiscard]] SolverType solver_type_named(std::string_view name);
 
 /// What a frame computes.
 enum class SolverMode {
@@ -164,6 +170,16 @@ struct SolverSettings {
     double isxfem_k = 0.1;
     double isxfem_regularisation_lambda = 0.0;     ///< isxfem: A + lambda I on enriched dofs below the threshold (relative to the mean diagonal)
     double isxfem_regularisation_threshold = 1e-4; ///< isxfem: the volume ratio below which an enriched dof is regularised
+    /// shape_matching (shape/shape_matching.hpp): key "cluster_levels", levels of clusters above
+    /// the simulated one (0 .. 5, default 2); "adaptive" (default true: the paper's termination,
+    /// subdivision and origination conditions; false: every level and cluster, classic
+    /// hierarchical shape matching); "max_iterations", shape-matching iterations a step (default
+    /// 60); "termination_rate" in (0, 1) (default 0.01); "subdivision_strain" (default 1e-4).
+    int sm_cluster_levels = 2;
+    bool sm_adaptive = true;
+    int sm_max_iterations = 60;
+    double sm_termination_rate = 0.01;
+    double sm_subdivision_strain = 1e-4;
 };
 
 enum class ConstraintType {

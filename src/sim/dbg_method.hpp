@@ -35,7 +35,8 @@ public:
     DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, std::unique_ptr<grid::BranchedGrid> grid, int level);
     ~DbgMethod() override;
 
-    [[nodiscard]] const char* name() const override { return "dbg"; }
+    /// "dbg", or "shape_matching" when shape matching steps the grid's nodes (sim/dbg_simulation.hpp).
+    [[nodiscard]] const char* name() const override { return io::solver_type_name(m_scene.solver.type).data(); }
     [[nodiscard]] int level() const override { return m_level; }
     [[nodiscard]] std::size_t element_count() const override { return m_sim->model().elements().size(); }
     [[nodiscard]] std::size_t dof_count() const override { return m_sim->solver().dof_count(); }

@@ -1,5 +1,7 @@
 #include "sim/dbg_simulation.hpp"
 
+#include "shape/shape_matching.hpp"
+
 #include "cut/pieces.hpp"
 #include "cut/state_transfer.hpp"
 #include "sim/rigid_parts.hpp"
@@ -36,6 +38,17 @@ fem::SolverOptions solver_options(const io::SolverSettings& s)
     o.quasi_static = s.mode == io::SolverMode::static_equilibrium;
     o.newton_max_iterations = s.newton_max_iterations;
     o.lumped_mass = s.lumped_mass;
+    return o;
+}
+
+shape::Settings shape_settings(const io::SolverSettings& s)
+{
+    shape::Settings o;
+    o.coarse_levels = s.sm_cluster_levels;
+    o.adaptive = s.sm_adaptive;
+    o.max_iterations = s.sm_max_iterations;
+    o.termination_rate = s.sm_termination_rate;
+    o.subdivision_strain = s.sm_subdivision_strain;
     return o;
 }
 
@@ -373,12 +386,17 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     if (choice == io::PreconditionerChoice::multigrid && level >= grid.max_level())
         throw scene.error("solver.preconditioner", "multigrid needs a level coarser than the simulated one");
     fem::SolverOptions options = solver_options(scene.solver);
-    options.matrix_free = choice == io::PreconditionerChoice::jacobi;
+    const bool shape_matching = scene.solver.type == io::SolverType::shape_matching;
+    options.matrix_free = shape_matching || choice == io::PreconditionerChoice::jacobi;
     m_solver = std::make_unique<fem::ImplicitSolver>(model, options, previous_solver);
     fem::ImplicitSolver& solver = *m_solver;
     for (std::uint32_t n = 0; n < model.node_count(); ++n)
         if (held_axes[n]) solver.fix(n, held_axes[n]);
-    switch (choice) {
+    if (shape_matching) {
+        auto integrator = std::make_unique<shape::ShapeMatching>(grid, model, shape_settings(scene.solver));
+        m_linear_solver = integrator->description();
+        solver.set_integrator(std::move(integrator));
+    } else switch (choice) {
     case io::PreconditionerChoice::cholesky:
         solver.set_preconditioner(std::make_unique<fem::RestCholesky>(model.frame()));
         m_linear_solver = "CG, warped Cholesky preconditioner";

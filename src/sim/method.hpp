@@ -87,7 +87,7 @@ class Method {
 public:
     virtual ~Method() = default;
 
-    /// The scene's `solver.type`: "dbg" or "isxfem".
+    /// The scene's `solver.type`: "dbg", "isxfem" or "shape_matching".
     [[nodiscard]] virtual const char* name() const = 0;
     /// The simulated level of the scene's grid.
     [[nodiscard]] virtual int level() const = 0;

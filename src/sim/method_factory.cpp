@@ -28,6 +28,12 @@ OpenedMethod open_method(const io::Scene& scene, std::shared_ptr<const grid::Lab
     // Coarser levels than the simulated one serve only the multigrid preconditioner: every level
     // costs memory and time at each cut, so they are built only when the solver will use it.
     const int level = scene.object.levels, simulated = std::max(level, 1);
+    if (scene.solver.type == io::SolverType::shape_matching) { // the clusters' levels above the simulated one
+        auto grid = std::make_unique<grid::BranchedGrid>(
+            build_scene_grid(scene, *labels, std::min(6, simulated + scene.solver.sm_cluster_levels)));
+        out.method = std::make_unique<DbgMethod>(scene, std::move(labels), std::move(grid), level);
+        return out;
+    }
     auto grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *labels, simulated));
     if (simulated < 6 && wants_multigrid(scene, *grid, level))
         grid = std::make_unique<grid::BranchedGrid>(build_scene_grid(scene, *labels, std::min(6, simulated + 3)));

@@ -39,14 +39,14 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     // The user moves the tools: the script does not.
     io::Scene scene = loaded;
     scene.script.clear();
-    if (!options.solver.empty()) io::use_method(scene, options.solver == "isxfem" ? io::SolverType::isxfem : io::SolverType::dbg);
+    if (!options.solver.empty()) io::use_method(scene, io::solver_type_named(options.solver));
     render::CameraSpec spec = render::parse_camera(options.camera);
     spec.up = scene_up(scene);
     spec.orthographic = false; // the viewer orbits in perspective
     const auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     const int level = std::max(scene.object.levels, 1);
     // The branched grid has two levels above the scene's, for the coarser-level key.
-    int grid_levels = std::min(6, level + 2);
+    int grid_levels = std::min(6, level + std::max(2, scene.solver.type == io::SolverType::shape_matching ? scene.solver.sm_cluster_levels : 0));
     std::unique_ptr<sim::Method> method;
     std::optional<sim::LevelGovernor> governor;
     if (scene.solver.type == io::SolverType::isxfem) {

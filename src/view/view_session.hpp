@@ -25,7 +25,7 @@ struct ViewOptions {
     /// "auto": a 6-DoF controller when one can be opened, else the mouse; "mouse"; "hid" (a
     /// controller, or an error saying why there is none).
     std::string device = "auto";
-    /// "dbg" or "isxfem": simulate with this method instead of the scene's solver.type (empty: the scene's).
+    /// "dbg", "isxfem" or "shape_matching": simulate with this method instead of the scene's solver.type (empty: the scene's).
     std::string solver;
 };
 

@@ -1,0 +1,309 @@
+#include "shape/shape_matching.hpp"
+
+#include "fem/corotation.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace vox::shape {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// Sum over [0, n) of f(i), in parallel.
+template <typename F>
+double parallel_sum(std::size_t n, F&& f)
+{
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, 256), 0.0,
+        [&](const tbb::blocked_range<std::size_t>& r, double s) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) s += f(i);
+            return s;
+        },
+        [](double a, double b) { return a + b; });
+}
+
+} // namespace
+
+ShapeMatching::ShapeMatching(const grid::BranchedGrid& grid, const fem::HexModel& model, const Settings& settings)
+    : m_model(&model), m_settings(settings), m_clusters(grid, model, settings.coarse_levels)
+{
+    for (const ClusterLevel& level : m_clusters.levels()) {
+        m_rotation.emplace_back(level.size(), Eigen::Quaterniond::Identity());
+        m_goal.emplace_back(level.particle.size(), Eigen::Vector3d::Zero());
+        m_energy.emplace_back(level.size(), 0.0);
+        m_active.emplace_back(level.size(), 1);
+        std::vector<std::uint32_t>& cluster = m_member_cluster.emplace_back(level.particle.size());
+        for (std::uint32_t c = 0; c < level.size(); ++c) std::fill(cluster.begin() + level.start[c], cluster.begin() + level.start[c + 1], c);
+    }
+    m_skip.assign(m_clusters.levels().size(), 0);
+}
+
+std::string ShapeMatching::description() const
+{
+    char line[160];
+    std::snprintf(line, sizeof line, "%s hierarchical shape matching, %zu cluster levels (%zu clusters at the simulated level)",
+                  m_settings.adaptive ? "adaptive" : "classic", m_clusters.levels().size(), m_clusters.levels().front().size());
+    return line;
+}
+
+void ShapeMatching::goals(std::size_t level, std::size_t c, const std::vector<Eigen::Vector3d>& p, std::vector<Eigen::Vector3d>& out)
+{
+    const ClusterLevel& l = m_clusters.levels()[level];
+    fit(level, p, {}, std::vector<unsigned char>(l.size(), 1));
+    out.assign(m_goal[level].begin() + l.start[c], m_goal[level].begin() + l.start[c + 1]);
+}
+
+double ShapeMatching::energy(std::size_t level, const std::vector<Eigen::Vector3d>& p)
+{
+    return fit(level, p, {}, std::vector<unsigned char>(m_clusters.levels()[level].size(), 1));
+}
+
+double ShapeMatching::fit(std::size_t level, const std::vector<Eigen::Vector3d>& p, const std::vector<double>& scale,
+                          const std::vector<unsigned char>& active)
+{
+    const ClusterLevel& l = m_clusters.levels()[level];
+    std::vector<Eigen::Quaterniond>& rotation = m_rotation[level];
+    std::vector<Eigen::Vector3d>& goal = m_goal[level];
+    std::vector<double>& energy = m_energy[level];
+    return parallel_sum(l.size(), [&](std::size_t c) {
+        if (!active[c]) return 0.0;
+        const std::uint32_t begin = l.start[c], end = l.start[c + 1];
+        const double s = scale.empty() ? 1.0 : scale[c];
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        double total = 0.0;
+        for (std::uint32_t m = begin; m < end; ++m) {
+            centroid += l.weight[m] * p[l.particle[m]];
+            total += l.weight[m];
+        }
+        centroid /= total;
+        Eigen::Matrix3d a = Eigen::Matrix3d::Zero(); // the moment matrix sum w (p - c) q^T
+        for (std::uint32_t m = begin; m < end; ++m) a += l.weight[m] * (p[l.particle[m]] - centroid) * l.rest[m].transpose();
+        fem::extract_rotation(a, rotation[c]);
+        const Eigen::Matrix3d r = rotation[c].toRotationMatrix();
+        double e = 0.0;
+        for (std::uint32_t m = begin; m < end; ++m) {
+            goal[m] = centroid + r * l.rest[m];
+            e += l.weight[m] * (p[l.particle[m]] - goal[m]).squaredNorm();
+        }
+        energy[c] = 0.5 * s * e;
+        return energy[c];
+    });
+}
+
+fem::StepStats ShapeMatching::step(fem::ImplicitSolver& solver)
+{
+    const auto start = std::chrono::steady_clock::now();
+    fem::StepStats stats;
+    const fem::SolverOptions& options = solver.options();
+    const bool quasi_static = options.quasi_static;
+    const double dt = options.dt_s;
+    const std::vector<double>& mass = m_model->nodal_mass();
+    const std::vector<unsigned char>& fixed = solver.fixed_dofs();
+    std::vector<Eigen::Vector3d>& x = solver.positions();
+    std::vector<Eigen::Vector3d>& v = solver.velocities();
+    const std::size_t n = x.size();
+    const std::size_t levels = m_clusters.levels().size();
+
+    // The particles' own terms: inertia toward y = x + dt v (Rayleigh's mass damping taken
+    // implicitly), the constant loads f, the contacts at their stiffness.
+    const double damping = quasi_static ? 0.0 : 1.0 / (1.0 + dt * options.rayleigh_mass_per_s);
+    std::vector<double> inertia(n, 0.0);
+    std::vector<Eigen::Vector3d> y(n), f(n), p(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        if (!quasi_static) inertia[j] = mass[j] / (dt * dt);
+        y[j] = x[j] + dt * damping * v[j];
+        f[j] = mass[j] * solver.gravity() + solver.external_forces()[j];
+        p[j] = quasi_static ? x[j] : y[j];
+        for (int a = 0; a < 3; ++a)
+            if (fixed[3 * j + static_cast<std::size_t>(a)]) p[j][a] = x[j][a];
+    }
+    const std::vector<Eigen::Matrix3d> contact_stiffness = solver.contact_node_stiffness();
+    const bool has_contact = std::any_of(contact_stiffness.begin(), contact_stiffness.end(), [](const Eigen::Matrix3d& k) { return !k.isZero(); });
+    Eigen::VectorXd contact_force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
+    // Water softens the simulated level's clusters as it softens the FEM's elements.
+    std::vector<double> scale(m_clusters.levels().front().size(), 1.0);
+    for (std::size_t e = 0; e < scale.size(); ++e)
+        scale[e] = solver.stiffness_scale(static_cast<std::uint32_t>(e), m_model->elements()[e].material);
+
+    // Phi's particle terms (inertia and loads, relative to y) and their non-negative part.
+    auto particle_terms = [&](double& positive) {
+        positive = parallel_sum(n, [&](std::size_t j) { return 0.5 * inertia[j] * (p[j] - y[j]).squaredNorm(); });
+        return positive - parallel_sum(n, [&](std::size_t j) { return f[j].dot(p[j] - y[j]); });
+    };
+
+    // One Jacobi pass of `level`: each particle to the minimiser of its terms with the goals fixed.
+    auto move = [&](std::size_t level, const std::vector<double>& level_scale) {
+        const ClusterLevel& l = m_clusters.levels()[level];
+        const std::vector<Eigen::Vector3d>& goal = m_goal[level];
+        const std::vector<unsigned char>& active = m_active[level];
+        if (has_contact) {
+            contact_force.setZero();
+            solver.add_contact_forces(p, contact_force);
+        }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+                double weight = 0.0;
+                for (std::uint32_t k = l.particle_start[j]; k < l.particle_start[j + 1]; ++k) {
+                    const std::uint32_t m = l.particle_member[k];
+                    const std::uint32_t c = m_member_cluster[level][m];
+                    if (!active[c]) continue;
+                    const double w = l.weight[m] * (level_scale.empty() ? 1.0 : level_scale[c]);
+                    pull += w * goal[m];
+                    weight += w;
+                }
+                if (weight == 0.0) continue;
+                Eigen::Vector3d r = inertia[j] * (y[j] - p[j]) + f[j] + pull - weight * p[j];
+                Eigen::Matrix3d d = (inertia[j] + weight) * Eigen::Matrix3d::Identity();
+                if (has_contact) {
+                    r += contact_force.segment<3>(static_cast<Eigen::Index>(3 * j));
+                    d += contact_stiffness[j];
+                }
+                for (int a = 0; a < 3; ++a)
+                    if (fixed[3 * j + static_cast<std::size_t>(a)]) {
+                        r[a] = 0.0;
+                        d.row(a).setZero();
+                        d.col(a).setZero();
+                        d(a, a) = 1.0;
+                    }
+                p[j] += d.ldlt().solve(r);
+            }
+        });
+    };
+
+    // Which levels this step starts from (origination) and how many iterations each may take.
+    std::size_t top = levels - 1;
+    if (m_settings.adaptive)
+        while (top > 0 && m_skip[top] > 0) --top;
+    for (std::size_t l = 0; l < levels; ++l)
+        if (m_skip[l] > 0) --m_skip[l];
+    m_report = StepReport{};
+    m_report.iterations.assign(levels, 0);
+    m_report.active.assign(levels, 0);
+    int budget = m_settings.max_iterations;
+    const double tiny = 1e-300;
+    // Phi is always measured on the simulated level's clusters: coarser levels only propose moves,
+    // kept when they lower it (a coarse cluster is stiffer than the fine ones it spans, and
+    // converging it alone would pull the object toward its own, coarser minimum).
+    const std::vector<unsigned char> every(m_clusters.levels().front().size(), 1);
+    auto measure = [&](const std::vector<unsigned char>& fitted, double& size) {
+        fit(0, p, scale, fitted);
+        double positive = 0.0;
+        const double terms = particle_terms(positive);
+        double elastic = 0.0;
+        for (double e : m_energy[0]) elastic += e; // clusters not fitted count with their last energy
+        size = positive + elastic;
+        return terms + elastic;
+    };
+    double size = 0.0;
+    double phi = measure(every, size);
+    std::vector<Eigen::Vector3d> before;
+    // Cycles through the levels, coarse to fine (the paper's sweep, repeated as a multigrid's
+    // V-cycles: a level's iterations per cycle are capped so that the coarse levels carry on what
+    // the fine ones leave), until a cycle lowers Phi by less than the termination rate or the budget
+    // is spent.
+    for (int cycle = 0; budget > 0; ++cycle) {
+        const double phi_cycle = phi;
+        for (std::size_t level = top + 1; level-- > 0;) {
+            const ClusterLevel& l = m_clusters.levels()[level];
+            const std::vector<double>& level_scale = level == 0 ? scale : std::vector<double>{};
+            // Subdivision: below the top, the children of the clusters still deformed.
+            std::vector<unsigned char>& active = m_active[level];
+            const double threshold = m_settings.subdivision_strain * m_settings.subdivision_strain;
+            std::size_t count = 0;
+            for (std::size_t c = 0; c < l.size(); ++c) {
+                bool on = true;
+                if (m_settings.adaptive && level < top) {
+                    const std::uint32_t parent = l.parent[c];
+                    const ClusterLevel& above = m_clusters.levels()[level + 1];
+                    on = m_active[level + 1][parent] &&
+                         2.0 * m_energy[level + 1][parent] > threshold * above.rest_moment[parent];
+                }
+                active[c] = on ? 1 : 0;
+                count += on ? 1 : 0;
+            }
+            m_report.active[level] = count;
+            // Each finer level keeps at least one iteration of the budget.
+            const int cap = std::max(1, std::min(k_cycle_iterations, budget - static_cast<int>(level)));
+            int it = 0;
+            bool terminated = count == 0;
+            while (it < cap && count > 0) {
+                if (level > 0) { // the simulated level's goals are those of the last measure
+                    fit(level, p, level_scale, active);
+                    before = p;
+                }
+                move(level, level_scale);
+                ++it;
+                double size_now = 0.0;
+                double phi_now = measure(level == 0 ? active : every, size_now);
+                if (level > 0 && phi_now > phi) {
+                    // A coarse move overshoots where its clusters pull particles the fine ones hold:
+                    // shorter steps along it, the first that lowers Phi kept, else none.
+                    const std::vector<Eigen::Vector3d> full = p;
+                    for (double step = 0.5; step > 0.06 && phi_now > phi; step *= 0.5) {
+                        for (std::size_t j = 0; j < n; ++j) p[j] = before[j] + step * (full[j] - before[j]);
+                        phi_now = measure(every, size_now);
+                    }
+                    if (phi_now > phi) {
+                        p = before;
+                        phi_now = measure(every, size_now);
+                    }
+                }
+                const double rate = (phi - phi_now) / std::max({size, size_now, tiny});
+                phi = phi_now;
+                size = size_now;
+                if (cycle == 0 && it == 1 && level > 0 && m_settings.adaptive && rate < m_settings.termination_rate)
+                    m_skip[level] = k_origination_skip;
+                if (rate < m_settings.termination_rate) {
+                    terminated = true;
+                    break;
+                }
+            }
+            (void)terminated;
+            m_report.iterations[level] += it;
+            m_report.total_iterations += it;
+            budget -= it;
+        }
+        if (phi_cycle - phi < m_settings.termination_rate * std::max(size, tiny)) {
+            m_report.converged = true;
+            break;
+        }
+    }
+    // The simulated level's energy at the end, every cluster fitted.
+    std::copy(every.begin(), every.end(), m_active[0].begin());
+    m_report.potential_j = measure(every, size);
+    double elastic = 0.0;
+    for (double e : m_energy[0]) elastic += e;
+    m_report.elastic_energy_j = elastic;
+
+    double kinetic = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+        if (quasi_static) {
+            v[j].setZero();
+        } else {
+            v[j] = (p[j] - x[j]) / dt;
+            for (int a = 0; a < 3; ++a)
+                if (fixed[3 * j + static_cast<std::size_t>(a)]) v[j][a] = 0.0;
+            kinetic += 0.5 * mass[j] * v[j].squaredNorm();
+        }
+        x[j] = p[j];
+    }
+    stats.cg_iterations = m_report.total_iterations; // the step's iterations, as the FEM reports its CG's
+    stats.kinetic_energy_j = kinetic;
+    stats.elastic_energy_j = elastic;
+    stats.converged = m_report.converged;
+    stats.solve_ms = ms_since(start);
+    return stats;
+}
+
+} // namespace vox::shape
