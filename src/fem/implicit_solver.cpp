@@ -239,6 +239,17 @@ void ImplicitSolver::add_contact_forces(const std::vector<Eigen::Vector3d>& at, 
     m_pairs.add_forces(at, f);
 }
 
+double ImplicitSolver::contact_potential(const std::vector<Eigen::Vector3d>& at) const
+{
+    double u = m_pairs.potential(at);
+    for (std::size_t c = 0; c < m_contact.size(); ++c) {
+        const NodeContact& k = m_contact[c];
+        const Eigen::Vector3d d = at[k.node] - m_contact_x0[c];
+        u += -k.force_n.dot(d) + 0.5 * d.dot(k.stiffness_n_per_m * d);
+    }
+    return u;
+}
+
 std::vector<Eigen::Matrix3d> ImplicitSolver::contact_node_stiffness() const
 {
     std::vector<Eigen::Matrix3d> k(m_x.size(), Eigen::Matrix3d::Zero());

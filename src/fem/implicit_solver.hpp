@@ -147,6 +147,13 @@ public:
     /// Adds the tools' and pairs' contact forces at positions `at` to `f` (per dof), each the
     /// linearised penalty it was set with.
     void add_contact_forces(const std::vector<Eigen::Vector3d>& at, Eigen::VectorXd& f) const;
+    /// Lets go of the pair contacts that would pull at positions `at` and lets in the waiting ones
+    /// pressed in there (PairContacts::settle); returns how many changed. An integrator ends its
+    /// step with this, solving again while it changes something, as the FEM's step does.
+    std::size_t settle_pairs(const std::vector<Eigen::Vector3d>& at) { return m_pairs.settle(at); }
+    /// The tools' and pairs' contact potential at positions `at`, J, relative to where they were
+    /// set (-f d + d^T K d / 2 for each, d the move since).
+    [[nodiscard]] double contact_potential(const std::vector<Eigen::Vector3d>& at) const;
     /// Per node, the contacts' stiffness on it alone (N/m, 3 x 3: the tool's, plus the node's own
     /// block of each pair's): what an iteration over single nodes takes implicitly.
     [[nodiscard]] std::vector<Eigen::Matrix3d> contact_node_stiffness() const;
@@ -182,6 +189,8 @@ public:
         return m_plastic.empty() ? Eigen::Matrix3d::Zero() : m_plastic[element];
     }
     [[nodiscard]] bool has_plasticity() const { return !m_plastic.empty(); }
+    /// Per material, as set_materials() gave it (empty before).
+    [[nodiscard]] const std::vector<MaterialBehaviour>& behaviour() const { return m_behaviour; }
     /// Sets an element's plastic strain (carried over when a cut rebuilds the model); ignored
     /// without plasticity.
     void set_plastic_strain(std::uint32_t element, const Eigen::Matrix3d& strain)

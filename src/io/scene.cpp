@@ -492,6 +492,7 @@ SolverSettings read_solver(JsonReader r)
     s.isxfem_regularisation_threshold = r.optional("regularisation_threshold", s.isxfem_regularisation_threshold, closed_range(0.0, 1.0));
     s.sm_cluster_levels = r.optional("cluster_levels", s.sm_cluster_levels, closed_range(0, 5));
     s.sm_adaptive = r.optional("adaptive", s.sm_adaptive);
+    s.sm_global_step = r.optional("global_step", s.sm_global_step);
     s.sm_max_iterations = r.optional("max_iterations", s.sm_max_iterations, closed_range(1, 100000));
     s.sm_termination_rate = r.optional("termination_rate", s.sm_termination_rate, open_range(0.0, 1.0));
     s.sm_subdivision_strain = r.optional("subdivision_strain", s.sm_subdivision_strain, closed_range(0.0, 1.0));
@@ -842,7 +843,7 @@ Scene load_scene(const std::filesystem::path& path)
 
 bool smooths_surface(const SceneObject& object, SolverType solver)
 {
-    return object.smooth_surface.value_or(object.kind != ObjectKind::phantom && solver == SolverType::dbg);
+    return object.smooth_surface.value_or(object.kind != ObjectKind::phantom && solver != SolverType::isxfem);
 }
 
 } // namespace vox::io

@@ -174,9 +174,12 @@ struct SolverSettings {
     /// the simulated one (0 .. 5, default 2); "adaptive" (default true: the paper's termination,
     /// subdivision and origination conditions; false: every level and cluster, classic
     /// hierarchical shape matching); "max_iterations", shape-matching iterations a step (default
-    /// 60); "termination_rate" in (0, 1) (default 0.01); "subdivision_strain" (default 1e-4).
+    /// 60); "termination_rate" in (0, 1) (default 0.01); "subdivision_strain" (default 1e-4);
+    /// "global_step" (default true: the simulated level's iterations solve the global step;
+    /// false: the paper's averaging, particle by particle).
     int sm_cluster_levels = 2;
     bool sm_adaptive = true;
+    bool sm_global_step = true;
     int sm_max_iterations = 60;
     double sm_termination_rate = 0.01;
     double sm_subdivision_strain = 1e-4;

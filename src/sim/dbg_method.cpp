@@ -63,7 +63,8 @@ std::string DbgMethod::linear_solver() const
 std::string DbgMethod::description() const
 {
     char text[256];
-    std::snprintf(text, sizeof text, "branched grid, level %d, %zu elements, %zu degrees of freedom", m_level, element_count(), dof_count());
+    std::snprintf(text, sizeof text, "branched grid%s, level %d, %zu elements, %zu degrees of freedom",
+                  m_scene.solver.type == io::SolverType::shape_matching ? " moved by shape matching" : "", m_level, element_count(), dof_count());
     return text;
 }
 

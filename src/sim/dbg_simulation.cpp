@@ -46,6 +46,7 @@ shape::Settings shape_settings(const io::SolverSettings& s)
     shape::Settings o;
     o.coarse_levels = s.sm_cluster_levels;
     o.adaptive = s.sm_adaptive;
+    o.global_step = s.sm_global_step;
     o.max_iterations = s.sm_max_iterations;
     o.termination_rate = s.sm_termination_rate;
     o.subdivision_strain = s.sm_subdivision_strain;

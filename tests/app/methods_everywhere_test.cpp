@@ -114,7 +114,7 @@ TEST_P(EachMethodEndToEnd, TheViewerShowsThreeScenesInAWindow)
                                     " --device mouse --size 480x360 --exit-after 1 --screenshot " + quote((d / "view.png").string()) + " > " +
                                     quote((d / "log.txt").string()) + " 2>&1";
         ASSERT_EQ(std::system(command.c_str()), 0) << command << "\n" << slurp(d / "log.txt");
-        EXPECT_NE(slurp(d / "log.txt").find(std::string(GetParam()) == "dbg" ? "branched grid" : "Is-XFEM"), std::string::npos)
+        EXPECT_NE(slurp(d / "log.txt").find(std::string(GetParam()) == "dbg" ? "branched grid" : std::string(GetParam()) == "isxfem" ? "Is-XFEM" : "moved by shape matching"), std::string::npos)
             << slurp(d / "log.txt");
         int w = 0, h = 0, channels = 0;
         std::unique_ptr<unsigned char, void (*)(void*)> data(stbi_load((d / "view.png").c_str(), &w, &h, &channels, 3), stbi_image_free);
@@ -130,4 +130,5 @@ TEST_P(EachMethodEndToEnd, TheViewerShowsThreeScenesInAWindow)
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, EachMethodEndToEnd, ::testing::Values("dbg", "isxfem"), [](const auto& info) { return std::string(info.param); });
+INSTANTIATE_TEST_SUITE_P(Methods, EachMethodEndToEnd, ::testing::Values("dbg", "isxfem", "shape_matching"),
+                         [](const auto& method) { return std::string(method.param); });

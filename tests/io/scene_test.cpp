@@ -866,7 +866,7 @@ const BadScene bad_scenes[] = {
     BadScene{"syntax", "line 3 column 29", "syntax error"},
     BadScene{"duplicate_key", "solver.dt_s", "key given twice"},
     BadScene{"threshold_order", "object.select.threshold", "lower bound 3071 is above upper bound 226"},
-    BadScene{"solver_type", "solver.type", "expected one of \"dbg\", \"isxfem\", got \"fem\""},
+    BadScene{"solver_type", "solver.type", "expected one of \"dbg\", \"isxfem\", \"shape_matching\", got \"fem\""},
     BadScene{"solver_mode", "solver.mode", "expected one of \"dynamic\", \"static\", got \"quasistatic\""},
     BadScene{"rayleigh_negative", "solver.rayleigh_mass_per_s", "must be >= 0, got -0.5"},
     BadScene{"newton_zero", "solver.newton_max_iterations", "must be >= 1, got 0"},

@@ -38,9 +38,7 @@ double tip_sag(const Eigen::Vector3d& size_mm, int level, bool shape_matching)
         for (std::uint32_t n : test::nodes_at(model, 0, -0.5e-3)) solver.fix(n, 7);
         solver.set_gravity(Eigen::Vector3d(0, 0, -9.81));
         solver.step();
-        std::printf("iterations");
-        for (int i : integrator->last_step().iterations) std::printf(" %d", i);
-        std::printf(" converged %d\n", integrator->last_step().converged);
+        EXPECT_TRUE(integrator->last_step().converged) << integrator->last_step().total_iterations << " iterations";
         double sag = 0.0;
         for (std::uint32_t n = 0; n < model.node_count(); ++n)
             sag = std::max(sag, model.rest_positions()[n].z() - solver.positions()[n].z());
@@ -67,13 +65,13 @@ double ratio(const Eigen::Vector3d& size_mm, int level)
 
 TEST(ShapeMatchingCalibration, ACantileverSagsAsTheFemDoes)
 {
-    // The calibrated case: within 2 %.
-    EXPECT_NEAR(ratio({32, 4, 4}, 1), 1.0, 0.02);
+    // The calibrated case (measured 1.0044): within 1 %.
+    EXPECT_NEAR(ratio({32, 4, 4}, 1), 1.0, 0.01);
 }
 
 TEST(ShapeMatchingCalibration, OtherBeamsSagWithinTheStatedError)
 {
     // Cases the constant was not fitted to: another level and another section (docs/shape-matching.md).
-    EXPECT_NEAR(ratio({64, 8, 8}, 2), 1.0, 0.15);
-    EXPECT_NEAR(ratio({32, 8, 4}, 1), 1.0, 0.15);
+    EXPECT_NEAR(ratio({64, 8, 8}, 2), 1.0, 0.03);
+    EXPECT_NEAR(ratio({32, 8, 4}, 1), 1.0, 0.03);
 }

@@ -36,16 +36,6 @@ fem::SolverOptions dynamic(double dt = 0.01)
     return o;
 }
 
-/// Phi of ShapeMatching at positions p for a step from x at velocities v (no contact).
-double potential(ShapeMatching& sm, const fem::HexModel& model, const std::vector<Eigen::Vector3d>& p,
-                 const std::vector<Eigen::Vector3d>& y, const Eigen::Vector3d& g, double dt)
-{
-    double phi = sm.energy(0, p);
-    for (std::size_t j = 0; j < p.size(); ++j)
-        phi += 0.5 * model.nodal_mass()[j] / (dt * dt) * (p[j] - y[j]).squaredNorm() - model.nodal_mass()[j] * g.dot(p[j] - y[j]);
-    return phi;
-}
-
 } // namespace
 
 TEST(ShapeMatching, ClustersCoverEveryNodeAndNestInTheirParents)
@@ -98,7 +88,7 @@ TEST(ShapeMatching, RigidMotionsAreReproducedExactly)
     // At rest, turned and moved: nothing moves, no energy.
     fem::StepStats s = b.solver.step();
     for (std::size_t j = 0; j < b.model.node_count(); ++j)
-        EXPECT_LT((b.solver.positions()[j] - (r * b.model.rest_positions()[j] + t)).norm(), 1e-14);
+        EXPECT_LT((b.solver.positions()[j] - (r * b.model.rest_positions()[j] + t)).norm(), 1e-12); // round-off of the global solve
     EXPECT_LT(s.elastic_energy_j, 1e-28);
     // Moving uniformly: it goes on exactly (no damping).
     fem::SolverOptions o = dynamic();
@@ -108,8 +98,8 @@ TEST(ShapeMatching, RigidMotionsAreReproducedExactly)
     for (auto& v : c.solver.velocities()) v = u;
     for (int k = 0; k < 5; ++k) c.solver.step();
     for (std::size_t j = 0; j < c.model.node_count(); ++j) {
-        EXPECT_LT((c.solver.positions()[j] - (c.model.rest_positions()[j] + 0.05 * u)).norm(), 1e-14);
-        EXPECT_LT((c.solver.velocities()[j] - u).norm(), 1e-12);
+        EXPECT_LT((c.solver.positions()[j] - (c.model.rest_positions()[j] + 0.05 * u)).norm(), 1e-12);
+        EXPECT_LT((c.solver.velocities()[j] - u).norm(), 1e-10); // 0.3 m/s to round-off
     }
 }
 
@@ -184,10 +174,13 @@ TEST(ShapeMatching, TheAdaptiveSweepReachesTheFullSweepsPotential)
         auto sm = std::make_unique<ShapeMatching>(b.grid, b.model, settings);
         b.integrator = sm.get();
         b.solver.set_integrator(std::move(sm));
+        // Where the step starts: each particle moved by its velocity and gravity alone, where Phi
+        // is the clusters' energy only (the inertia term is zero there).
         std::vector<Eigen::Vector3d> y = b.solver.positions();
         for (std::size_t j = 0; j < y.size(); ++j)
-            if (!b.solver.fixed_dofs()[3 * j]) y[j] += 0.01 / (1.0 + 0.01 * b.solver.options().rayleigh_mass_per_s) * b.solver.velocities()[j];
-        phi_start = potential(*b.integrator, b.model, y, y, g, 0.01);
+            if (!b.solver.fixed_dofs()[3 * j])
+                y[j] += 0.01 * (b.solver.velocities()[j] + 0.01 * g) / (1.0 + 0.01 * b.solver.options().rayleigh_mass_per_s);
+        phi_start = b.integrator->energy(0, y);
         b.solver.step();
         phi = b.integrator->last_step().potential_j;
         iterations = b.integrator->last_step().total_iterations;
@@ -245,4 +238,43 @@ TEST(ShapeMatching, AKiloNewtonKickStaysBoundedAndSettles)
     }
     std::printf("kicked %.4g m, after 3 s %.4g m, energy %.3g J\n", kicked, farthest(), energy);
     EXPECT_LT(farthest(), 0.1 * kicked);
+}
+
+TEST(ShapeMatching, PlasticityKeepsASculptedShapeAndBoundsTheStrain)
+{
+    // As the FEM's test (tests/fem/solver_modes_test.cpp): push the free end of a clamped bar
+    // sideways, then let go; an elastic bar springs back, a plastic one keeps part of the bend,
+    // its plastic strain never beyond max_strain.
+    double kept[2] = {0.0, 0.0};
+    for (int plastic = 0; plastic < 2; ++plastic) {
+        fem::SolverOptions o;
+        o.quasi_static = true;
+        Settings settings;
+        settings.max_iterations = 20000;
+        settings.termination_rate = 1e-10;
+        Block b({16, 4, 4}, 1, o, settings, 2);
+        fem::MaterialBehaviour behaviour;
+        if (plastic) {
+            behaviour.yield_strain = 0.002;
+            behaviour.creep_per_s = 50.0;
+            behaviour.max_strain = 0.004;
+        }
+        b.solver.set_materials({behaviour});
+        for (std::uint32_t n : nodes_at(b.model, 0, -0.5e-3)) b.solver.fix(n, 7);
+        const std::vector<std::uint32_t> end = nodes_at(b.model, 0, 15.5e-3);
+        for (std::uint32_t n : end) b.solver.external_forces()[n] = Eigen::Vector3d(0, 1e-3, 0) / static_cast<double>(end.size());
+        double loaded = 0.0;
+        for (int k = 0; k < 30; ++k) loaded = b.solver.step().max_displacement_m;
+        for (std::uint32_t n : end) b.solver.external_forces()[n].setZero();
+        fem::StepStats s;
+        // Static frames of shape matching end when an iteration gains too little: the last per
+        // cent of a bend springs back over tens of frames (local-global iterations converge
+        // linearly, slowly where rotations dominate), where the FEM's Newton solve takes one.
+        for (int k = 0; k < 50; ++k) s = b.solver.step();
+        kept[plastic] = s.max_displacement_m / loaded;
+        for (std::uint32_t e = 0; e < b.model.elements().size(); ++e) EXPECT_LE(b.solver.plastic_strain(e).norm(), 0.004 * (1 + 1e-12));
+        std::printf("%s: loaded %.4g mm, kept %.3f of it\n", plastic ? "plastic" : "elastic", loaded * 1e3, kept[plastic]);
+    }
+    EXPECT_LT(kept[0], 1e-3);
+    EXPECT_GT(kept[1], 0.2);
 }

@@ -139,9 +139,9 @@ class JournalOnEachMethod : public ::testing::TestWithParam<io::SolverType> {};
 
 TEST_P(JournalOnEachMethod, AKilledDeviceRunResumesWithTheCutsOfAnUninterruptedRunAtThatStroke)
 {
-    const bool dbg = GetParam() == io::SolverType::dbg;
-    const fs::path dir = fresh_dir(dbg ? "dbg" : "isxfem");
-    const fs::path scene_file = write_scene(dir, dbg ? "dbg" : "isxfem");
+    const std::string method_name(io::solver_type_name(GetParam()));
+    const fs::path dir = fresh_dir(method_name);
+    const fs::path scene_file = write_scene(dir, method_name);
     const io::Scene scene = io::load_scene(scene_file);
     const auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
 
@@ -207,8 +207,8 @@ TEST_P(JournalOnEachMethod, AKilledDeviceRunResumesWithTheCutsOfAnUninterruptedR
     EXPECT_GT(continued.cuts().size(), read.cuts().size());
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, JournalOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
+INSTANTIATE_TEST_SUITE_P(Methods, JournalOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 /// A journal file: the header for `header`, then `lines`.
 fs::path write_journal(const fs::path& dir, const JournalHeader& header, const std::string& lines)

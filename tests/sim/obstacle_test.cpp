@@ -41,7 +41,7 @@ nlohmann::json block_scene(io::SolverType type, const nlohmann::json& obstacles,
 {
     return {{"object", {{"phantom", {{"shape", "block"}, {"size_mm", {40, 20, 10}}}}, {"levels", 2}}},
             {"materials", {{"default", {{"youngs_modulus_pa", 1e5}, {"poisson_ratio", 0.4}, {"density_kg_m3", 1000}}}}},
-            {"solver", {{"type", type == io::SolverType::dbg ? "dbg" : "isxfem"}, {"dt_s", 0.01}}},
+            {"solver", {{"type", std::string(io::solver_type_name(type))}, {"dt_s", 0.01}}},
             {"gravity_m_s2", {gravity.x(), gravity.y(), gravity.z()}},
             {"obstacles", obstacles}};
 }
@@ -162,8 +162,8 @@ TEST_P(Obstacles, ClosedMeshHoldsTheObjectAsTheBoxItIsShapedAs)
     EXPECT_NEAR(on_mesh.method->obstacle_force_n().z(), on_box.method->obstacle_force_n().z(), 1e-6);
 }
 
-INSTANTIATE_TEST_SUITE_P(BothMethods, Obstacles, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const auto& test) { return test.param == io::SolverType::dbg ? "dbg" : "isxfem"; });
+INSTANTIATE_TEST_SUITE_P(BothMethods, Obstacles, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 } // namespace
 } // namespace vox::sim

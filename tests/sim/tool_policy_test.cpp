@@ -96,8 +96,8 @@ TEST_P(EachMethod, ADrivenToolIsWhereTheDeviceSaysAndTheScriptAgainOnceReleased)
     EXPECT_LT(scripted.tools.tools[0].position_mm.z(), 20.5);
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, EachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
+INSTANTIATE_TEST_SUITE_P(Methods, EachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 } // namespace
 } // namespace vox::sim

@@ -24,7 +24,7 @@ TEST_P(UndoOnEachMethod, UndoPutsTheObjectBackStrokeByStroke)
     const io::Scene scene = bar(GetParam());
     auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
     std::unique_ptr<Method> method;
-    if (GetParam() == io::SolverType::dbg) method = std::make_unique<DbgMethod>(scene, labels, 2, 2);
+    if (GetParam() != io::SolverType::isxfem) method = std::make_unique<DbgMethod>(scene, labels, 2, 2);
     else method = std::make_unique<IsxfemMethod>(scene, labels, 2);
     ToolPolicy tools(scene);
     FrameLoop loop(scene, *method, tools);
@@ -53,8 +53,8 @@ TEST_P(UndoOnEachMethod, UndoPutsTheObjectBackStrokeByStroke)
     for (int f = 0; f < 8; ++f) EXPECT_TRUE(loop.next().step.converged); // and it goes on from there
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, UndoOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const auto& info) { return std::string(info.param == io::SolverType::dbg ? "dbg" : "isxfem"); });
+INSTANTIATE_TEST_SUITE_P(Methods, UndoOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 } // namespace
 } // namespace vox::sim

@@ -37,7 +37,7 @@ io::Scene scene(io::SolverType type, const char* unheld)
 {
     nlohmann::json doc = {
         {"object", {{"volume", two_blocks().string()}, {"levels", 1}}},
-        {"solver", {{"type", type == io::SolverType::dbg ? "dbg" : "isxfem"}, {"dt_s", 0.01}}},
+        {"solver", {{"type", std::string(io::solver_type_name(type))}, {"dt_s", 0.01}}},
         {"gravity_m_s2", {0, 0, -9.81}},
         {"constraints", {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {0, 4, 4}}}}}},
     };
@@ -97,10 +97,8 @@ TEST_P(UnheldPieces, AreLeftOutWhenAskedTo)
     EXPECT_GT(lo, hi) << "no vertex of the loose block is left";
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, UnheldPieces, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
-                         [](const ::testing::TestParamInfo<io::SolverType>& p) {
-                             return std::string(p.param == io::SolverType::dbg ? "dbg" : "isxfem");
-                         });
+INSTANTIATE_TEST_SUITE_P(Methods, UnheldPieces, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 } // namespace
 } // namespace vox::sim
