@@ -49,6 +49,7 @@ Run run_method(io::Scene scene, const std::shared_ptr<const grid::LabelGrid>& la
     Run r;
     char name[48];
     if (type == io::SolverType::dbg) std::snprintf(name, sizeof name, "dbg");
+    else if (type == io::SolverType::shape_matching) std::snprintf(name, sizeof name, "shape matching");
     else std::snprintf(name, sizeof name, k > 0.0 ? "Is-XFEM (k = %g)" : "XFEM (k = %g)", k);
     r.method = name;
     r.frames = frames;
@@ -115,20 +116,22 @@ void run_compare(const std::string& scene_path, std::optional<int> frame_count, 
     const double dt = scene.solver.dt_s;
     const double duration = scene.script.empty() ? 0.0 : scene.script.back().t_s;
     const int frames = frame_count.value_or(duration > 0 ? static_cast<int>(std::ceil(duration / dt)) : 100);
-    log::info("{}: {} frames of {} s at level {}, dbg then Is-XFEM (k = 0.1) then XFEM (k = 0)", scene_path, frames, dt, scene.object.levels);
+    log::info("{}: {} frames of {} s at level {}, dbg, Is-XFEM (k = 0.1), XFEM (k = 0), then shape matching", scene_path, frames, dt,
+              scene.object.levels);
     std::vector<Run> runs;
     runs.push_back(run_method(scene, labels, frames, io::SolverType::dbg, scene.solver.isxfem_k));
     runs.push_back(run_method(scene, labels, frames, io::SolverType::isxfem, 0.1));
     runs.push_back(run_method(scene, labels, frames, io::SolverType::isxfem, 0.0));
+    runs.push_back(run_method(scene, labels, frames, io::SolverType::shape_matching, scene.solver.isxfem_k));
 
     std::ostringstream md;
-    md << "# " << scene_path << ": dbg against Is-XFEM (`voxsculpt bench compare`)\n\n"
+    md << "# " << scene_path << ": dbg against Is-XFEM and shape matching (`voxsculpt bench compare`)\n\n"
        << frames << " frames of " << dt << " s at level " << scene.object.levels
        << ", the same tool script and tool policy, cutting tools separating; one run each, machine: " << machine_description()
        << "; times in ms. A frame is the tools (contact, cut, closure) and the step; a cut update is what a cutting frame "
           "spends on the cut itself (propagation, grid update, remesh or closure, model update); volumes are enclosed by "
           "the closed surface.\n\n"
-          "| method | DOFs (start - end) | frame median | frame max | step median | CG iterations (median) | converged steps | "
+          "| method | DOFs (start - end) | frame median | frame max | step median | CG (shape matching: its) iterations (median) | converged steps | "
           "frames held | frames that cut | cut update p95 | volume before - after (mm^3) | surface triangles | pieces |\n"
           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     char line[640];

@@ -1,7 +1,7 @@
 #pragma once
 // voxsculpt bench compare SCENE.json: the same scene, tool script and level simulated by the
-// dynamic branched grid ("dbg") and by Is-XFEM with k = 0.1 and with k = 0 (standard XFEM), side by
-// side: degrees of freedom, step time, CG iterations, cut-update time, volume lost, surface
+// dynamic branched grid ("dbg"), by Is-XFEM with k = 0.1 and with k = 0 (standard XFEM), and by
+// shape matching on the branched grid, side by side, every column by the same code: degrees of freedom, step time, CG iterations, cut-update time, volume lost, surface
 // triangles, whether every step converged, and how far the final surfaces lie apart.
 
 #include <filesystem>

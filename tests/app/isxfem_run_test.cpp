@@ -245,7 +245,7 @@ TEST(IsxfemRun, WhatItCannotDoYetIsRefusedByName)
     EXPECT_FALSE(fs::exists(d / "out" / "stats.json"));
 }
 
-TEST(IsxfemRun, CompareRunsBothMethodsOnTheSameScene)
+TEST(IsxfemRun, CompareRunsEveryMethodOnTheSameScene)
 {
     const fs::path out = fresh_dir("isxfem_compare");
     const auto r = run_voxsculpt("bench compare " + quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/bar_cut_isxfem.json") +
@@ -254,7 +254,7 @@ TEST(IsxfemRun, CompareRunsBothMethodsOnTheSameScene)
     std::ifstream in(out / "compare-bar_cut_isxfem.md");
     std::stringstream md;
     md << in.rdbuf();
-    for (const std::string method : {"| dbg |", "| Is-XFEM (k = 0.1) |", "| XFEM (k = 0) |"}) {
+    for (const std::string method : {"| dbg |", "| Is-XFEM (k = 0.1) |", "| XFEM (k = 0) |", "| shape matching |"}) {
         const std::size_t row = md.str().find(method);
         ASSERT_NE(row, std::string::npos) << method;
         const std::string line = md.str().substr(row, md.str().find('\n', row) - row);
@@ -263,7 +263,7 @@ TEST(IsxfemRun, CompareRunsBothMethodsOnTheSameScene)
     // Every column measured for every method, by the same code: the same figures, none missing.
     std::ifstream json_in(out / "compare-bar_cut_isxfem.json");
     const nlohmann::json data = nlohmann::json::parse(json_in);
-    ASSERT_EQ(data["methods"].size(), 3u);
+    ASSERT_EQ(data["methods"].size(), 4u);
     for (const nlohmann::json& m : data["methods"]) {
         EXPECT_EQ(m.size(), data["methods"][0].size()) << m["method"];
         for (const auto& [key, value] : m.items()) EXPECT_FALSE(value.is_null()) << m["method"] << " " << key;
