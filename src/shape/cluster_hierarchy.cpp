@@ -14,13 +14,7 @@ constexpr double k_weight_floor = 1e-3;
 void finish_cluster(ClusterLevel& level, std::size_t c, const std::vector<Eigen::Vector3d>& rest)
 {
     const std::uint32_t begin = level.start[c], end = level.start[c + 1];
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    double total = 0.0;
-    for (std::uint32_t m = begin; m < end; ++m) {
-        centroid += level.weight[m] * rest[level.particle[m]];
-        total += level.weight[m];
-    }
-    centroid /= total;
+    const Eigen::Vector3d centroid = level.centroid(c, rest);
     double moment = 0.0;
     for (std::uint32_t m = begin; m < end; ++m) {
         level.rest[m] = rest[level.particle[m]] - centroid;

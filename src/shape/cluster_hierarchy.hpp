@@ -44,6 +44,17 @@ struct ClusterLevel {
     std::vector<std::uint32_t> particle_start;  ///< per particle, into particle_member; one more than particles
     std::vector<std::uint32_t> particle_member; ///< members grouped by particle
     [[nodiscard]] std::size_t size() const { return start.empty() ? 0 : start.size() - 1; }
+    /// The weighted centroid of cluster c's particles at positions `x` (per particle).
+    [[nodiscard]] Eigen::Vector3d centroid(std::size_t c, const std::vector<Eigen::Vector3d>& x) const
+    {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        double total = 0.0;
+        for (std::uint32_t m = start[c]; m < start[c + 1]; ++m) {
+            sum += weight[m] * x[particle[m]];
+            total += weight[m];
+        }
+        return sum / total;
+    }
 };
 
 class ClusterHierarchy {

@@ -83,14 +83,7 @@ double ShapeMatching::fit(std::size_t level, const std::vector<Eigen::Vector3d>&
         if (!active[c]) return 0.0;
         const std::uint32_t begin = l.start[c], end = l.start[c + 1];
         const double s = scale.empty() ? 1.0 : scale[c];
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        double total = 0.0;
-        for (std::uint32_t m = begin; m < end; ++m) {
-            centroid += l.weight[m] * p[l.particle[m]];
-            total += l.weight[m];
-        }
-        centroid /= total;
-        centroids[c] = centroid;
+        const Eigen::Vector3d centroid = centroids[c] = l.centroid(c, p);
         Eigen::Matrix3d a = Eigen::Matrix3d::Zero(); // the moment matrix sum w (p - c) q^T
         const std::vector<Eigen::Vector3d>& rest = m_rest[level];
         for (std::uint32_t m = begin; m < end; ++m) a += l.weight[m] * (p[l.particle[m]] - centroid) * rest[m].transpose();
