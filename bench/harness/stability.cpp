@@ -169,6 +169,19 @@ std::vector<Case> cases(const Object& object)
                            if (step == 1)
                                for (Eigen::Vector3d& f : sim.solver().external_forces()) f.setZero();
                        }});
+    // The same slams on the third method (docs/shape-matching.md), whose paper claims stability
+    // under impulse-like input: the same object, elements and load, moved by shape matching.
+    for (double force : {100.0, 1000.0})
+        out.push_back({number(force) + " N on the free end for one step, shape matching",
+                       [lo, hi, force](nlohmann::json& s) {
+                           s["loads"] = {{{"box_mm", {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}}}, {"force_n", {0, 0, -force}}}};
+                           s["solver"]["type"] = "shape_matching";
+                       },
+                       {},
+                       [](DbgSimulation& sim, int step) {
+                           if (step == 1)
+                               for (Eigen::Vector3d& f : sim.solver().external_forces()) f.setZero();
+                       }});
     return out;
 }
 
