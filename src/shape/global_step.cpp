@@ -58,22 +58,16 @@ void GlobalStep::prepare(const ClusterLevel& level, const std::vector<double>& s
     m_fixed = fixed;
 }
 
-void GlobalStep::solve(const std::vector<Eigen::Vector3d>& rhs, const std::vector<Eigen::Vector3d>& held,
-                       std::vector<Eigen::Vector3d>& out) const
+void GlobalStep::solve(const std::vector<Eigen::Vector3d>& rhs, std::vector<Eigen::Vector3d>& out) const
 {
     const auto n = static_cast<Eigen::Index>(rhs.size());
     out.resize(rhs.size());
     // The axes sharing a factor are solved together (one pass over the factor for up to three
     // right-hand sides: the back-substitutions are most of a step's time).
-    Eigen::MatrixX3d b(n, 3), h = Eigen::MatrixX3d::Zero(n, 3);
+    Eigen::MatrixX3d b(n, 3);
     for (Eigen::Index j = 0; j < n; ++j)
         for (Eigen::Index axis = 0; axis < 3; ++axis)
-            if (m_held[static_cast<std::size_t>(axis)][static_cast<std::size_t>(j)]) h(j, axis) = held[static_cast<std::size_t>(j)][axis];
-    const Eigen::MatrixX3d seen = m_full * h; // what the free rows see of the held dofs
-    for (Eigen::Index j = 0; j < n; ++j)
-        for (Eigen::Index axis = 0; axis < 3; ++axis)
-            b(j, axis) = m_held[static_cast<std::size_t>(axis)][static_cast<std::size_t>(j)] ? h(j, axis)
-                                                                                              : rhs[static_cast<std::size_t>(j)][axis] - seen(j, axis);
+            b(j, axis) = m_held[static_cast<std::size_t>(axis)][static_cast<std::size_t>(j)] ? 0.0 : rhs[static_cast<std::size_t>(j)][axis];
     Eigen::MatrixX3d x(n, 3);
     if (m_factor[1] == m_factor[0] && m_factor[2] == m_factor[0]) {
         x = m_factor[0]->solve(b);

@@ -28,9 +28,9 @@ public:
     /// solvable) and the held dofs `fixed` (per dof), unless they are those of the last factorisation.
     void prepare(const ClusterLevel& level, const std::vector<double>& scale, const std::vector<double>& inertia,
                  const std::vector<unsigned char>& fixed);
-    /// out = A^-1 rhs on the free dofs; held dofs keep `held` (their positions), which the free
-    /// rows see through the matrix.
-    void solve(const std::vector<Eigen::Vector3d>& rhs, const std::vector<Eigen::Vector3d>& held, std::vector<Eigen::Vector3d>& out) const;
+    /// out = A^-1 rhs on the free dofs, zero on the held ones (the step solves for corrections,
+    /// which held dofs do not take).
+    void solve(const std::vector<Eigen::Vector3d>& rhs, std::vector<Eigen::Vector3d>& out) const;
     /// out = A u, every dof (the matrix without holds).
     void multiply_full(const std::vector<Eigen::Vector3d>& u, std::vector<Eigen::Vector3d>& out) const;
     /// out = A u on the free dofs (held dofs: 0), u zero on held dofs.

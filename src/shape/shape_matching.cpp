@@ -158,8 +158,9 @@ fem::StepStats ShapeMatching::step(fem::ImplicitSolver& solver)
 
     // The particles' own terms: inertia toward y = x + dt v + dt^2 f / m, where each particle
     // goes under its velocity and the constant loads f alone (the paper's "virtually displaced
-    // via Newton's second law"), and the contacts at their stiffness. The iterations start there, so that a step cut short leaves the loads'
-    // motion in (softer) rather than out (a free fall slowed by the object's stiffness).
+    // via Newton's second law"), and the contacts at their stiffness. The iterations start there,
+    // so that a step cut short leaves the loads' motion in (softer) rather than out (a free fall
+    // slowed by the object's stiffness).
     // Statically, no inertia: the loads f stay as forces and the iterations start at x.
     // Rayleigh's mass damping alpha as the FEM's implicit Euler takes it: (1 + alpha dt) M v' =
     // M v + dt f, so the inertia weighs (1 + alpha dt) m / dt^2 and y = x + dt (v + dt f / m) / (1 + alpha dt).
@@ -278,8 +279,7 @@ fem::StepStats ShapeMatching::step(fem::ImplicitSolver& solver)
                     if (fixed[3 * j + static_cast<std::size_t>(a)]) r[j][a] = 0.0;
             }
         });
-        const std::vector<Eigen::Vector3d> none(n, Eigen::Vector3d::Zero());
-        m_global.solve(r, none, z);
+        m_global.solve(r, z);
         if (!has_contact) {
             for (std::size_t j = 0; j < n; ++j) p[j] += z[j];
             return;
@@ -311,7 +311,7 @@ fem::StepStats ShapeMatching::step(fem::ImplicitSolver& solver)
                 r[j] -= alpha * q[j];
             }
             if (std::sqrt(dot(r, r)) <= k_contact_tolerance * r0) break;
-            m_global.solve(r, none, z);
+            m_global.solve(r, z);
             const double rz_next = dot(r, z);
             for (std::size_t j = 0; j < n; ++j) d[j] = z[j] + (rz_next / rz) * d[j];
             rz = rz_next;
