@@ -538,11 +538,7 @@ Eigen::VectorXd ImplicitSolver::external_force() const
         // every frame from the tenth, 81 ms a step; now none, 12 ms). The weight added is the
         // floor's: at most 1e-3 of a full cell corner's mass at each nearly empty node.
         f.segment<3>(static_cast<Eigen::Index>(3 * n)) = m_model.nodal_mass()[n] * m_gravity + m_external[n];
-    for (std::size_t c = 0; c < m_contact.size(); ++c) {
-        const NodeContact& k = m_contact[c];
-        f.segment<3>(static_cast<Eigen::Index>(3 * k.node)) += k.force_n - k.stiffness_n_per_m * (m_x[k.node] - m_contact_x0[c]);
-    }
-    m_pairs.add_forces(m_x, f);
+    add_contact_forces(m_x, f);
     return f;
 }
 
