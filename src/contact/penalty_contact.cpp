@@ -218,9 +218,20 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     const bool keep = distance.size() >= points.count;
     PointPenalty pp;
+    // Each point's parameters: the tool's, or the stiffness the snapshot gives it.
+    const bool own = points.stiffness_n_per_mm.size() >= points.count;
+    ContactParameters at = parameters;
+    auto parameters_of = [&](std::size_t i) -> const ContactParameters& {
+        if (own) at.stiffness_n_per_mm = points.stiffness_n_per_mm[i];
+        return at;
+    };
+    auto edge_parameters = [&](std::size_t a, std::size_t b) -> const ContactParameters& {
+        if (own) at.stiffness_n_per_mm = 0.5 * (points.stiffness_n_per_mm[a] + points.stiffness_n_per_mm[b]);
+        return at;
+    };
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        const bool inside = point_penalty(tool, nullptr, parameters, reach, p, points.areas_mm2[i], points.normals[i], pp);
+        const bool inside = point_penalty(tool, nullptr, parameters_of(i), reach, p, points.areas_mm2[i], points.normals[i], pp);
         if (keep) distance[i] = pp.measured ? pp.distance : std::numeric_limits<double>::infinity();
         if (!inside) continue;
         out.force_on_tool_n -= pp.force;
@@ -255,7 +266,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
             if (b >= points.count || !may_reach_in(a, b)) continue;
             const double d_a = measured(a), d_b = measured(b);
-            if (edge_penalty(tool, nullptr, parameters, points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
+            if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                              points.areas_mm2[b], points.normals[a], points.normals[b], ep))
                 visit(ep);
         }
@@ -272,7 +283,8 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     for (std::size_t i = 0; i < points.count; ++i) {
-        if (!point_penalty(tool, nullptr, parameters, reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp)) continue;
+        if (!point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
+            continue;
         if (!carries_load(pp.force, net)) continue;
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];

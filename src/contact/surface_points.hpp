@@ -35,6 +35,10 @@ struct SurfacePoints {
     std::vector<Eigen::Vector3d> positions_mm;
     std::vector<Eigen::Vector3d> normals;     ///< outward, unit
     std::vector<double> areas_mm2;
+    /// Per point, the contact's stiffness as ContactParameters::stiffness_n_per_mm (N/mm per cm^2
+    /// of contact), where the material sets it (shape matching's constraint particles,
+    /// docs/shape-matching.md); empty: the tool's own.
+    std::vector<double> stiffness_n_per_mm;
     bool truncated = false;                   ///< more points were near than the capacity holds
     /// Surface triangles whose three corners are among the points (indices into them), and a box
     /// tree over them (a static mesh: start = end) for the continuous tool-mesh check.

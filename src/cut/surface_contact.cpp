@@ -262,10 +262,11 @@ std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const S
 }
 
 void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& box,
-                    contact::SurfacePoints& out)
+                    contact::SurfacePoints& out, const std::vector<double>* node_stiffness)
 {
     out.count = 0;
     out.truncated = false;
+    out.stiffness_n_per_mm.clear();
     std::vector<std::uint32_t> slots;
     DeformedPositions position(surface, node_positions);
     vertices_in(surface, node_positions, box, [&](std::uint32_t v, const Eigen::Vector3d& p) {
@@ -281,6 +282,13 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
         point_of.emplace(v, static_cast<int>(out.count));
         out.positions_mm[out.count] = position(v);
         area_and_normal(surface, v, position, out.areas_mm2[out.count], out.normals[out.count]);
+        if (node_stiffness) {
+            const fem::HexElement& el = surface.model().elements()[surface.vertex_element(v)];
+            const Eigen::Vector3d local = surface.vertex_local(v);
+            double k = 0.0;
+            for (int c = 0; c < 8; ++c) k += grid::hex8_shape(c, local) * (*node_stiffness)[el.dof_node[c]];
+            out.stiffness_n_per_mm.push_back(k);
+        }
         ++out.count;
     }
     // The triangles among the points, their tree and edges.

@@ -58,9 +58,11 @@ void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weigh
 
 /// Fills `out` with the surface points within `box` (world mm) of the surface deformed by
 /// `node_positions` (m), each with its area and outward normal: the snapshot the haptic thread
-/// touches. At most out.capacity() points (out.truncated says when more were there).
+/// touches. At most out.capacity() points (out.truncated says when more were there). With
+/// `node_stiffness` (per node, N/mm per cm^2 of contact), each point's contact stiffness is its
+/// value interpolated where the point is embedded; without, the snapshot leaves it to the tool.
 void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions, const Eigen::AlignedBox3d& box,
-                    contact::SurfacePoints& out);
+                    contact::SurfacePoints& out, const std::vector<double>* node_stiffness = nullptr);
 
 /// Adds `b`'s node contacts to `a` (several tools on one object).
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b);

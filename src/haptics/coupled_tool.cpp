@@ -14,9 +14,18 @@ CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::Contact
 Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept
 {
     if (!m_started) {
-        m_proxy.position = m_previous_proxy = m_previous_device = device.position_mm;
+        m_proxy.position = m_previous_felt = m_previous_device = device.position_mm;
+        m_snapshot_t_s = surface.t_s;
         m_started = true;
     }
+    const bool fresh = surface.t_s != m_snapshot_t_s;
+    if (fresh) {
+        m_spread_ticks = std::clamp(m_ticks_on_snapshot, 1, k_max_spread_ticks);
+        m_ticks_on_snapshot = 0;
+        m_snapshot_t_s = surface.t_s;
+    }
+    ++m_ticks_on_snapshot;
+    const Eigen::Vector3d felt_before = felt_position();
     m_proxy.orientation = device.orientation;
     const double kc = m_coupling.stiffness_n_per_mm;
     // One Newton step a tick on k_c (x_d - x) + F(x) = 0, F linearised at the proxy: warm started
@@ -42,12 +51,22 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
         const double t = m_sweep.first_stop(m_proxy, moved, surface, distance);
         m_proxy.position += t * step;
     }
+    // The tick a new snapshot arrives, the proxy's move (the surface moved under it) is not felt
+    // yet: the felt proxy moves with the device that tick, and the rest of the move is spread
+    // evenly over as many ticks as the last snapshot lasted. The spread of the snapshot before, if
+    // unfinished, goes on within it.
+    if (fresh) {
+        m_spread = felt_before + (device.position_mm - m_previous_device) - m_proxy.position;
+        m_spread_step = m_spread / m_spread_ticks;
+    } else if (m_spread.squaredNorm() > 0.0) {
+        m_spread = m_spread.squaredNorm() > m_spread_step.squaredNorm() ? Eigen::Vector3d(m_spread - m_spread_step) : Eigen::Vector3d::Zero();
+    }
+    const Eigen::Vector3d felt = felt_position();
     const double dt = dt_s > 0.0 ? dt_s : 1e-3;
-    const Eigen::Vector3d relative_velocity =
-        ((m_proxy.position - m_previous_proxy) - (device.position_mm - m_previous_device)) / dt; // mm/s
-    m_previous_proxy = m_proxy.position;
+    const Eigen::Vector3d relative_velocity = ((felt - m_previous_felt) - (device.position_mm - m_previous_device)) / dt; // mm/s
+    m_previous_felt = felt;
     m_previous_device = device.position_mm;
-    return kc * (m_proxy.position - device.position_mm) + m_coupling.damping_n_s_per_mm * relative_velocity;
+    return kc * (felt - device.position_mm) + m_coupling.damping_n_s_per_mm * relative_velocity;
 }
 
 } // namespace vox::haptics

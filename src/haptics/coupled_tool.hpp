@@ -9,8 +9,10 @@
 // then clamps. A step that would carry the tool past points it touches at neither end stops at
 // the first such touch, and the tool's triangle mesh is swept against the snapshot's triangles
 // for features thinner than the gaps between surface points (contact/tool_sweep.hpp), so a fast,
-// thin tool cannot tunnel through the surface between ticks. Everything here runs in the 1 kHz loop: no allocation, lock, log
-// or throw.
+// thin tool cannot tunnel through the surface between ticks. A new snapshot moves the surface under
+// the proxy at once (the simulation stepped): what the user feels follows the proxy's move over as
+// many ticks as the snapshots come apart, not in one, so the force does not jump once a frame.
+// Everything here runs in the 1 kHz loop: no allocation, lock, log or throw.
 
 #include "contact/penalty_contact.hpp"
 #include "contact/tool_sweep.hpp"
@@ -37,6 +39,11 @@ public:
 
     /// The proxy: where the tool is in the simulation.
     [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
+    /// A new snapshot's move is spread over at most this many ticks (the safety stage fades the
+    /// force of a snapshot 50 ms old).
+    static constexpr int k_max_spread_ticks = 50;
+    /// Where the user feels it: the proxy, plus what is left of a new snapshot's move to spread.
+    [[nodiscard]] Eigen::Vector3d felt_position() const { return m_proxy.position + m_spread; }
     /// The continuous check of the last update (whether it swept the tool's mesh, and stopped on it).
     [[nodiscard]] const contact::ToolSweep& sweep() const { return m_sweep; }
     /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
@@ -49,7 +56,12 @@ private:
     contact::ContactTotals m_contact;
     contact::ToolSweep m_sweep;
     std::vector<double> m_distance; ///< per snapshot point, this tick's distance at the proxy
-    Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_proxy = Eigen::Vector3d::Zero();
+    Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_felt = Eigen::Vector3d::Zero();
+    /// A new snapshot's move of the proxy not felt yet, and how much of it goes each tick.
+    Eigen::Vector3d m_spread = Eigen::Vector3d::Zero(), m_spread_step = Eigen::Vector3d::Zero();
+    double m_snapshot_t_s = 0.0;  ///< the snapshot of the last update
+    int m_ticks_on_snapshot = 0;  ///< updates since the snapshot changed
+    int m_spread_ticks = 1;       ///< updates between the last two snapshots: the move's spread
     bool m_started = false;
 };
 

@@ -71,6 +71,32 @@ double ShapeMatching::energy(std::size_t level, const std::vector<Eigen::Vector3
     return fit(level, p, {}, std::vector<unsigned char>(m_clusters.levels()[level].size(), 1));
 }
 
+void ShapeMatching::particle_goals(const std::vector<Eigen::Vector3d>& p, const std::vector<double>& scale,
+                                   std::vector<Eigen::Vector3d>& goal, std::vector<double>& stiffness) const
+{
+    const ClusterLevel& l = m_clusters.levels().front();
+    std::vector<Eigen::Vector3d> pull(p.size(), Eigen::Vector3d::Zero());
+    stiffness.assign(p.size(), 0.0);
+    // Serial: a snapshot's fit of every cluster takes about as long as one iteration's local step.
+    for (std::size_t c = 0; c < l.size(); ++c) {
+        const std::uint32_t begin = l.start[c], end = l.start[c + 1];
+        const Eigen::Vector3d centroid = l.centroid(c, p);
+        Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+        for (std::uint32_t m = begin; m < end; ++m) a += l.weight[m] * (p[l.particle[m]] - centroid) * m_rest[0][m].transpose();
+        Eigen::Quaterniond q = m_rotation[0][c]; // warm start, left as the step has it
+        fem::extract_rotation(a, q);
+        const Eigen::Matrix3d r = q.toRotationMatrix();
+        const double s = scale.empty() ? 1.0 : scale[c];
+        for (std::uint32_t m = begin; m < end; ++m) {
+            const double w = s * l.weight[m];
+            pull[l.particle[m]] += w * (centroid + r * m_rest[0][m]);
+            stiffness[l.particle[m]] += w;
+        }
+    }
+    goal.resize(p.size());
+    for (std::size_t j = 0; j < p.size(); ++j) goal[j] = stiffness[j] > 0.0 ? Eigen::Vector3d(pull[j] / stiffness[j]) : p[j];
+}
+
 double ShapeMatching::fit(std::size_t level, const std::vector<Eigen::Vector3d>& p, const std::vector<double>& scale,
                           const std::vector<unsigned char>& active)
 {

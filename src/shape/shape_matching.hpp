@@ -88,6 +88,13 @@ public:
     /// The clusters' shape-matching energy of level `level` at positions p, J (goals fitted at p).
     double energy(std::size_t level, const std::vector<Eigen::Vector3d>& p);
 
+    /// Stable constraint particle coupling (docs/shape-matching.md): where the simulated level's
+    /// clusters, fitted at positions p, put each particle (the mean of its goals weighted by their
+    /// stiffness) and how stiffly (the sum of those weights, N/m; cluster c's times `scale[c]`,
+    /// the water's softening, when given). A particle in no cluster keeps p, with stiffness 0.
+    void particle_goals(const std::vector<Eigen::Vector3d>& p, const std::vector<double>& scale, std::vector<Eigen::Vector3d>& goal,
+                        std::vector<double>& stiffness) const;
+
     static constexpr int k_origination_skip = 8;
     static constexpr int k_origination_skip_max = 64;
     /// Iterations of one level in one cycle at most.

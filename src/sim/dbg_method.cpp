@@ -8,6 +8,7 @@
 #include "cut/piece_contact.hpp"
 #include "cut/pieces.hpp"
 #include "cut/voxel_cut.hpp"
+#include "shape/shape_matching.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -418,7 +419,27 @@ std::vector<std::uint64_t> DbgMethod::surface_keys() const
 
 void DbgMethod::sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec&, contact::SurfacePoints& out) const
 {
-    cut::sample_surface(m_sim->surface(), m_sim->solver().positions(), box, out);
+    const fem::ImplicitSolver& solver = m_sim->solver();
+    const auto* shape_matching = dynamic_cast<const shape::ShapeMatching*>(solver.integrator());
+    if (!shape_matching) {
+        cut::sample_surface(m_sim->surface(), solver.positions(), box, out);
+        return;
+    }
+    // Stable constraint particle coupling (docs/shape-matching.md): the haptic thread touches the
+    // surface where the clusters put it (their goals), each point held there as stiffly as its
+    // clusters hold their particles: a particle's weights s (N/m) over the area it stands for, h^2
+    // (a face particle of a full block lies in four clusters of kappa = mu h: s = 4 mu h, so a patch
+    // of area a pressed in with the goals held costs 4 mu a / h N/mm, the paper's kappa (g - x)).
+    const fem::HexModel& model = m_sim->model();
+    std::vector<double> scale(model.elements().size());
+    for (std::uint32_t e = 0; e < scale.size(); ++e) scale[e] = solver.stiffness_scale(e, model.elements()[e].material);
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> stiffness;
+    shape_matching->particle_goals(solver.positions(), scale, goal, stiffness);
+    const Eigen::Vector3d voxel = m_grid->voxels().voxel_size_m();
+    const double h = std::ldexp(std::cbrt(voxel.prod()), m_level); // the element's edge, m
+    for (double& s : stiffness) s *= 1e-7 / (h * h); // N/m per m^2 -> N/mm per cm^2
+    cut::sample_surface(m_sim->surface(), goal, box, out, &stiffness);
 }
 
 std::size_t DbgMethod::piece_count() const { return cut::piece_count(m_sim->model()); }

@@ -278,3 +278,58 @@ TEST(ShapeMatching, PlasticityKeepsASculptedShapeAndBoundsTheStrain)
     EXPECT_LT(kept[0], 1e-3);
     EXPECT_GT(kept[1], 0.2);
 }
+
+TEST(ShapeMatching, ConstraintParticleGoalsFollowARigidMotionAndHoldAFaceParticleAtFourMuH)
+{
+    // SCPC's goals (shape_matching.hpp): a rigidly moved block is where its clusters want it, so
+    // every particle's goal is its position; and a particle in the middle of a face of a full block
+    // lies in four element clusters, each weighing it kappa = mu d (a full cube's corners weigh
+    // kappa each): s = 4 mu d, the stiffness per face area d^2 the haptic snapshot uses 4 mu / d.
+    Block b({8, 8, 8}, 1, dynamic(), Settings{}, 2);
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    std::vector<Eigen::Vector3d> p = b.model.rest_positions();
+    for (Eigen::Vector3d& x : p) x = r * x + Eigen::Vector3d(0.01, -0.02, 0.03);
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> stiffness;
+    b.integrator->particle_goals(p, {}, goal, stiffness);
+    for (std::size_t j = 0; j < p.size(); ++j) EXPECT_LT((goal[j] - p[j]).norm(), 1e-12) << "particle " << j;
+    const grid::Lame lame = grid::lame_from_young_poisson(test::k_e, test::k_nu);
+    const double d = 2e-3;
+    std::vector<std::uint32_t> face;
+    for (std::uint32_t n = 0; n < b.model.node_count(); ++n)
+        if ((b.model.rest_positions()[n] - Eigen::Vector3d(3.5e-3, 3.5e-3, 7.5e-3)).norm() < 1e-9) face.push_back(n); // voxel 0 is centred at 0
+    ASSERT_EQ(face.size(), 1u);
+    EXPECT_NEAR(stiffness[face.front()], 4.0 * lame.mu * d, 1e-9 * lame.mu * d);
+    // Softened by water by the scale given.
+    b.integrator->particle_goals(p, std::vector<double>(b.model.elements().size(), 0.25), goal, stiffness);
+    EXPECT_NEAR(stiffness[face.front()], 0.25 * 4.0 * lame.mu * d, 1e-9 * lame.mu * d);
+}
+
+TEST(ShapeMatching, AConstraintParticleGoalIsTheMeanOfItsClustersBestFits)
+{
+    // A deformed block: each particle's goal is the stiffness-weighted mean of the goals its
+    // clusters' optimal rotations give it (against goals() computed cluster by cluster).
+    Block b({4, 4, 4}, 1, dynamic(), Settings{}, 2);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> jitter(-3e-4, 3e-4);
+    std::vector<Eigen::Vector3d> p = b.model.rest_positions();
+    for (Eigen::Vector3d& x : p) x += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> stiffness;
+    b.integrator->particle_goals(p, {}, goal, stiffness);
+    const ClusterLevel& l = b.integrator->clusters().levels().front();
+    std::vector<Eigen::Vector3d> pull(p.size(), Eigen::Vector3d::Zero());
+    std::vector<double> weight(p.size(), 0.0);
+    for (std::size_t c = 0; c < l.size(); ++c) {
+        std::vector<Eigen::Vector3d> g;
+        b.integrator->goals(0, c, p, g);
+        for (std::uint32_t m = l.start[c]; m < l.start[c + 1]; ++m) {
+            pull[l.particle[m]] += l.weight[m] * g[m - l.start[c]];
+            weight[l.particle[m]] += l.weight[m];
+        }
+    }
+    for (std::size_t j = 0; j < p.size(); ++j) {
+        EXPECT_NEAR(stiffness[j], weight[j], 1e-12 * weight[j]);
+        EXPECT_LT((goal[j] - pull[j] / weight[j]).norm(), 1e-12) << "particle " << j;
+    }
+}
