@@ -1,17 +1,19 @@
 // voxsculpt bench haptics: how steady the 1 kHz loop is, and how long its force takes, while a
 // cutting simulation runs beside it. The threads are those of a live session:
-//  - the haptic thread (its own, 1 kHz on absolute deadlines) reads a scripted device pressing a
-//    knife into the block of data/scenes/press_and_cut.json again and again, a little further
-//    along each time, and jabbing it in between (jumps of several mm a tick); couples the tool to
-//    it (virtual coupling against the penalty contact with
-//    the newest surface snapshot); publishes the tool's pose;
-//  - the simulation thread (this one) puts the tool where the haptic thread says, lets it cut,
-//    steps the simulation (the branched grid, or Is-XFEM with --isxfem), publishes the surface
-//    near the tool, and keeps simulated time in pace with
-//    wall time. The scene is press_and_cut.json one level coarser, which one core steps in real
-//    time: the snapshots stay fresher than the safety stage's 50 ms.
-// They share only two triple buffers. Prints period error and force-computation time (p50, p99,
-// max), with the cutting and the snapshots' sizes.
+//  - the haptic thread (its own, 1 kHz on absolute deadlines) serves every device: a scripted
+//    device pressing a knife into the block of data/scenes/press_and_cut.json again and again, a
+//    little further along each time, and jabbing it in between (jumps of several mm a tick); with
+//    --devices 2 a second one pressing a finger (a ball) into the block beside the knife's path at
+//    the same time, out of step with it. Each device has its own virtual coupling against the
+//    penalty contact with the newest surface snapshot near its tool, and its own safety stage; the
+//    loop publishes the tools' poses;
+//  - the simulation thread (this one) puts the tools where the haptic thread says, lets them cut
+//    and push, steps the simulation (the scene's method, or another with --solver), publishes the
+//    surface near each tool, and keeps simulated time in pace with wall time. The scene is
+//    press_and_cut.json one level coarser, which one core steps in real time: the snapshots stay
+//    fresher than the safety stage's 50 ms.
+// They share only triple buffers. Prints period error and force-computation time (p50, p99,
+// max; a tick's force time covers every device), with the cutting and the snapshots' sizes.
 
 #include "bench/harness/haptics.hpp"
 #include "sim/frame_loop.hpp"
@@ -65,79 +67,129 @@ std::vector<haptics::KeyFrame> presses(double seconds)
     return frames;
 }
 
+/// The second hand: a ball of 4 mm pressing 2 mm into the block at y = 16 (clear of the knife
+/// at y = 10), half a second out of step with the knife, from the far end of the block inwards.
+std::vector<haptics::KeyFrame> finger_presses(double seconds)
+{
+    std::vector<haptics::KeyFrame> frames;
+    const Eigen::Quaterniond level = Eigen::Quaterniond::Identity();
+    for (int k = 0; k <= static_cast<int>(seconds) + 1; ++k) {
+        const double x = 32.0 - 1.5 * (k % 16);
+        frames.push_back({static_cast<double>(k), {x, 16, 20}, level});
+        frames.push_back({k + 0.3, {x, 16, 20}, level});
+        frames.push_back({k + 0.8, {x, 16, 14}, level});
+        frames.push_back({k + 0.95, {x, 16, 14}, level});
+    }
+    return frames;
+}
+
+/// One device and its tool: the haptic thread's side (device, coupling) and what the threads share.
+struct Hand {
+    std::size_t tool = 0;
+    haptics::VirtualDevice device;
+    haptics::CoupledTool coupled;
+    haptics::TripleBuffer<contact::SurfacePoints> snapshots; ///< simulation -> haptics
+    haptics::TripleBuffer<contact::PlacedShape> poses;       ///< haptics -> simulation
+    contact::PlacedShape pose;                               ///< simulation side: the last pose read
+    Hand(std::size_t t, std::vector<haptics::KeyFrame> frames, const contact::ToolShape& shape, const io::ToolSpec& spec, std::size_t capacity)
+        : tool(t), device(std::move(frames)),
+          coupled(shape, contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, haptics::CouplingSettings{}, capacity),
+          snapshots(contact::SurfacePoints(capacity))
+    {
+    }
+};
+
 } // namespace
 
-void run_haptics_bench(double seconds, bool isxfem)
+void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
 {
     // The press-and-cut scene one level coarser (2 mm -> 4 mm elements), so that the simulation
     // thread alone keeps its snapshots fresh (under the 50 ms the safety stage allows).
     io::Scene scene = io::load_scene(VOX_DATA_DIR "/scenes/press_and_cut.json");
     scene.object.levels = 2;
-    if (isxfem) io::use_method(scene, io::SolverType::isxfem);
-    const io::ToolSpec& knife = scene.tools.front();
-    const contact::ContactParameters parameters{knife.push_margin_mm, knife.contact_stiffness_n_per_mm};
+    if (devices > 1) { // the second hand's tool
+        io::ToolSpec finger;
+        finger.name = "finger";
+        finger.shape = io::ToolShape::sphere;
+        finger.radius_mm = 4.0;
+        finger.action = io::default_tool_action(io::ToolShape::sphere);
+        scene.tools.push_back(finger);
+    }
+    io::use_method(scene, method_type);
     constexpr std::size_t snapshot_capacity = 50000;
     const std::unique_ptr<sim::Method> method =
         sim::open_method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene))).method;
     sim::ToolPolicy tools(scene);
     sim::FrameLoop frame_loop(scene, *method, tools);
-    haptics::CoupledTool coupled(tools.shape(0), parameters, haptics::CouplingSettings{}, snapshot_capacity);
-    // One simulation frame with the knife where the device put it (tools, step), and the surface
-    // near the knife into `out`; true when it cut.
-    auto simulate = [&](const contact::PlacedShape& pose, contact::SurfacePoints& out) {
-        tools.drive(0, pose.position, pose.orientation);
-        const sim::FrameStats f = frame_loop.next();
-        method->sample_surface(pose.world_bounds(knife.push_margin_mm + 5.0), knife, out);
-        return f.tools.cut.changed();
-    };
+    std::vector<std::unique_ptr<Hand>> hands;
+    hands.push_back(std::make_unique<Hand>(0, presses(seconds), tools.shape(0), scene.tools[0], snapshot_capacity));
+    if (devices > 1) hands.push_back(std::make_unique<Hand>(1, finger_presses(seconds), tools.shape(1), scene.tools[1], snapshot_capacity));
 
-    // Surface near the tool (simulation -> haptics) and the tool's pose (haptics -> simulation).
-    haptics::TripleBuffer<contact::SurfacePoints> snapshots{contact::SurfacePoints(snapshot_capacity)};
-    haptics::TripleBuffer<contact::PlacedShape> poses;
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
     auto now_s = [&start] { return std::chrono::duration<double>(clock::now() - start).count(); };
-
     // The simulation keeps to one thread: the other core is the loop's.
     const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-    haptics::VirtualDevice device(presses(seconds));
-    // Written by the haptic thread only (sized here), read after it has stopped.
+    // Written by the haptic thread only (sized here), read after it has stopped. The knife's mesh
+    // sweeps are counted per tick.
     std::size_t stale_ticks = 0, tick = 0;
     const std::size_t capacity = static_cast<std::size_t>(seconds * 1000) + 1000;
     std::vector<unsigned char> swept_mesh(capacity, 0), stopped_by_mesh(capacity, 0); // per tick
     const double stale_s = haptics::SafetySettings{}.stale_s;
-    haptics::HapticLoop loop(
-        device,
-        [&](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
-            const contact::SurfacePoints& surface = snapshots.latest();
-            age = now_s() - surface.t_s;
-            stale_ticks += age > stale_s;
-            const Eigen::Vector3d f = coupled.update(s, surface, 1e-3);
-            if (tick < capacity) {
-                swept_mesh[tick] = coupled.sweep().swept_mesh();
-                stopped_by_mesh[tick] = coupled.sweep().stopped_by_mesh();
-            }
-            ++tick;
-            poses.write_slot() = coupled.proxy();
-            poses.publish();
-            return f;
-        },
-        haptics::SafetySettings{}, capacity);
+    std::vector<haptics::HapticChannel> channels;
+    for (std::size_t i = 0; i < hands.size(); ++i) {
+        Hand* hand = hands[i].get();
+        const bool knife = i == 0;
+        channels.push_back({&hand->device,
+                            [&, hand, knife](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
+                                const contact::SurfacePoints& surface = hand->snapshots.latest();
+                                age = now_s() - surface.t_s;
+                                stale_ticks += age > stale_s;
+                                const Eigen::Vector3d f = hand->coupled.update(s, surface, 1e-3);
+                                if (knife) {
+                                    if (tick < capacity) {
+                                        swept_mesh[tick] = hand->coupled.sweep().swept_mesh();
+                                        stopped_by_mesh[tick] = hand->coupled.sweep().stopped_by_mesh();
+                                    }
+                                    ++tick;
+                                }
+                                hand->poses.write_slot() = hand->coupled.proxy();
+                                hand->poses.publish();
+                                return f;
+                            },
+                            haptics::SafetySettings{}});
+    }
+    haptics::HapticLoop loop(std::move(channels), capacity);
 
-    log::info("bench haptics: 1 kHz loop for {} s against a cutting simulation ({}, {})", seconds, scene.source, isxfem ? "isxfem" : "dbg");
+    log::info("bench haptics: 1 kHz loop for {} s, {} device(s), against a cutting simulation ({}, {})", seconds, hands.size(), scene.source,
+              io::solver_type_name(method_type));
     loop.start();
     int frames = 0, cutting_frames = 0;
     std::vector<double> snapshot_points, frame_ms;
-    contact::PlacedShape pose = coupled.proxy(); // the device's first pose, until the loop reports
-    pose.position = Eigen::Vector3d(8, 10, 17);
+    for (const std::unique_ptr<Hand>& hand : hands) { // the devices' first poses, until the loop reports
+        hand->pose = hand->coupled.proxy();
+        haptics::DeviceState first;
+        hand->device.read(0.0, first);
+        hand->pose.position = first.position_mm;
+    }
     while (now_s() < seconds) {
         const auto frame_start = clock::now();
-        if (poses.update()) pose = poses.read_slot();
-        contact::SurfacePoints& out = snapshots.write_slot();
-        cutting_frames += simulate(pose, out);
-        out.t_s = now_s();
-        snapshots.publish();
-        snapshot_points.push_back(static_cast<double>(out.count));
+        for (const std::unique_ptr<Hand>& hand : hands) {
+            if (hand->poses.update()) hand->pose = hand->poses.read_slot();
+            tools.drive(hand->tool, hand->pose.position, hand->pose.orientation);
+        }
+        const sim::FrameStats f = frame_loop.next();
+        cutting_frames += f.tools.cut.changed();
+        double points = 0.0;
+        for (const std::unique_ptr<Hand>& hand : hands) {
+            const io::ToolSpec& spec = scene.tools[hand->tool];
+            contact::SurfacePoints& out = hand->snapshots.write_slot();
+            method->sample_surface(hand->pose.world_bounds(spec.push_margin_mm + 5.0), spec, out);
+            out.t_s = now_s();
+            hand->snapshots.publish();
+            points += static_cast<double>(out.count);
+        }
+        snapshot_points.push_back(points);
         frame_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - frame_start).count());
         ++frames;
         // Simulated time keeps pace with wall time, as in a live session (a late frame does not wait).
@@ -146,7 +198,7 @@ void run_haptics_bench(double seconds, bool isxfem)
     loop.stop();
     const Percentiles period = percentiles(loop.timings().period_error_ms);
     const Percentiles force = percentiles(loop.timings().force_us);
-    // The ticks that swept the tool's mesh (the costliest kind), on their own.
+    // The ticks that swept the knife's mesh (the costliest kind), on their own.
     std::vector<double> mesh_force_us;
     std::size_t mesh_stops = 0;
     for (std::size_t i = 0; i < loop.timings().force_us.size() && i < capacity; ++i)
@@ -157,13 +209,14 @@ void run_haptics_bench(double seconds, bool isxfem)
     const Percentiles mesh_force = percentiles(mesh_force_us);
     std::printf("machine: %s\n\n", machine_description().c_str());
     const std::size_t ticks = loop.timings().period_error_ms.size();
-    std::printf("| ticks | simulation frames (median) | cutting frames | snapshot points (median) | ticks on a stale snapshot | "
-                "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | ticks that swept the tool's mesh (stopped by it) | "
-                "their force time p50 / p99 / max |\n|---|---|---|---|---|---|---|---|---|---|\n");
-    std::printf("| %zu | %d (%.1f ms) | %d | %.0f | %.1f %% | %s | %.4f / %.4f / %.3f ms | %.1f / %.1f / %.1f us | %zu (%zu) | %.1f / %.1f / %.1f us |\n", ticks, frames,
-                quantile(frame_ms, 0.5), cutting_frames, quantile(snapshot_points, 0.5), 100.0 * static_cast<double>(stale_ticks) / static_cast<double>(std::max<std::size_t>(ticks, 1)),
+    std::printf("| ticks | simulation frames (median) | cutting frames | snapshot points, all devices (median) | device ticks on a stale snapshot | "
+                "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | ticks that swept the knife's mesh (stopped by it) | "
+                "their force time p50 / p99 / max | devices |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("| %zu | %d (%.1f ms) | %d | %.0f | %.1f %% | %s | %.4f / %.4f / %.3f ms | %.1f / %.1f / %.1f us | %zu (%zu) | %.1f / %.1f / %.1f us | %zu |\n",
+                ticks, frames, quantile(frame_ms, 0.5), cutting_frames, quantile(snapshot_points, 0.5),
+                100.0 * static_cast<double>(stale_ticks) / static_cast<double>(std::max<std::size_t>(ticks * hands.size(), 1)),
                 loop.timings().realtime_priority ? "yes" : "no (not permitted)", period.p50, period.p99, period.max, force.p50, force.p99,
-                force.max, mesh_force_us.size(), mesh_stops, mesh_force.p50, mesh_force.p99, mesh_force.max);
+                force.max, mesh_force_us.size(), mesh_stops, mesh_force.p50, mesh_force.p99, mesh_force.max, hands.size());
     std::printf("\ntargets: p99 period error under 0.1 ms (%s), p99 force time under 100 us (%s)\n", period.p99 < 0.1 ? "met" : "not met",
                 force.p99 < 100.0 ? "met" : "not met");
 }

@@ -1,10 +1,13 @@
 #pragma once
-// voxsculpt bench haptics (see bench_haptics.cpp).
+// voxsculpt bench haptics (see haptics.cpp).
+
+#include "io/scene.hpp"
 
 namespace vox::bench {
 
-/// Runs the 1 kHz loop for `seconds` beside the press-and-cut simulation (the branched grid, or
-/// Is-XFEM with `isxfem`) and prints its timing table.
-void run_haptics_bench(double seconds, bool isxfem = false);
+/// Runs the 1 kHz loop for `seconds` beside the press-and-cut simulation with `method`, serving
+/// `devices` devices (1: a knife; 2: a knife and a finger pressing at once), and prints its
+/// timing table.
+void run_haptics_bench(double seconds, io::SolverType method = io::SolverType::dbg, int devices = 1);
 
 } // namespace vox::bench

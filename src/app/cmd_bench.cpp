@@ -38,8 +38,16 @@ void add_bench_command(CLI::App& app)
     CLI::App* haptics = bench->add_subcommand("haptics", "Period error and force time of the 1 kHz loop beside a running simulation");
     haptics->add_option("--seconds", *seconds, "How long to run (default 10)")->check(CLI::Range(0.5, 3600.0));
     auto isxfem = std::make_shared<bool>(false);
-    haptics->add_flag("--isxfem", *isxfem, "Simulate with the Is-XFEM solver instead of the branched grid");
-    haptics->callback([seconds, isxfem] { run_haptics_bench(*seconds, *isxfem); });
+    auto haptics_solver = std::make_shared<std::string>("dbg");
+    auto devices = std::make_shared<int>(1);
+    haptics->add_flag("--isxfem", *isxfem, "Simulate with the Is-XFEM solver (as --solver isxfem)");
+    haptics->add_option("--solver", *haptics_solver, "The method simulating the scene: dbg (default), isxfem or shape_matching")
+        ->check(CLI::IsMember({"dbg", "isxfem", "shape_matching"}));
+    haptics->add_option("--devices", *devices, "Devices the loop serves at once: 1 (a knife) or 2 (a knife and a finger pressing together)")
+        ->check(CLI::Range(1, 2));
+    haptics->callback([seconds, isxfem, haptics_solver, devices] {
+        run_haptics_bench(*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices);
+    });
 
     auto cutting_runs = std::make_shared<int>(3);
     auto cutting_out = std::make_shared<std::string>("out");

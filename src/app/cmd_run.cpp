@@ -74,7 +74,8 @@ void add_run_command(CLI::App& app)
         std::string scene;
         std::optional<int> frames;
         std::string out;
-        std::string device, replay, record, tool, resume;
+        std::vector<std::string> devices, tools;
+        std::string replay, record, resume;
         int render_every = 0;
         std::string camera = "iso", size = "960x720";
         std::string solver;
@@ -85,12 +86,14 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--frames", args->frames, "Number of frames (default: the script's duration / dt_s, else 100)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--out", args->out, "Output folder (default: the scene's output.dir)");
-    cmd->add_option("--device", args->device, "Drive a tool by a device through the haptic loop (lockstep, 1 ms ticks): "
-                                               "\"script\" follows the tool's script")
-        ->check(CLI::IsMember({"script"}));
-    cmd->add_option("--replay", args->replay, "Drive the tool by replaying this recording (docs/recording-format.md)");
-    cmd->add_option("--record", args->record, "Record the device and the force sent at every tick to this file");
-    cmd->add_option("--tool", args->tool, "The tool the device drives (default: the scene's first tool)");
+    cmd->add_option("--device", args->devices, "Drive a tool by a device through the haptic loop (lockstep, 1 ms ticks): "
+                                                "\"script\" follows the tool's script. Once per device, each with its --tool")
+        ->check(CLI::IsMember({"script"}))
+        ->allow_extra_args(false);
+    cmd->add_option("--replay", args->replay, "Drive the tools by replaying this recording, every device in it (docs/recording-format.md)");
+    cmd->add_option("--record", args->record, "Record every device and the force sent to it at every tick to this file");
+    cmd->add_option("--tool", args->tools, "The tool a device drives, once per --device in the same order (default, one device: the scene's first tool)")
+        ->allow_extra_args(false);
     cmd->add_option("--resume", args->resume,
                     "Start from the last stroke of this session journal (a device run writes OUT.journal; docs/journal.md)");
     cmd->add_option("--solver", args->solver, "Simulate with this method instead of the scene's solver.type: dbg, isxfem or shape_matching")
@@ -108,8 +111,14 @@ void add_run_command(CLI::App& app)
         picture_options.camera = render::parse_camera(args->camera);
         picture_options.camera.up = scene_up(scene);
         std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
-        if (!args->record.empty() && args->device.empty() && args->replay.empty())
+        if (!args->record.empty() && args->devices.empty() && args->replay.empty())
             throw InputError("--record: there is no device to record; add --device script or --replay FILE");
+        if (!args->replay.empty() && !args->devices.empty())
+            throw InputError("--replay and --device: a replay drives the tools with the devices it recorded; give one or the other");
+        const std::size_t device_count = args->replay.empty() ? args->devices.size() : 1;
+        if (args->tools.size() > std::max<std::size_t>(device_count, 1) || (device_count > 1 && args->tools.size() != device_count))
+            throw InputError("--tool: give one per --device, in the same order (" + std::to_string(args->devices.size()) + " device(s), " +
+                             std::to_string(args->tools.size()) + " tool(s))");
         if (!args->resume.empty() && !std::filesystem::is_regular_file(args->resume)) // before the object is loaded
             throw file_error(args->resume, "no such file (--resume takes a session journal)");
 
@@ -118,13 +127,14 @@ void add_run_command(CLI::App& app)
         sim::Method& method = *opened.method;
         sim::ToolPolicy tools(scene);
         std::unique_ptr<sim::DeviceRun> device;
-        if (!args->device.empty() || !args->replay.empty()) {
+        if (!args->devices.empty() || !args->replay.empty()) {
             sim::DeviceOptions o;
-            o.tool = args->tool;
+            o.tools = args->tools;
             if (!args->replay.empty()) o.replay = args->replay;
             device = std::make_unique<sim::DeviceRun>(scene, tools, o);
-            log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, lockstep)", scene.tools[device->tool()].name,
-                      device->device_name());
+            for (std::size_t i = 0; i < device->device_count(); ++i)
+                log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, lockstep)", scene.tools[device->tool(i)].name,
+                          device->device_name(i));
         }
         std::unique_ptr<ScenePictures> pictures;
         if (args->render_every > 0) {
@@ -234,7 +244,14 @@ void add_run_command(CLI::App& app)
         }
         if (pictures) pictures->write(dir / "final.png", method, tools, scene);
         if (device) {
-            sim::write_forces(dir, device->forces(), "force on the device, " + scene.tools[device->tool()].name);
+            // forces.csv for the first device, as ever; forces_2.csv ... for the others.
+            nlohmann::json devices = nlohmann::json::array();
+            for (std::size_t i = 0; i < device->device_count(); ++i) {
+                const std::string name = i == 0 ? "forces" : "forces_" + std::to_string(i + 1);
+                sim::write_forces(dir, device->forces(i), "force on the device, " + scene.tools[device->tool(i)].name, name);
+                devices.push_back({{"device", device->device_name(i)}, {"tool", scene.tools[device->tool(i)].name}, {"forces", name + ".csv"}});
+            }
+            record.document()["devices"] = std::move(devices);
             if (!args->record.empty()) haptics::write_recording(args->record, device->recording());
         } else if (!tool_forces.empty()) {
             sim::write_forces(dir, tool_forces, "contact force on the tool");

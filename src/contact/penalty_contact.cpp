@@ -63,9 +63,24 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     if (from_a < margin || from_b < margin) return false; // a point contact has it, at the step's start
     if (out_of_reach(d_a, d_b) && out_of_reach(from_a, from_b)) return false;
 
-    // Whether any point of it is inside, at either pose: halving the edge while the distance's
-    // Lipschitz bound leaves room (most edges near the tool are out after a sample or two).
+    // Whether any point of it is inside, at either pose. A convex shape's distance is convex along
+    // the edge, so it lies above its tangents at the two ends: where they meet above the margin,
+    // the edge is out (an edge of a crack wall alongside a blade, parallel to its face a hair
+    // beyond the margin, took dozens of halvings below, a tick's worth of time over a wall). Else
+    // halve the edge while the distance's Lipschitz bound leaves room.
+    const bool convex = tool.shape && tool.shape->kind() != ToolShape::Kind::mesh;
+    auto above_tangents = [&](const PlacedShape& shape, double f0, double f1) {
+        Eigen::Vector3d g0, g1;
+        shape.signed_distance(a, &g0);
+        shape.signed_distance(b, &g1);
+        const double s0 = g0.dot(b - a), s1 = g1.dot(b - a); // slopes at the ends, per unit of t
+        if (s0 >= 0.0) return f0 >= margin;
+        if (s1 <= 0.0) return f1 >= margin;
+        const double t = std::clamp((f1 - s1 - f0) / (s0 - s1), 0.0, 1.0);
+        return f0 + s0 * t >= margin;
+    };
     auto reaches_in = [&](const PlacedShape& shape, double f0, double f1) {
+        if (convex && above_tangents(shape, f0, f1)) return false;
         struct Span {
             double t0, t1, f0, f1;
         };
@@ -217,6 +232,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     ContactTotals out;
     const Eigen::AlignedBox3d reach = tool.world_bounds(parameters.margin_mm);
     const bool keep = distance.size() >= points.count;
+    if (keep) std::fill(distance.begin(), distance.begin() + static_cast<std::ptrdiff_t>(points.count), std::numeric_limits<double>::infinity());
     PointPenalty pp;
     // Each point's parameters: the tool's, or the stiffness the snapshot gives it.
     const bool own = points.stiffness_n_per_mm.size() >= points.count;
@@ -229,17 +245,19 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         if (own) at.stiffness_n_per_mm = 0.5 * (points.stiffness_n_per_mm[a] + points.stiffness_n_per_mm[b]);
         return at;
     };
-    for (std::size_t i = 0; i < points.count; ++i) {
+    // Only the points and edges near the tool are visited (the snapshot's grid); the others keep
+    // +infinity.
+    points.for_each_point_near(reach, [&](std::size_t i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
         const bool inside = point_penalty(tool, nullptr, parameters_of(i), reach, p, points.areas_mm2[i], points.normals[i], pp);
-        if (keep) distance[i] = pp.measured ? pp.distance : std::numeric_limits<double>::infinity();
-        if (!inside) continue;
+        if (keep && pp.measured) distance[i] = pp.distance;
+        if (!inside) return;
         out.force_on_tool_n -= pp.force;
         out.torque_on_tool_n_mm -= (p - tool.position).cross(pp.force);
         out.stiffness_n_per_mm += pp.stiffness * pp.normal * pp.normal.transpose();
         out.area_mm2 += points.areas_mm2[i];
         out.inner_reaches_surface = out.inner_reaches_surface || pp.distance < 0.0;
-    }
+    });
     // The edges, as penalty_contact takes them (their ends' distances from the pass above when
     // kept, else measured again).
     EdgePenalty ep;
@@ -262,14 +280,15 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     };
     // Calls visit(ep) for each edge pressed (both passes).
     auto for_each_pressed_edge = [&](auto&& visit) {
-        for (const Eigen::Vector2i& edge : points.edges) {
+        points.for_each_edge_near(reach, [&](std::size_t k) {
+            const Eigen::Vector2i& edge = points.edges[k];
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-            if (b >= points.count || !may_reach_in(a, b)) continue;
+            if (b >= points.count || !may_reach_in(a, b)) return;
             const double d_a = measured(a), d_b = measured(b);
             if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                              points.areas_mm2[b], points.normals[a], points.normals[b], ep))
                 visit(ep);
-        }
+        });
     };
     for_each_pressed_edge([&](const EdgePenalty& e) {
         out.force_on_tool_n -= e.force;
@@ -282,13 +301,13 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     // A second pass for the load-carrying part: nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
-    for (std::size_t i = 0; i < points.count; ++i) {
+    points.for_each_point_near(reach, [&](std::size_t i) {
         if (!point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
-            continue;
-        if (!carries_load(pp.force, net)) continue;
+            return;
+        if (!carries_load(pp.force, net)) return;
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
-    }
+    });
     for_each_pressed_edge([&](const EdgePenalty& e) {
         if (!carries_load(e.force, net)) return;
         magnitude += e.force.norm();

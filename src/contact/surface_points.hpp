@@ -7,8 +7,11 @@
 #include "contact/mesh_ccd.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -29,6 +32,19 @@ namespace vox::contact {
     return out;
 }
 
+/// A uniform grid over a snapshot's points, so that the haptic loop visits only the points and
+/// edges near the tool rather than the whole snapshot (a knife's snapshot on a block it has cut
+/// again and again holds thousands of crack-wall points, a few hundred of them near the blade):
+/// per cell, the points in it and the edges whose first end is one of them.
+struct PointGrid {
+    double cell_mm = 0.0; ///< 0: no grid, every point and edge is visited
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    Eigen::Vector3i cells = Eigen::Vector3i::Zero();
+    std::vector<std::uint32_t> point_start, points; ///< per cell (and one more) into `points`: point indices
+    std::vector<std::uint32_t> edge_start, edges;   ///< per cell (and one more) into `edges`: edge indices
+    double longest_edge_mm = 0.0;
+};
+
 struct SurfacePoints {
     double t_s = -1e300;                      ///< simulated time the positions are from
     std::size_t count = 0;                    ///< points in use (the vectors hold capacity())
@@ -47,11 +63,58 @@ struct SurfacePoints {
     /// The triangles' edges, each once (surface_edges): what the edge penalty presses.
     std::vector<Eigen::Vector2i> edges;
 
+    /// The points' grid (index()).
+    PointGrid grid;
+
     explicit SurfacePoints(std::size_t capacity = 0)
         : positions_mm(capacity), normals(capacity), areas_mm2(capacity)
     {
     }
     [[nodiscard]] std::size_t capacity() const { return positions_mm.size(); }
+
+    /// After the points and triangles are filled (simulation thread): the triangles' tree, their
+    /// edges and the points' grid.
+    void index();
+
+    /// Calls visit(i) for every point that may lie in `box` (at least those that do); never allocates.
+    template <class Visit> void for_each_point_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
+    {
+        if (grid.cell_mm <= 0.0) {
+            for (std::size_t i = 0; i < count; ++i) visit(i);
+            return;
+        }
+        for_each_cell(box, [&](std::size_t c) {
+            for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.points[k]));
+        });
+    }
+    /// Calls visit(e) (an index into `edges`) for every edge that may meet `box` (at least those that do).
+    template <class Visit> void for_each_edge_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
+    {
+        if (grid.cell_mm <= 0.0) {
+            for (std::size_t e = 0; e < edges.size(); ++e) visit(e);
+            return;
+        }
+        // An edge meets the box only if both its ends lie within the box grown by its length.
+        const Eigen::Vector3d grow = Eigen::Vector3d::Constant(grid.longest_edge_mm);
+        for_each_cell(Eigen::AlignedBox3d(box.min() - grow, box.max() + grow), [&](std::size_t c) {
+            for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.edges[k]));
+        });
+    }
+
+private:
+    template <class Visit> void for_each_cell(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
+    {
+        Eigen::Vector3i lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max(0, static_cast<int>(std::floor((box.min()[a] - grid.origin[a]) / grid.cell_mm)));
+            hi[a] = std::min(grid.cells[a] - 1, static_cast<int>(std::floor((box.max()[a] - grid.origin[a]) / grid.cell_mm)));
+            if (!(box.max()[a] >= grid.origin[a]) || lo[a] > hi[a]) return; // outside the grid (or a NaN box)
+        }
+        for (int z = lo.z(); z <= hi.z(); ++z)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int x = lo.x(); x <= hi.x(); ++x)
+                    visit(static_cast<std::size_t>(x + grid.cells.x() * (y + static_cast<std::size_t>(grid.cells.y()) * z)));
+    }
 };
 
 } // namespace vox::contact

@@ -293,9 +293,7 @@ void sample_surface(const ModelSurface& surface, const std::vector<Eigen::Vector
     }
     // The triangles among the points, their tree and edges.
     out.triangles = triangles_among(surface, point_of);
-    const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
-    out.triangle_tree.rebuild(positions, positions, out.triangles);
-    out.edges = contact::surface_edges(out.triangles);
+    out.index();
 }
 
 void merge_node_contacts(std::vector<fem::NodeContact>& a, const std::vector<fem::NodeContact>& b)

@@ -7,28 +7,36 @@
 
 namespace vox::haptics {
 
-HapticLoop::HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity)
-    : m_device(device), m_model(std::move(model)), m_safety(safety)
+HapticLoop::HapticLoop(std::vector<HapticChannel> channels, std::size_t capacity)
 {
+    m_channels.reserve(channels.size());
+    for (HapticChannel& c : channels) m_channels.push_back({c.device, std::move(c.model), ForceSafety(c.safety), {}, Eigen::Vector3d::Zero()});
     m_timings.period_error_ms.resize(capacity);
     m_timings.force_us.resize(capacity);
+}
+
+HapticLoop::HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity)
+    : HapticLoop(std::vector<HapticChannel>{{&device, std::move(model), safety}}, capacity)
+{
 }
 
 HapticLoop::~HapticLoop() { stop(); }
 
 Eigen::Vector3d HapticLoop::tick(double t_s) noexcept
 {
-    m_device.read(t_s, m_state);
-    double age = 0.0;
-    Eigen::Vector3d f = Eigen::Vector3d::Zero();
-    try {
-        f = m_model(m_state, age);
-    } catch (...) { // a model that throws yields no force rather than ending the loop
-        age = 1e9;
+    for (Served& c : m_channels) {
+        c.device->read(t_s, c.state);
+        double age = 0.0;
+        Eigen::Vector3d f = Eigen::Vector3d::Zero();
+        try {
+            f = c.model(c.state, age);
+        } catch (...) { // a model that throws yields no force rather than ending the loop
+            age = 1e9;
+        }
+        c.force = c.safety.filter(f, t_s, age);
+        c.device->send(c.force, Eigen::Vector3d::Zero());
     }
-    f = m_safety.filter(f, t_s, age);
-    m_device.send(f, Eigen::Vector3d::Zero());
-    return f;
+    return m_channels.empty() ? Eigen::Vector3d::Zero() : m_channels.front().force;
 }
 
 void HapticLoop::start()

@@ -1,9 +1,10 @@
 #pragma once
-// The haptic loop: every millisecond, read the device, compute the force, pass it through the
-// safety stage, send it. Two ways to drive it:
+// The haptic loop: every millisecond, for each device it serves, read the device, compute the
+// force, pass it through that device's safety stage, send it. One loop serves every device of a
+// session (two hands, two tools): one thread, one deadline, the devices in turn. Two ways to drive it:
 //  - live: its own thread on absolute deadlines (sleep until shortly before the deadline, spin the
-//    rest; real-time priority where the system allows it), timing every period and every force
-//    computation into preallocated buffers;
+//    rest; real-time priority where the system allows it), timing every period and every tick's
+//    force computation (all devices) into preallocated buffers;
 //  - lockstep: tick(t) called by the simulation thread a fixed number of times per step, in
 //    simulated time, so headless runs and replays are deterministic.
 // The tick never allocates, locks, logs or throws.
@@ -28,30 +29,47 @@ struct LoopTimings {
     bool realtime_priority = false;      ///< SCHED_FIFO was granted
 };
 
+/// One device the loop serves: its force model and its own safety stage.
+struct HapticChannel {
+    Device* device = nullptr;
+    ForceModel model;
+    SafetySettings safety;
+};
+
 class HapticLoop {
 public:
     /// `capacity`: ticks whose timings are kept (live mode), allocated here.
+    HapticLoop(std::vector<HapticChannel> channels, std::size_t capacity = 60000);
+    /// One device.
     HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity = 60000);
     ~HapticLoop();
     HapticLoop(const HapticLoop&) = delete;
     HapticLoop& operator=(const HapticLoop&) = delete;
 
-    /// One tick at loop time t_s (lockstep mode); returns the force sent.
+    /// One tick at loop time t_s (lockstep mode), every device in turn; returns the force sent to
+    /// the first.
     Eigen::Vector3d tick(double t_s) noexcept;
 
     void start();        ///< live mode: starts the 1 kHz thread
     void stop();         ///< joins it
     /// The live thread's timings so far (call after stop()).
     [[nodiscard]] const LoopTimings& timings() const { return m_timings; }
-    [[nodiscard]] const DeviceState& state() const { return m_state; }
+    [[nodiscard]] std::size_t device_count() const { return m_channels.size(); }
+    /// Device i's state read and force sent at the last tick.
+    [[nodiscard]] const DeviceState& state(std::size_t i = 0) const { return m_channels[i].state; }
+    [[nodiscard]] const Eigen::Vector3d& force(std::size_t i = 0) const { return m_channels[i].force; }
 
 private:
+    struct Served {
+        Device* device;
+        ForceModel model;
+        ForceSafety safety;
+        DeviceState state;
+        Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    };
     void run();
 
-    Device& m_device;
-    ForceModel m_model;
-    ForceSafety m_safety;
-    DeviceState m_state;
+    std::vector<Served> m_channels;
     LoopTimings m_timings;
     std::size_t m_recorded = 0;
     std::atomic<bool> m_running{false};

@@ -15,7 +15,8 @@ namespace vox::haptics {
 namespace {
 
 constexpr const char* k_header_v1 = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n";
-constexpr const char* k_header = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change";
+constexpr const char* k_header_v2 = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change";
+constexpr const char* k_header = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change,device,tool";
 
 /// A reason as one CSV field: no commas, no line breaks.
 std::string field_text(std::string text)
@@ -35,10 +36,10 @@ void write_recording(const std::filesystem::path& path, const std::vector<Record
         std::fprintf(f, "%s\n", k_header);
         for (const RecordedTick& t : ticks) {
             const auto& s = t.state;
-            std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%u,%.17g,%.17g,%.17g,%d,%s\n", s.t_s, s.position_mm.x(),
+            std::fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%u,%.17g,%.17g,%.17g,%d,%s,%d,%s\n", s.t_s, s.position_mm.x(),
                          s.position_mm.y(), s.position_mm.z(), s.orientation.w(), s.orientation.x(), s.orientation.y(),
                          s.orientation.z(), static_cast<unsigned>(s.buttons), t.force_n.x(), t.force_n.y(), t.force_n.z(), t.level,
-                         field_text(t.level_change).c_str());
+                         field_text(t.level_change).c_str(), t.device, field_text(t.tool).c_str());
         }
         if (std::fclose(f) != 0) throw file_error(tmp.string(), "could not be written completely");
     });
@@ -52,9 +53,11 @@ std::vector<RecordedTick> read_recording(const std::filesystem::path& path)
     std::string line;
     if (!std::getline(in, line)) throw file_error(name, "is empty; a recording starts with the line " + std::string(k_header));
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line != k_header && line != k_header_v1) throw file_error(name, "line 1: expected the header " + std::string(k_header));
-    const bool levels = line == k_header; // older recordings have no level columns
-    const std::size_t expected = levels ? 14 : 12;
+    if (line != k_header && line != k_header_v2 && line != k_header_v1)
+        throw file_error(name, "line 1: expected the header " + std::string(k_header));
+    // Older recordings have no level columns (v1), or no device columns (v2).
+    const bool levels = line != k_header_v1, devices = line == k_header;
+    const std::size_t expected = devices ? 16 : levels ? 14 : 12;
     std::vector<RecordedTick> ticks;
     for (std::size_t row = 2; std::getline(in, line); ++row) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -91,7 +94,22 @@ std::vector<RecordedTick> read_recording(const std::filesystem::path& path)
             if (v[12] < 0 || v[12] != std::floor(v[12]) || v[12] > 64)
                 throw file_error(name, "line " + std::to_string(row) + ": level must be a whole number from 0 to 64");
             t.level = static_cast<int>(v[12]);
-            t.level_change = line.substr(line.rfind(',') + 1);
+            // The text fields after the numbers: level_change, then device and tool.
+            std::size_t at = 0;
+            for (int k = 0; k < 13; ++k) at = line.find(',', at) + 1;
+            const std::size_t end = line.find(',', at);
+            t.level_change = line.substr(at, end == std::string::npos ? std::string::npos : end - at);
+            if (devices) {
+                const std::size_t tool_at = line.find(',', end + 1);
+                const std::string cell = line.substr(end + 1, tool_at - end - 1);
+                char* stop = nullptr;
+                const long d = std::strtol(cell.c_str(), &stop, 10);
+                if (cell.empty() || *stop != '\0' || d < 0 || d >= k_max_devices)
+                    throw file_error(name, "line " + std::to_string(row) + ": device (\"" + cell + "\") must be a whole number from 0 to " +
+                                               std::to_string(k_max_devices - 1));
+                t.device = static_cast<int>(d);
+                t.tool = line.substr(tool_at + 1);
+            }
         }
         if (!ticks.empty() && t.state.t_s < ticks.back().state.t_s)
             throw file_error(name, "line " + std::to_string(row) + ": time goes backwards");
@@ -99,6 +117,21 @@ std::vector<RecordedTick> read_recording(const std::filesystem::path& path)
     }
     if (ticks.empty()) throw file_error(name, "holds no tick after its header");
     return ticks;
+}
+
+int recorded_devices(const std::vector<RecordedTick>& ticks)
+{
+    int n = 0;
+    for (const RecordedTick& t : ticks) n = std::max(n, t.device + 1);
+    return n;
+}
+
+std::vector<RecordedTick> device_ticks(const std::vector<RecordedTick>& ticks, int device)
+{
+    std::vector<RecordedTick> out;
+    for (const RecordedTick& t : ticks)
+        if (t.device == device) out.push_back(t);
+    return out;
 }
 
 ReplayDevice::ReplayDevice(std::vector<RecordedTick> ticks) : m_ticks(std::move(ticks))

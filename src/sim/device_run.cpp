@@ -25,80 +25,123 @@ constexpr double k_snapshot_margin_mm = 5.0;
 
 } // namespace
 
-DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options)
-    : m_scene(scene), m_snapshot(k_snapshot_points)
+DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options) : m_scene(scene)
 {
     if (scene.tools.empty()) throw scene.error("tools", "a device needs a tool to drive; the scene has none");
-    if (!options.tool.empty()) {
-        const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == options.tool; });
-        if (found == scene.tools.end()) throw InputError("--tool: the scene has no tool named \"" + options.tool + "\"");
-        m_tool = static_cast<std::size_t>(found - scene.tools.begin());
-    }
+    auto tool_named = [&](const std::string& name) -> std::size_t {
+        if (name.empty()) return 0;
+        const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == name; });
+        if (found == scene.tools.end()) throw InputError("--tool: the scene has no tool named \"" + name + "\"");
+        return static_cast<std::size_t>(found - scene.tools.begin());
+    };
     if (options.replay) {
-        auto replay = std::make_unique<haptics::ReplayDevice>(haptics::read_recording(*options.replay));
-        m_replay = replay.get();
-        m_device = std::move(replay);
+        m_replayed = haptics::read_recording(*options.replay);
+        const int devices = haptics::recorded_devices(m_replayed);
+        for (int d = 0; d < devices; ++d) {
+            std::vector<haptics::RecordedTick> ticks = haptics::device_ticks(m_replayed, d);
+            if (ticks.empty()) throw file_error(options.replay->string(), "holds no tick of device " + std::to_string(d));
+            // Recordings made before several devices name no tool: the one asked for, else the first.
+            const std::string& recorded = ticks.front().tool;
+            const std::size_t tool = recorded.empty() ? tool_named(options.tools.empty() ? std::string() : options.tools.front())
+                                                      : tool_named(recorded);
+            add_hand(tool, std::make_unique<haptics::ReplayDevice>(std::move(ticks)), tools);
+        }
     } else {
-        std::vector<haptics::KeyFrame> frames;
-        for (const io::ScriptEntry& e : scene.script)
-            if (e.tool_index == m_tool) frames.push_back({e.t_s, e.position_mm, e.orientation});
-        if (frames.empty())
-            throw scene.error("script", "the device follows the script of tool \"" + scene.tools[m_tool].name + "\", which has no entry");
-        m_device = std::make_unique<haptics::VirtualDevice>(std::move(frames));
+        const std::vector<std::string> names = options.tools.empty() ? std::vector<std::string>{std::string()} : options.tools;
+        for (const std::string& name : names) {
+            const std::size_t tool = tool_named(name);
+            std::vector<haptics::KeyFrame> frames;
+            for (const io::ScriptEntry& e : scene.script)
+                if (e.tool_index == tool) frames.push_back({e.t_s, e.position_mm, e.orientation});
+            if (frames.empty())
+                throw scene.error("script", "the device follows the script of tool \"" + scene.tools[tool].name + "\", which has no entry");
+            add_hand(tool, std::make_unique<haptics::VirtualDevice>(std::move(frames)), tools);
+        }
     }
-    const io::ToolSpec& spec = scene.tools[m_tool];
-    // The device's own limits where it declares them: its force, and a coupling it renders stably.
-    const haptics::DeviceLimits& limits = m_device->limits();
+    if (m_hands.size() > static_cast<std::size_t>(haptics::k_max_devices))
+        throw InputError("--device: at most " + std::to_string(haptics::k_max_devices) + " devices, " + std::to_string(m_hands.size()) +
+                         " given");
+    for (std::size_t i = 0; i < m_hands.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (m_hands[i]->tool == m_hands[j]->tool)
+                throw InputError("--tool: tool \"" + scene.tools[m_hands[i]->tool].name + "\" is driven by two devices; give each device its own --tool");
+    // One loop serves every device, each through its own coupling and safety stage.
+    std::vector<haptics::HapticChannel> channels;
+    for (const std::unique_ptr<Hand>& owned : m_hands) {
+        Hand* hand = owned.get();
+        haptics::SafetySettings safety;
+        const haptics::DeviceLimits& limits = hand->device->limits();
+        if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
+        channels.push_back({hand->device.get(),
+                            [this, hand](const haptics::DeviceState& state, double& age) {
+                                age = state.t_s - hand->snapshot.t_s;
+                                return hand->coupled->update(state, hand->snapshot, m_tick_s);
+                            },
+                            safety});
+    }
+    m_loop = std::make_unique<haptics::HapticLoop>(std::move(channels), 0);
+}
+
+void DeviceRun::add_hand(std::size_t tool, std::unique_ptr<haptics::Device> device, const ToolPolicy& tools)
+{
+    auto hand = std::make_unique<Hand>();
+    hand->tool = tool;
+    hand->device = std::move(device);
+    hand->snapshot = contact::SurfacePoints(k_snapshot_points);
+    const io::ToolSpec& spec = m_scene.tools[tool];
+    // The device's own limits where it declares them: a coupling it renders stably.
     haptics::CouplingSettings coupling;
+    const haptics::DeviceLimits& limits = hand->device->limits();
     if (limits.max_stiffness_n_per_mm > 0.0) coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, limits.max_stiffness_n_per_mm);
-    haptics::SafetySettings safety;
-    if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
-    m_coupled = std::make_unique<haptics::CoupledTool>(tools.shape(m_tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
-                                                       coupling, m_snapshot.capacity());
-    m_loop = std::make_unique<haptics::HapticLoop>(
-        *m_device,
-        [this](const haptics::DeviceState& state, double& age) {
-            age = state.t_s - m_snapshot.t_s;
-            return m_coupled->update(state, m_snapshot, m_tick_s);
-        },
-        safety, 0);
+    hand->coupled = std::make_unique<haptics::CoupledTool>(tools.shape(tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
+                                                           coupling, hand->snapshot.capacity());
+    m_hands.push_back(std::move(hand));
 }
 
 void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, double dt_s)
 {
-    // The snapshot: the surface around where the tool is, as the simulation has it at the frame's start.
-    if (!m_started) { // the proxy starts at the device; the reading is recorded so a replay starts alike
-        haptics::DeviceState first;
-        m_device->read(t0_s, first);
-        m_coupled->update(first, m_snapshot, k_tick_s);
-        m_recording.push_back({first, Eigen::Vector3d::Zero(), method.level(), {}});
+    if (!m_started) { // each proxy starts at its device; the readings are recorded so a replay starts alike
+        for (std::size_t i = 0; i < m_hands.size(); ++i) {
+            Hand& hand = *m_hands[i];
+            haptics::DeviceState first;
+            hand.device->read(t0_s, first);
+            hand.coupled->update(first, hand.snapshot, k_tick_s);
+            m_recording.push_back({first, Eigen::Vector3d::Zero(), method.level(), {}, static_cast<int>(i), m_scene.tools[hand.tool].name});
+        }
         m_started = true;
     }
-    const io::ToolSpec& spec = m_scene.tools[m_tool];
-    method.sample_surface(m_coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), spec, m_snapshot);
-    m_snapshot.t_s = t0_s;
-    if (m_snapshot.truncated && !m_warned_truncated) {
-        log::warn("the surface near the tool has more than {} points; the haptic snapshot keeps the first ones", m_snapshot.capacity());
-        m_warned_truncated = true;
+    // The snapshots: the surface around where each tool is, as the simulation has it at the frame's start.
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        const io::ToolSpec& spec = m_scene.tools[hand->tool];
+        method.sample_surface(hand->coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), spec, hand->snapshot);
+        hand->snapshot.t_s = t0_s;
+        if (hand->snapshot.truncated && !hand->warned_truncated) {
+            log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name,
+                      hand->snapshot.capacity());
+            hand->warned_truncated = true;
+        }
     }
     const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
     m_tick_s = dt_s / ticks;
-    for (int i = 1; i <= ticks; ++i) {
-        const double t = t0_s + i * dt_s / ticks;
-        const Eigen::Vector3d f = m_loop->tick(t);
-        m_recording.push_back({m_loop->state(), f, method.level(), std::exchange(m_level_change, {})});
-        m_forces.push_back({t, m_coupled->proxy().position, f});
+    for (int k = 1; k <= ticks; ++k) {
+        const double t = t0_s + k * dt_s / ticks;
+        m_loop->tick(t);
+        const std::string change = std::exchange(m_level_change, {});
+        for (std::size_t i = 0; i < m_hands.size(); ++i) {
+            Hand& hand = *m_hands[i];
+            const Eigen::Vector3d& f = m_loop->force(i);
+            m_recording.push_back({m_loop->state(i), f, method.level(), change, static_cast<int>(i), m_scene.tools[hand.tool].name});
+            hand.forces.push_back({t, hand.coupled->proxy().position, f});
+        }
     }
-    tools.drive(m_tool, m_coupled->proxy().position, m_coupled->proxy().orientation);
+    for (const std::unique_ptr<Hand>& hand : m_hands) tools.drive(hand->tool, hand->coupled->proxy().position, hand->coupled->proxy().orientation);
 }
 
 namespace {
 
 /// The first recorded tick after `t0_s`, or null.
-const haptics::RecordedTick* tick_after(const haptics::ReplayDevice* replay, double t0_s)
+const haptics::RecordedTick* tick_after(const std::vector<haptics::RecordedTick>& ticks, double t0_s)
 {
-    if (!replay) return nullptr;
-    const auto& ticks = replay->ticks();
     const auto it = std::upper_bound(ticks.begin(), ticks.end(), t0_s + 1e-9,
                                      [](double t, const haptics::RecordedTick& tick) { return t < tick.state.t_s; });
     return it == ticks.end() ? nullptr : &*it;
@@ -108,20 +151,20 @@ const haptics::RecordedTick* tick_after(const haptics::ReplayDevice* replay, dou
 
 std::optional<int> DeviceRun::recorded_level(double t0_s) const
 {
-    const haptics::RecordedTick* tick = tick_after(m_replay, t0_s);
+    const haptics::RecordedTick* tick = tick_after(m_replayed, t0_s);
     if (!tick || tick->level <= 0) return std::nullopt;
     return tick->level;
 }
 
 std::string DeviceRun::recorded_reason(double t0_s) const
 {
-    const haptics::RecordedTick* tick = tick_after(m_replay, t0_s);
+    const haptics::RecordedTick* tick = tick_after(m_replayed, t0_s);
     return tick && !tick->level_change.empty() ? tick->level_change : "the recording's level";
 }
 
-void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title)
+void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title, const std::string& name)
 {
-    write_atomically(dir / "forces.csv", [&](const std::filesystem::path& tmp) {
+    write_atomically(dir / (name + ".csv"), [&](const std::filesystem::path& tmp) {
         std::FILE* f = std::fopen(tmp.c_str(), "w");
         if (!f) throw file_error(tmp.string(), "cannot be written");
         std::fprintf(f, "t_s,x_mm,y_mm,z_mm,fx_n,fy_n,fz_n\n");
@@ -159,7 +202,7 @@ void write_forces(const std::filesystem::path& dir, const std::vector<ForceSampl
       << ")' text-anchor='middle'>force (N)</text>\n<polyline fill='none' stroke='#c0392b' stroke-width='1.5' points='";
     for (const ForceSample& s : samples) o << x(s.t_s) << ',' << y(s.force_n.norm()) << ' ';
     o << "'/>\n</svg>\n";
-    write_atomically(dir / "forces.svg", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << o.str(); });
+    write_atomically(dir / (name + ".svg"), [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << o.str(); });
 }
 
 } // namespace vox::sim

@@ -1,9 +1,10 @@
 #pragma once
-// A tool driven by a device in a headless run: the device (following the scene script, or
-// replaying a recording) is read every simulated millisecond by the haptic loop in lockstep with
-// the simulation; a virtual coupling holds the tool (the proxy) against a snapshot of the surface
-// near it, published once per frame; the proxy's pose is where the simulation puts the tool.
-// Every tick can be recorded (docs/recording-format.md) and replayed bit for bit.
+// Tools driven by devices in a headless run: each device (following the scene script for its
+// tool, or replaying a recording) is read every simulated millisecond by the one haptic loop, in
+// lockstep with the simulation; each has its own virtual coupling holding its tool (the proxy)
+// against a snapshot of the surface near that tool, published once per frame, and its own safety
+// stage; the proxies' poses are where the simulation puts the tools. Every tick of every device
+// can be recorded (docs/recording-format.md) and replayed bit for bit.
 
 #include "sim/level_governor.hpp"
 #include "sim/method.hpp"
@@ -30,29 +31,39 @@ struct ForceSample {
 };
 
 struct DeviceOptions {
-    std::string tool;                     ///< the scene tool the device drives (empty: the first tool)
-    std::optional<std::filesystem::path> replay; ///< play this recording instead of the script
+    /// One scripted device per entry, driving the scene tool of that name (`run --device script
+    /// --tool NAME`, once per device); an empty name: the scene's first tool. No entry: one device
+    /// on the first tool (with a replay: the recording's own devices).
+    std::vector<std::string> tools;
+    /// Play this recording instead: each device it holds drives the tool it recorded (a recording
+    /// made before several devices: tools.front(), or the first tool).
+    std::optional<std::filesystem::path> replay;
 };
 
 class DeviceRun {
 public:
-    /// Throws InputError for an unknown tool, a tool without script entries (script device), or a
-    /// bad recording.
+    /// Throws InputError for an unknown tool, a tool driven twice, a tool without script entries
+    /// (script device), a bad recording, or more than haptics::k_max_devices devices.
     DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options);
-    DeviceRun(const DeviceRun&) = delete; // the loop's force model refers to this object
+    DeviceRun(const DeviceRun&) = delete; // the loop's force models refer to this object
     DeviceRun& operator=(const DeviceRun&) = delete;
 
-    /// Runs the haptic ticks of the frame [t0, t0 + dt) against the surface as `method` has it
-    /// now, then tells `tools` where the device put the tool. Appends to forces() and recording().
+    /// Runs the haptic ticks of the frame [t0, t0 + dt) of every device against the surface as
+    /// `method` has it now, then tells `tools` where the devices put their tools. Appends to
+    /// forces() and recording().
     void frame(const Method& method, ToolPolicy& tools, double t0_s, double dt_s);
 
-    [[nodiscard]] std::size_t tool() const { return m_tool; }
-    [[nodiscard]] const std::vector<ForceSample>& forces() const { return m_forces; }
+    [[nodiscard]] std::size_t device_count() const { return m_hands.size(); }
+    /// The scene tool device `i` drives.
+    [[nodiscard]] std::size_t tool(std::size_t i = 0) const { return m_hands[i]->tool; }
+    /// Device `i`'s force at every tick.
+    [[nodiscard]] const std::vector<ForceSample>& forces(std::size_t i = 0) const { return m_hands[i]->forces; }
+    /// Every device's ticks, tick by tick.
     [[nodiscard]] const std::vector<haptics::RecordedTick>& recording() const { return m_recording; }
-    [[nodiscard]] std::string device_name() const { return m_device->name(); }
+    [[nodiscard]] std::string device_name(std::size_t i = 0) const { return m_hands[i]->device->name(); }
 
     /// A recording is being replayed: the run follows its levels, not a governor.
-    [[nodiscard]] bool replaying() const { return m_replay != nullptr; }
+    [[nodiscard]] bool replaying() const { return !m_replayed.empty(); }
     /// Replaying: the level the recording's first tick after `t0_s` ran at, and the reason it
     /// gave for being there; nothing without a replay or for a recording without levels.
     [[nodiscard]] std::optional<int> recorded_level(double t0_s) const;
@@ -61,23 +72,30 @@ public:
     void level_changed(const LevelChange& change) { m_level_change = change.reason; }
 
 private:
+    /// One device and what it drives.
+    struct Hand {
+        std::size_t tool = 0;
+        std::unique_ptr<haptics::Device> device;
+        std::unique_ptr<haptics::CoupledTool> coupled;
+        contact::SurfacePoints snapshot;
+        std::vector<ForceSample> forces;
+        bool warned_truncated = false;
+    };
+    void add_hand(std::size_t tool, std::unique_ptr<haptics::Device> device, const ToolPolicy& tools);
+
     const io::Scene& m_scene;
-    std::size_t m_tool = 0;
-    std::unique_ptr<haptics::Device> m_device;
-    const haptics::ReplayDevice* m_replay = nullptr; ///< m_device, when it replays a recording
+    std::vector<std::unique_ptr<Hand>> m_hands;
+    std::vector<haptics::RecordedTick> m_replayed;    ///< the recording replayed (all devices), if any
     std::string m_level_change;                       ///< for the next tick recorded
-    std::unique_ptr<haptics::CoupledTool> m_coupled;
-    contact::SurfacePoints m_snapshot;
     std::unique_ptr<haptics::HapticLoop> m_loop;
-    std::vector<ForceSample> m_forces;
     std::vector<haptics::RecordedTick> m_recording;
     bool m_started = false;
-    bool m_warned_truncated = false;
     double m_tick_s = 1e-3;
 };
 
-/// Writes forces.csv (t_s, x_mm, y_mm, z_mm, fx_n, fy_n, fz_n) and forces.svg (the force's
-/// magnitude against time) into `dir`.
-void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title);
+/// Writes NAME.csv (t_s, x_mm, y_mm, z_mm, fx_n, fy_n, fz_n) and NAME.svg (the force's magnitude
+/// against time) into `dir`.
+void write_forces(const std::filesystem::path& dir, const std::vector<ForceSample>& samples, const std::string& title,
+                  const std::string& name = "forces");
 
 } // namespace vox::sim

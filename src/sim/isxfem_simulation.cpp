@@ -562,9 +562,7 @@ void IsxfemSimulation::sample_surface(const Eigen::AlignedBox3d& box, contact::S
     out.triangles.clear();
     for (const Eigen::Vector3i& t : s.triangles)
         if (t.maxCoeff() < static_cast<int>(out.count)) out.triangles.push_back(t);
-    const std::span<const Eigen::Vector3d> positions(out.positions_mm.data(), out.count);
-    out.triangle_tree.rebuild(positions, positions, out.triangles);
-    out.edges = contact::surface_edges(out.triangles);
+    out.index();
 }
 
 } // namespace vox::sim

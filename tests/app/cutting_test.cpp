@@ -308,5 +308,15 @@ TEST(Cutting, DeviceOptionsRefuseWhatCannotBeDone)
     r = run_voxsculpt("run " + scene + " --replay " + quote((d / "missing.csv").string()) + " --out " + quote(d.string()));
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("missing.csv"), std::string::npos) << r.err;
+    // Several devices: one --tool per --device, each tool driven once, a replay on its own.
+    r = run_voxsculpt("run " + scene + " --device script --device script --tool knife --out " + quote(d.string()));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("give one per --device"), std::string::npos) << r.err;
+    r = run_voxsculpt("run " + scene + " --device script --tool knife --device script --tool knife --out " + quote(d.string()));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("driven by two devices"), std::string::npos) << r.err;
+    r = run_voxsculpt("run " + scene + " --device script --replay " + quote((d / "x.csv").string()) + " --out " + quote(d.string()));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--replay and --device"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(d / "x.csv"));
 }

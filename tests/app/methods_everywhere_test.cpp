@@ -104,6 +104,29 @@ TEST_P(EachMethodEndToEnd, ADeviceRunRecordedReplaysBitForBitOnThreeScenes)
     }
 }
 
+TEST_P(EachMethodEndToEnd, TwoDevicesAtOnceAreRecordedAndReplayedBitForBit)
+{
+    // data/scenes/two_hands.json with a device per tool, as a user runs it: a finger holds the
+    // block while a knife cuts it; each device's forces in its own file, both in the recording.
+    const fs::path d = fresh_dir(std::string("two_hands_") + GetParam());
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/two_hands.json");
+    const std::string recording = quote((d / "hands.csv").string());
+    const std::string common = " --solver " + std::string(GetParam()) + " --frames 120 ";
+    auto r = run_voxsculpt("run " + scene + common + "--device script --tool finger --device script --tool knife --record " + recording +
+                           " --out " + quote((d / "live").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_voxsculpt("run " + scene + common + "--replay " + recording + " --out " + quote((d / "replay").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* file : {"final.obj", "forces.csv", "forces_2.csv"}) EXPECT_EQ(slurp(d / "live" / file), slurp(d / "replay" / file)) << file;
+    std::ifstream in(d / "live" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    ASSERT_EQ(stats["devices"].size(), 2u);
+    EXPECT_EQ(stats["devices"][0]["tool"], "finger");
+    EXPECT_EQ(stats["devices"][1]["tool"], "knife");
+    EXPECT_EQ(stats["devices"][1]["forces"], "forces_2.csv");
+    EXPECT_GT(stats["summary"]["cutting_frames"].get<int>(), 0) << "the knife cut while the finger held";
+}
+
 TEST_P(EachMethodEndToEnd, TheViewerShowsThreeScenesInAWindow)
 {
     if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";

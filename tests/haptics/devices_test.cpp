@@ -83,4 +83,57 @@ TEST(Recording, MalformedFilesNameTheFileAndLine)
     refused("buttons.csv", header + "0,1,2,3,1,0,0,0,1.5,0,0,0\n", "buttons must be a whole number");
     refused("empty.csv", "", "is empty");
     refused("no_ticks.csv", header, "holds no tick");
+    const std::string header_devices = "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change,device,tool\n";
+    refused("device.csv", header_devices + "0,1,2,3,1,0,0,0,0,0,0,0,1,,x,knife\n", "line 2: device (\"x\") must be a whole number from 0 to 7");
+    refused("device_range.csv", header_devices + "0,1,2,3,1,0,0,0,0,0,0,0,1,,8,knife\n", "from 0 to 7");
+    refused("device_fields.csv", header_devices + "0,1,2,3,1,0,0,0,0,0,0,0,1,,0\n", "expected 16 comma-separated fields, got 15");
+}
+
+TEST(Recording, HoldsEveryDeviceAndReadsRecordingsFromBefore)
+{
+    // Two devices, tick by tick, each with the tool it drove; read back as written, and each
+    // device's ticks apart for its replay.
+    std::vector<RecordedTick> ticks;
+    for (int k = 0; k < 20; ++k)
+        for (int d = 0; d < 2; ++d) {
+            RecordedTick t;
+            t.state.t_s = k * 1e-3;
+            t.state.position_mm = Vector3d(d, k, 0.1 * k * (d + 1));
+            t.force_n = Vector3d(0, 0, 0.01 * k);
+            t.level = 2;
+            t.device = d;
+            t.tool = d == 0 ? "scalpel" : "finger";
+            ticks.push_back(t);
+        }
+    ticks[7].level_change = "as asked, with a comma"; // commas become semicolons
+    const auto dir = vox::test::fresh_dir("recording_devices");
+    write_recording(dir / "two.csv", ticks);
+    const auto back = read_recording(dir / "two.csv");
+    ASSERT_EQ(back.size(), ticks.size());
+    EXPECT_EQ(recorded_devices(back), 2);
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+        EXPECT_EQ(back[i].device, ticks[i].device);
+        EXPECT_EQ(back[i].tool, ticks[i].tool);
+        EXPECT_EQ(back[i].state.position_mm, ticks[i].state.position_mm);
+        EXPECT_EQ(back[i].level, 2);
+    }
+    EXPECT_EQ(back[7].level_change, "as asked; with a comma");
+    const std::vector<RecordedTick> finger = device_ticks(back, 1);
+    ASSERT_EQ(finger.size(), 20u);
+    ReplayDevice replay(finger);
+    DeviceState s;
+    replay.read(0.0125, s);
+    EXPECT_EQ(s.position_mm, ticks[2 * 12 + 1].state.position_mm); // tick 12, the last at or before
+    // Recordings from before several devices (with and without the level columns) are one device
+    // that named no tool.
+    std::ofstream(dir / "v2.csv") << "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n,level,level_change\n"
+                                     "0,1,2,3,1,0,0,0,0,0,0,0,3,\n0.001,1,2,4,1,0,0,0,0,0,0,0,4,over budget\n";
+    std::ofstream(dir / "v1.csv") << "t_s,x_mm,y_mm,z_mm,qw,qx,qy,qz,buttons,fx_n,fy_n,fz_n\n0,1,2,3,1,0,0,0,0,0,0,0\n";
+    for (const char* name : {"v2.csv", "v1.csv"}) {
+        const auto old = read_recording(dir / name);
+        EXPECT_EQ(recorded_devices(old), 1) << name;
+        EXPECT_EQ(old.front().device, 0);
+        EXPECT_TRUE(old.front().tool.empty());
+    }
+    EXPECT_EQ(read_recording(dir / "v2.csv").back().level_change, "over budget");
 }

@@ -80,3 +80,42 @@ TEST(HapticLoop, TicksNeverAllocate)
     EXPECT_LT(after_jab, 2.0 + 0.25 / 4 + 0.0011);
     EXPECT_GT(peak, 0.05);     // and the contact was felt
 }
+
+TEST(HapticLoop, OneLoopServesTwoDevicesEachWithItsOwnSafetyWithoutAllocating)
+{
+    // Two hands on one wall: a blade pressing in and a second blade pressing elsewhere, each
+    // coupled on its own; the second device's safety stage allows 0.05 N, the first's 3 N.
+    const contact::SurfacePoints wall = test::flat_wall(41, true);
+    const contact::ToolShape blade = contact::ToolShape::box({4, 0.5, 4});
+    haptics::CoupledTool left(blade, {0.25, 5.0}, {}, wall.capacity()), right(blade, {0.25, 5.0}, {}, wall.capacity());
+    const Eigen::Quaterniond level = Eigen::Quaterniond::Identity();
+    haptics::VirtualDevice a({{0.0, {-8, 0, 5}, level}, {0.2, {-8, 0, 1}, level}, {0.4, {-8, 0, 1}, level}});
+    haptics::VirtualDevice b({{0.0, {8, 0, 5}, level}, {0.3, {8, 0, 1}, level}, {0.4, {8, 0, 1}, level}});
+    haptics::SafetySettings gentle;
+    gentle.max_force_n = 0.05;
+    gentle.ramp_s = 0.0;
+    haptics::SafetySettings firm;
+    firm.ramp_s = 0.0;
+    std::vector<haptics::HapticChannel> channels;
+    channels.push_back({&a, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return left.update(s, wall, 1e-3); }, firm});
+    channels.push_back({&b, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return right.update(s, wall, 1e-3); }, gentle});
+    haptics::HapticLoop loop(std::move(channels), 0);
+    ASSERT_EQ(loop.device_count(), 2u);
+    loop.tick(0.0);
+    double peak_a = 0.0, peak_b = 0.0;
+    g_allocations = 0;
+    g_counting = true;
+    for (int k = 1; k <= 400; ++k) {
+        loop.tick(1e-3 * k);
+        peak_a = std::max(peak_a, loop.force(0).norm());
+        peak_b = std::max(peak_b, loop.force(1).norm());
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0);
+    EXPECT_GT(peak_a, 0.1);                // the first hand feels its press
+    EXPECT_NEAR(peak_b, 0.05, 1e-12);      // the second, clamped by its own stage
+    EXPECT_EQ(loop.state(1).position_mm, Eigen::Vector3d(8, 0, 1));
+    EXPECT_GT(left.proxy().position.x(), -9.0);
+    EXPECT_LT(left.proxy().position.x(), -7.0); // each proxy followed its own device
+    EXPECT_GT(right.proxy().position.x(), 7.0);
+}

@@ -1,0 +1,45 @@
+#include "contact/surface_points.hpp"
+
+namespace vox::contact {
+
+void SurfacePoints::index()
+{
+    const std::span<const Eigen::Vector3d> positions(positions_mm.data(), count);
+    triangle_tree.rebuild(positions, positions, triangles);
+    edges = surface_edges(triangles);
+    grid = PointGrid{};
+    if (count == 0) return;
+    Eigen::AlignedBox3d box;
+    box.setEmpty();
+    for (const Eigen::Vector3d& p : positions) box.extend(p);
+    for (const Eigen::Vector2i& e : edges)
+        grid.longest_edge_mm = std::max(grid.longest_edge_mm, (positions_mm[static_cast<std::size_t>(e[0])] - positions_mm[static_cast<std::size_t>(e[1])]).norm());
+    // Cells of 2 mm (a tool's reach covers a few hundred of them), fewer and larger on a snapshot
+    // so large that there would be more than 2^18.
+    const Eigen::Vector3d extent = box.sizes().cwiseMax(1e-6);
+    grid.cell_mm = std::max(2.0, std::cbrt(extent.prod() / 262144.0));
+    grid.origin = box.min();
+    for (int a = 0; a < 3; ++a) grid.cells[a] = static_cast<int>(extent[a] / grid.cell_mm) + 1;
+    const std::size_t cells = static_cast<std::size_t>(grid.cells.prod());
+    auto cell_of = [&](const Eigen::Vector3d& p) {
+        Eigen::Vector3i c;
+        for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - grid.origin[a]) / grid.cell_mm), 0, grid.cells[a] - 1);
+        return static_cast<std::size_t>(c.x() + grid.cells.x() * (c.y() + static_cast<std::size_t>(grid.cells.y()) * c.z()));
+    };
+    // Counting sorts: points by their cell, edges by their first end's.
+    std::vector<std::size_t> point_cell(count);
+    grid.point_start.assign(cells + 1, 0);
+    for (std::size_t i = 0; i < count; ++i) ++grid.point_start[(point_cell[i] = cell_of(positions_mm[i])) + 1];
+    for (std::size_t c = 0; c < cells; ++c) grid.point_start[c + 1] += grid.point_start[c];
+    grid.points.resize(count);
+    std::vector<std::uint32_t> fill(grid.point_start.begin(), grid.point_start.end() - 1);
+    for (std::size_t i = 0; i < count; ++i) grid.points[fill[point_cell[i]]++] = static_cast<std::uint32_t>(i);
+    grid.edge_start.assign(cells + 1, 0);
+    for (const Eigen::Vector2i& e : edges) ++grid.edge_start[point_cell[static_cast<std::size_t>(e[0])] + 1];
+    for (std::size_t c = 0; c < cells; ++c) grid.edge_start[c + 1] += grid.edge_start[c];
+    grid.edges.resize(edges.size());
+    fill.assign(grid.edge_start.begin(), grid.edge_start.end() - 1);
+    for (std::size_t k = 0; k < edges.size(); ++k) grid.edges[fill[point_cell[static_cast<std::size_t>(edges[k][0])]]++] = static_cast<std::uint32_t>(k);
+}
+
+} // namespace vox::contact
