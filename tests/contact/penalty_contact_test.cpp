@@ -459,3 +459,59 @@ TEST_F(EdgePenalty, AnEdgeLeftWithinTheStepPushesForThePartOfTheStepItWasIn)
     const double area = 0.1 * 8.0 / 6.0, share = 0.05 / 5.05, expected = 9.0 * 5.0 / 100.0 * area * 0.5 * 0.05 * share;
     EXPECT_NEAR(-c.force_on_tool_n.z(), -expected, 1e-3 * expected);
 }
+
+TEST(PenaltyTotals, TheSnapshotsGridVisitsEverythingThatTouches)
+{
+    // A wavy sheet of 0.7 mm triangles, indexed (SurfacePoints::index: its grid of cells), against
+    // the same sheet without a grid (every point and edge visited): the same totals and the same
+    // distances for the continuous check, for a blade and a ball at random poses, the blade's
+    // edge often lying across faces between points (the edge penalty's case).
+    const int n = 44;
+    SurfacePoints sheet(static_cast<std::size_t>(n * n));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j * n + i);
+            const double x = 0.7 * i - 15.0, y = 0.7 * j - 15.0;
+            sheet.positions_mm[k] = Vector3d(x, y, std::sin(0.3 * x) * std::cos(0.2 * y));
+            sheet.normals[k] = Vector3d(-0.3 * std::cos(0.3 * x) * std::cos(0.2 * y), 0.2 * std::sin(0.3 * x) * std::sin(0.2 * y), 1.0).normalized();
+            sheet.areas_mm2[k] = 0.49;
+        }
+    sheet.count = sheet.capacity();
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const int a = j * n + i;
+            sheet.triangles.emplace_back(a, a + 1, a + n + 1);
+            sheet.triangles.emplace_back(a, a + n + 1, a + n);
+        }
+    sheet.index();
+    ASSERT_GT(sheet.grid.cell_mm, 0.0);
+    SurfacePoints flat = sheet;
+    flat.grid = PointGrid{};
+    const ToolShape blade = ToolShape::box({8, 0.3, 4}), ball = ToolShape::sphere(2.0);
+    std::srand(11);
+    auto uniform = [](double lo, double hi) { return lo + (hi - lo) * std::rand() / static_cast<double>(RAND_MAX); };
+    std::vector<double> d_grid(sheet.count), d_flat(sheet.count);
+    int touched = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const ToolShape& shape = trial % 2 ? ball : blade;
+        const double height = trial % 2 ? 1.6 : 1.8;
+        PlacedShape tool{&shape, Vector3d(uniform(-12, 12), uniform(-12, 12), height + uniform(-0.4, 0.2)),
+                         Eigen::Quaterniond(Eigen::AngleAxisd(uniform(0, 3), Vector3d::UnitZ()))};
+        const ContactParameters parameters{0.25, 5.0};
+        const ContactTotals a = penalty_totals(tool, parameters, sheet, true, d_grid);
+        const ContactTotals b = penalty_totals(tool, parameters, flat, true, d_flat);
+        EXPECT_LT((a.force_on_tool_n - b.force_on_tool_n).norm(), 1e-12 * (1.0 + b.force_on_tool_n.norm())) << trial;
+        EXPECT_LT((a.torque_on_tool_n_mm - b.torque_on_tool_n_mm).norm(), 1e-12 * (1.0 + b.torque_on_tool_n_mm.norm())) << trial;
+        EXPECT_LT((a.stiffness_n_per_mm - b.stiffness_n_per_mm).norm(), 1e-12 * (1.0 + b.stiffness_n_per_mm.norm())) << trial;
+        EXPECT_NEAR(a.area_mm2, b.area_mm2, 1e-12 * (1.0 + b.area_mm2)) << trial;
+        EXPECT_NEAR(a.pressure_pa, b.pressure_pa, 1e-9 * (1.0 + b.pressure_pa)) << trial;
+        for (std::size_t k = 0; k < sheet.count; ++k) ASSERT_EQ(d_grid[k], d_flat[k]) << trial << ", point " << k;
+        // The same as the per-point model with the sheet's triangles (its edges included).
+        const ContactResult list = penalty_contact(tool, parameters, std::span(sheet.positions_mm.data(), sheet.count),
+                                                   std::span(sheet.areas_mm2.data(), sheet.count), std::span(sheet.normals.data(), sheet.count),
+                                                   nullptr, sheet.triangles);
+        EXPECT_LT((list.force_on_tool_n - a.force_on_tool_n).norm(), 1e-12 * (1.0 + a.force_on_tool_n.norm())) << trial;
+        touched += b.area_mm2 > 0.0;
+    }
+    EXPECT_GT(touched, 20); // not vacuous: most poses touch the sheet
+}
