@@ -280,8 +280,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     };
     // Calls visit(ep) for each edge pressed (both passes).
     auto for_each_pressed_edge = [&](auto&& visit) {
-        points.for_each_edge_near(reach, [&](std::size_t k) {
-            const Eigen::Vector2i& edge = points.edges[k];
+        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
             if (b >= points.count || !may_reach_in(a, b)) return;
             const double d_a = measured(a), d_b = measured(b);

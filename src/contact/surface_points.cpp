@@ -14,10 +14,10 @@ void SurfacePoints::index()
     for (const Eigen::Vector3d& p : positions) box.extend(p);
     for (const Eigen::Vector2i& e : edges)
         grid.longest_edge_mm = std::max(grid.longest_edge_mm, (positions_mm[static_cast<std::size_t>(e[0])] - positions_mm[static_cast<std::size_t>(e[1])]).norm());
-    // Cells of 2 mm (a tool's reach covers a few hundred of them), fewer and larger on a snapshot
+    // Cells of 1 mm (a knife's reach covers a few hundred of them), fewer and larger on a snapshot
     // so large that there would be more than 2^18.
     const Eigen::Vector3d extent = box.sizes().cwiseMax(1e-6);
-    grid.cell_mm = std::max(2.0, std::cbrt(extent.prod() / 262144.0));
+    grid.cell_mm = std::max(1.0, std::cbrt(extent.prod() / 262144.0));
     grid.origin = box.min();
     for (int a = 0; a < 3; ++a) grid.cells[a] = static_cast<int>(extent[a] / grid.cell_mm) + 1;
     const std::size_t cells = static_cast<std::size_t>(grid.cells.prod());
@@ -26,7 +26,7 @@ void SurfacePoints::index()
         for (int a = 0; a < 3; ++a) c[a] = std::clamp(static_cast<int>((p[a] - grid.origin[a]) / grid.cell_mm), 0, grid.cells[a] - 1);
         return static_cast<std::size_t>(c.x() + grid.cells.x() * (c.y() + static_cast<std::size_t>(grid.cells.y()) * c.z()));
     };
-    // Counting sorts: points by their cell, edges by their first end's.
+    // Counting sorts: points by their cell, edges by their middle's.
     std::vector<std::size_t> point_cell(count);
     grid.point_start.assign(cells + 1, 0);
     for (std::size_t i = 0; i < count; ++i) ++grid.point_start[(point_cell[i] = cell_of(positions_mm[i])) + 1];
@@ -34,12 +34,15 @@ void SurfacePoints::index()
     grid.points.resize(count);
     std::vector<std::uint32_t> fill(grid.point_start.begin(), grid.point_start.end() - 1);
     for (std::size_t i = 0; i < count; ++i) grid.points[fill[point_cell[i]]++] = static_cast<std::uint32_t>(i);
+    std::vector<std::size_t> edge_cell(edges.size());
+    for (std::size_t k = 0; k < edges.size(); ++k)
+        edge_cell[k] = cell_of(0.5 * (positions_mm[static_cast<std::size_t>(edges[k][0])] + positions_mm[static_cast<std::size_t>(edges[k][1])]));
     grid.edge_start.assign(cells + 1, 0);
-    for (const Eigen::Vector2i& e : edges) ++grid.edge_start[point_cell[static_cast<std::size_t>(e[0])] + 1];
+    for (const std::size_t c : edge_cell) ++grid.edge_start[c + 1];
     for (std::size_t c = 0; c < cells; ++c) grid.edge_start[c + 1] += grid.edge_start[c];
     grid.edges.resize(edges.size());
     fill.assign(grid.edge_start.begin(), grid.edge_start.end() - 1);
-    for (std::size_t k = 0; k < edges.size(); ++k) grid.edges[fill[point_cell[static_cast<std::size_t>(edges[k][0])]]++] = static_cast<std::uint32_t>(k);
+    for (std::size_t k = 0; k < edges.size(); ++k) grid.edges[fill[edge_cell[k]]++] = edges[k];
 }
 
 } // namespace vox::contact

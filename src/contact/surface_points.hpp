@@ -35,13 +35,15 @@ namespace vox::contact {
 /// A uniform grid over a snapshot's points, so that the haptic loop visits only the points and
 /// edges near the tool rather than the whole snapshot (a knife's snapshot on a block it has cut
 /// again and again holds thousands of crack-wall points, a few hundred of them near the blade):
-/// per cell, the points in it and the edges whose first end is one of them.
+/// per cell, the points in it and the edges whose middle is in it (their ends, in cell order, so
+/// that a tick reads them in sequence).
 struct PointGrid {
     double cell_mm = 0.0; ///< 0: no grid, every point and edge is visited
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     Eigen::Vector3i cells = Eigen::Vector3i::Zero();
     std::vector<std::uint32_t> point_start, points; ///< per cell (and one more) into `points`: point indices
-    std::vector<std::uint32_t> edge_start, edges;   ///< per cell (and one more) into `edges`: edge indices
+    std::vector<std::uint32_t> edge_start;          ///< per cell (and one more) into `edges`
+    std::vector<Eigen::Vector2i> edges;             ///< the edges' ends, cell by cell
     double longest_edge_mm = 0.0;
 };
 
@@ -87,17 +89,17 @@ struct SurfacePoints {
             for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.points[k]));
         });
     }
-    /// Calls visit(e) (an index into `edges`) for every edge that may meet `box` (at least those that do).
+    /// Calls visit(edge) (its two ends) for every edge that may meet `box` (at least those that do).
     template <class Visit> void for_each_edge_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
     {
         if (grid.cell_mm <= 0.0) {
-            for (std::size_t e = 0; e < edges.size(); ++e) visit(e);
+            for (const Eigen::Vector2i& e : edges) visit(e);
             return;
         }
-        // An edge meets the box only if both its ends lie within the box grown by its length.
-        const Eigen::Vector3d grow = Eigen::Vector3d::Constant(grid.longest_edge_mm);
+        // An edge meets the box only if its middle lies within half its length of the box.
+        const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.5 * grid.longest_edge_mm);
         for_each_cell(Eigen::AlignedBox3d(box.min() - grow, box.max() + grow), [&](std::size_t c) {
-            for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.edges[k]));
+            for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) visit(grid.edges[k]);
         });
     }
 

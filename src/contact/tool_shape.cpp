@@ -11,38 +11,6 @@
 namespace vox::contact {
 namespace {
 
-/// Exact signed distance from q to a convex counter-clockwise polygon; `g` the unit gradient.
-double polygon_distance(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& q, Eigen::Vector2d& g)
-{
-    const std::size_t n = poly.size();
-    double inside = -std::numeric_limits<double>::infinity();
-    Eigen::Vector2d inside_normal(1, 0);
-    double outside = std::numeric_limits<double>::infinity();
-    Eigen::Vector2d nearest = poly[0];
-    for (std::size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d a = poly[i], b = poly[(i + 1) % n];
-        const Eigen::Vector2d e = b - a;
-        const Eigen::Vector2d normal = Eigen::Vector2d(e.y(), -e.x()).normalized(); // outward for CCW
-        const double plane = normal.dot(q - a);
-        if (plane > inside) {
-            inside = plane;
-            inside_normal = normal;
-        }
-        const double t = std::clamp((q - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
-        const Eigen::Vector2d c = a + t * e;
-        const double d = (q - c).norm();
-        if (d < outside) {
-            outside = d;
-            nearest = c;
-        }
-    }
-    if (inside <= 0.0) { // inside a convex polygon the nearest edge is the nearest plane
-        g = inside_normal;
-        return inside;
-    }
-    g = outside > 0.0 ? Eigen::Vector2d((q - nearest) / outside) : inside_normal;
-    return outside;
-}
 
 /// The convex polygon moved out by `margin` (each edge along its outward normal).
 std::vector<Eigen::Vector2d> offset_polygon(const std::vector<Eigen::Vector2d>& poly, double margin)
@@ -143,7 +111,7 @@ ToolShape ToolShape::box(const Eigen::Vector3d& size)
     s.m_kind = Kind::box;
     s.m_size = size;
     const double hx = size.x() / 2, hz = size.z() / 2;
-    s.m_profile = {{-hx, -hz}, {hx, -hz}, {hx, hz}, {-hx, hz}};
+    s.set_profile({{-hx, -hz}, {hx, -hz}, {hx, hz}, {-hx, hz}});
     s.m_bounds = Eigen::AlignedBox3d(-size / 2, size / 2);
     return s;
 }
@@ -156,10 +124,10 @@ ToolShape ToolShape::scalpel(const Eigen::Vector3d& size)
     // The front rises at 45 degrees from the point; a blade shorter than it is tall becomes the
     // 45-degree triangle whose slanted side meets the back at height size.x() above the bottom.
     const double top_front = hx - size.z();
-    s.m_profile = {{-hx, -hz}, {hx, -hz}, {top_front, hz}, {-hx, hz}};
+    s.set_profile({{-hx, -hz}, {hx, -hz}, {top_front, hz}, {-hx, hz}});
     if (top_front <= -hx) {
         const double top = std::min(hz, -hz + size.x());
-        s.m_profile = {{-hx, -hz}, {hx, -hz}, {-hx, top}};
+        s.set_profile({{-hx, -hz}, {hx, -hz}, {-hx, top}});
         s.m_bounds.max().z() = top;
     }
     return s;
@@ -195,10 +163,44 @@ ToolShape ToolShape::from_mesh(TriangleMesh mesh)
     return s;
 }
 
+void ToolShape::set_profile(std::vector<Eigen::Vector2d> profile)
+{
+    m_profile = std::move(profile);
+    m_edges.clear();
+    for (std::size_t i = 0; i < m_profile.size(); ++i) {
+        const Eigen::Vector2d a = m_profile[i], e = m_profile[(i + 1) % m_profile.size()] - a;
+        m_edges.push_back({a, e, Eigen::Vector2d(e.y(), -e.x()).normalized(), 1.0 / e.squaredNorm()}); // outward for CCW
+    }
+}
+
 double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
 {
-    Eigen::Vector2d g2;
-    const double d2 = polygon_distance(m_profile, Eigen::Vector2d(p.x(), p.z()), g2);
+    // The exact signed distance to the convex profile in the x-z plane, and its unit gradient g2:
+    // inside, the nearest edge is the nearest plane; outside, the nearest point of the edges
+    // (squared distances compared, one square root).
+    const Eigen::Vector2d q(p.x(), p.z());
+    double inside = -std::numeric_limits<double>::infinity(), outside2 = std::numeric_limits<double>::infinity();
+    Eigen::Vector2d inside_normal(1, 0), nearest = m_edges.front().a;
+    for (const ProfileEdge& edge : m_edges) {
+        const Eigen::Vector2d from_a = q - edge.a;
+        const double plane = edge.normal.dot(from_a);
+        if (plane > inside) {
+            inside = plane;
+            inside_normal = edge.normal;
+        }
+        const Eigen::Vector2d c = edge.a + std::clamp(from_a.dot(edge.e) * edge.inverse_length2, 0.0, 1.0) * edge.e;
+        const double d2 = (q - c).squaredNorm();
+        if (d2 < outside2) {
+            outside2 = d2;
+            nearest = c;
+        }
+    }
+    Eigen::Vector2d g2 = inside_normal;
+    double d2 = inside;
+    if (inside > 0.0) {
+        d2 = std::sqrt(outside2);
+        if (d2 > 0.0) g2 = (q - nearest) / d2;
+    }
     const double sy = p.y() >= 0.0 ? 1.0 : -1.0;
     const double dy = std::abs(p.y()) - m_size.y() / 2;
     double d;
@@ -208,7 +210,7 @@ double ToolShape::prism_distance(const Eigen::Vector3d& p, Eigen::Vector3d* grad
         g = d2 >= dy ? Eigen::Vector3d(g2.x(), 0, g2.y()) : Eigen::Vector3d(0, sy, 0);
     } else {
         const double a = std::max(d2, 0.0), b = std::max(dy, 0.0);
-        d = std::hypot(a, b);
+        d = std::sqrt(a * a + b * b); // mm: no overflow to guard against (std::hypot is several times slower)
         g = (Eigen::Vector3d(a * g2.x(), b * sy, a * g2.y()) / d);
     }
     if (gradient) *gradient = g;
@@ -250,7 +252,7 @@ double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gra
     }
     case Kind::cylinder: {
         // Distances to the side (radial) and to the end planes (axial), combined as for a box.
-        const double rho = std::hypot(p.x(), p.y());
+        const double rho = std::sqrt(p.x() * p.x() + p.y() * p.y());
         const Eigen::Vector2d radial = rho > 0.0 ? Eigen::Vector2d(p.x() / rho, p.y() / rho) : Eigen::Vector2d(1, 0);
         const double dr = rho - m_radius, dz = std::abs(p.z()) - m_length / 2;
         const double sz = p.z() >= 0.0 ? 1.0 : -1.0;
@@ -258,7 +260,7 @@ double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gra
             if (gradient) *gradient = dr >= dz ? Eigen::Vector3d(radial.x(), radial.y(), 0) : Eigen::Vector3d(0, 0, sz);
             return std::max(dr, dz);
         }
-        const double a = std::max(dr, 0.0), b = std::max(dz, 0.0), d = std::hypot(a, b);
+        const double a = std::max(dr, 0.0), b = std::max(dz, 0.0), d = std::sqrt(a * a + b * b);
         if (gradient) *gradient = Eigen::Vector3d(a * radial.x(), a * radial.y(), b * sz) / d;
         return d;
     }

@@ -74,6 +74,14 @@ private:
     double m_length = 0.0; ///< cylinder
     /// box, scalpel: the convex profile in the x-z plane, counter-clockwise (x right, z up).
     std::vector<Eigen::Vector2d> m_profile;
+    /// Its edges as the distance needs them, worked out once (set_profile): the distance is
+    /// taken for every surface point near the tool at every 1 kHz tick.
+    struct ProfileEdge {
+        Eigen::Vector2d a, e, normal; ///< start, edge vector, outward unit normal
+        double inverse_length2 = 0.0; ///< 1 / |e|^2
+    };
+    std::vector<ProfileEdge> m_edges;
+    void set_profile(std::vector<Eigen::Vector2d> profile);
     TriangleMesh m_mesh; ///< mesh tools
     Eigen::AlignedBox3d m_bounds;
 };
