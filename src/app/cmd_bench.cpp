@@ -7,6 +7,7 @@
 #include "bench/harness/conditioning.hpp"
 #include "bench/harness/cutting.hpp"
 #include "bench/harness/drilling.hpp"
+#include "bench/harness/glide.hpp"
 #include "bench/harness/haptics.hpp"
 #include "bench/harness/stability.hpp"
 #include "bench/harness/tradeoff.hpp"
@@ -48,6 +49,11 @@ void add_bench_command(CLI::App& app)
     haptics->callback([seconds, isxfem, haptics_solver, devices] {
         run_haptics_bench(*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices);
     });
+
+    auto glide_out = std::make_shared<std::string>("out");
+    CLI::App* glide = bench->add_subcommand("glide", "The force's change per 1 kHz tick while a ball glides across a block, each method, two speeds");
+    glide->add_option("--out", *glide_out, "Folder for glide.md and glide.json (default out)");
+    glide->callback([glide_out] { run_glide_bench(*glide_out); });
 
     auto cutting_runs = std::make_shared<int>(3);
     auto cutting_out = std::make_shared<std::string>("out");
