@@ -29,6 +29,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <chrono>
 #include <thread>
@@ -101,7 +102,7 @@ struct Hand {
 
 } // namespace
 
-void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
+void run_haptics_bench(double seconds, io::SolverType method_type, int devices, bool lockstep)
 {
     // The press-and-cut scene one level coarser (2 mm -> 4 mm elements), so that the simulation
     // thread alone keeps its snapshots fresh (under the 50 ms the safety stage allows).
@@ -127,7 +128,9 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
 
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    auto now_s = [&start] { return std::chrono::duration<double>(clock::now() - start).count(); };
+    // Lockstep: simulated time, the ticks run by this thread between frames (the same ticks every run).
+    double simulated_s = 0.0;
+    auto now_s = [&] { return lockstep ? simulated_s : std::chrono::duration<double>(clock::now() - start).count(); };
     // The simulation keeps to one thread: the other core is the loop's.
     const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
     // Written by the haptic thread only (sized here), read after it has stopped. The knife's mesh
@@ -161,9 +164,10 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
     }
     haptics::HapticLoop loop(std::move(channels), capacity);
 
-    log::info("bench haptics: 1 kHz loop for {} s, {} device(s), against a cutting simulation ({}, {})", seconds, hands.size(), scene.source,
-              io::solver_type_name(method_type));
-    loop.start();
+    log::info("bench haptics: 1 kHz loop for {} s, {} device(s), against a cutting simulation ({}, {}){}", seconds, hands.size(), scene.source,
+              io::solver_type_name(method_type), lockstep ? ", lockstep" : "");
+    if (!lockstep) loop.start();
+    std::vector<double> lockstep_force_us;
     int frames = 0, cutting_frames = 0;
     std::vector<double> snapshot_points, frame_ms;
     for (const std::unique_ptr<Hand>& hand : hands) { // the devices' first poses, until the loop reports
@@ -172,7 +176,7 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
         hand->device.read(0.0, first);
         hand->pose.position = first.position_mm;
     }
-    while (now_s() < seconds) {
+    while (lockstep ? frames * scene.solver.dt_s < seconds : now_s() < seconds) {
         const auto frame_start = clock::now();
         for (const std::unique_ptr<Hand>& hand : hands) {
             if (hand->poses.update()) hand->pose = hand->poses.read_slot();
@@ -192,23 +196,34 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices)
         snapshot_points.push_back(points);
         frame_ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - frame_start).count());
         ++frames;
+        if (lockstep) { // the frame's ticks, timed one by one
+            const int ticks_per_frame = static_cast<int>(std::lround(scene.solver.dt_s / 1e-3));
+            for (int k = 1; k <= ticks_per_frame; ++k) {
+                simulated_s = (frames - 1) * scene.solver.dt_s + k * 1e-3;
+                const auto t0 = clock::now();
+                loop.tick(simulated_s);
+                lockstep_force_us.push_back(std::chrono::duration<double, std::micro>(clock::now() - t0).count());
+            }
+            continue;
+        }
         // Simulated time keeps pace with wall time, as in a live session (a late frame does not wait).
         std::this_thread::sleep_until(start + std::chrono::duration<double>(frames * scene.solver.dt_s));
     }
     loop.stop();
-    const Percentiles period = percentiles(loop.timings().period_error_ms);
-    const Percentiles force = percentiles(loop.timings().force_us);
+    const Percentiles period = percentiles(lockstep ? std::vector<double>{0.0} : loop.timings().period_error_ms);
+    const std::vector<double>& force_us = lockstep ? lockstep_force_us : loop.timings().force_us;
+    const Percentiles force = percentiles(force_us);
     // The ticks that swept the knife's mesh (the costliest kind), on their own.
     std::vector<double> mesh_force_us;
     std::size_t mesh_stops = 0;
-    for (std::size_t i = 0; i < loop.timings().force_us.size() && i < capacity; ++i)
+    for (std::size_t i = 0; i < force_us.size() && i < capacity; ++i)
         if (swept_mesh[i]) {
-            mesh_force_us.push_back(loop.timings().force_us[i]);
+            mesh_force_us.push_back(force_us[i]);
             mesh_stops += stopped_by_mesh[i];
         }
     const Percentiles mesh_force = percentiles(mesh_force_us);
     std::printf("machine: %s\n\n", machine_description().c_str());
-    const std::size_t ticks = loop.timings().period_error_ms.size();
+    const std::size_t ticks = force_us.size();
     std::printf("| ticks | simulation frames (median) | cutting frames | snapshot points, all devices (median) | device ticks on a stale snapshot | "
                 "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | ticks that swept the knife's mesh (stopped by it) | "
                 "their force time p50 / p99 / max | devices |\n|---|---|---|---|---|---|---|---|---|---|---|\n");

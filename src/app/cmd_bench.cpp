@@ -46,8 +46,11 @@ void add_bench_command(CLI::App& app)
         ->check(CLI::IsMember({"dbg", "isxfem", "shape_matching"}));
     haptics->add_option("--devices", *devices, "Devices the loop serves at once: 1 (a knife) or 2 (a knife and a finger pressing together)")
         ->check(CLI::Range(1, 2));
-    haptics->callback([seconds, isxfem, haptics_solver, devices] {
-        run_haptics_bench(*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices);
+    auto lockstep = std::make_shared<bool>(false);
+    haptics->add_flag("--lockstep", *lockstep,
+                      "No threads: the simulation and the ticks take turns in simulated time, the same ticks every run (force time only)");
+    haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep] {
+        run_haptics_bench(*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices, *lockstep);
     });
 
     auto glide_out = std::make_shared<std::string>("out");

@@ -42,7 +42,10 @@ void SurfacePoints::index()
     for (std::size_t c = 0; c < cells; ++c) grid.edge_start[c + 1] += grid.edge_start[c];
     grid.edges.resize(edges.size());
     fill.assign(grid.edge_start.begin(), grid.edge_start.end() - 1);
-    for (std::size_t k = 0; k < edges.size(); ++k) grid.edges[fill[edge_cell[k]]++] = edges[k];
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+        const Eigen::Vector3d &a = positions_mm[static_cast<std::size_t>(edges[k][0])], &b = positions_mm[static_cast<std::size_t>(edges[k][1])];
+        grid.edges[fill[edge_cell[k]]++] = {edges[k], (0.5 * (a + b)).cast<float>(), static_cast<float>(0.5 * (b - a).norm())};
+    }
 }
 
 } // namespace vox::contact

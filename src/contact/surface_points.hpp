@@ -42,8 +42,15 @@ struct PointGrid {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     Eigen::Vector3i cells = Eigen::Vector3i::Zero();
     std::vector<std::uint32_t> point_start, points; ///< per cell (and one more) into `points`: point indices
-    std::vector<std::uint32_t> edge_start;          ///< per cell (and one more) into `edges`
-    std::vector<Eigen::Vector2i> edges;             ///< the edges' ends, cell by cell
+    /// An edge as a tick reads it: its ends, and the ball around it (middle and half its length),
+    /// which rejects most edges near the tool without reading their ends' positions.
+    struct Edge {
+        Eigen::Vector2i ends;
+        Eigen::Vector3f middle;
+        float half_length;
+    };
+    std::vector<std::uint32_t> edge_start; ///< per cell (and one more) into `edges`
+    std::vector<Edge> edges;               ///< cell by cell
     double longest_edge_mm = 0.0;
 };
 
@@ -98,8 +105,15 @@ struct SurfacePoints {
         }
         // An edge meets the box only if its middle lies within half its length of the box.
         const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.5 * grid.longest_edge_mm);
+        const Eigen::Vector3f lo = box.min().cast<float>(), hi = box.max().cast<float>();
         for_each_cell(Eigen::AlignedBox3d(box.min() - grow, box.max() + grow), [&](std::size_t c) {
-            for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) visit(grid.edges[k]);
+            for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) {
+                const PointGrid::Edge& e = grid.edges[k];
+                // A float's rounding is far below the 1e-3 mm slack.
+                const float h = e.half_length + 1e-3f;
+                if ((e.middle.array() + h < lo.array()).any() || (e.middle.array() - h > hi.array()).any()) continue;
+                visit(e.ends);
+            }
         });
     }
 
