@@ -8,10 +8,9 @@
 #include "sim/device_run.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/method_factory.hpp"
+#include "test_support.hpp"
 
 #include <gtest/gtest.h>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -22,14 +21,7 @@ namespace vox::sim {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path fresh_dir(const std::string& name)
-{
-    const fs::path d = fs::temp_directory_path() / ("voxsculpt-two-devices-" + std::to_string(::getpid()) + "-" + name);
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
+using test::fresh_dir;
 
 /// A block held at its base; a ball presses its left end from the start, another its right end
 /// from 0.15 s on.
@@ -77,7 +69,7 @@ class TwoDevicesOnEachMethod : public ::testing::TestWithParam<io::SolverType> {
 TEST_P(TwoDevicesOnEachMethod, EachDrivesItsToolAndTheRecordingReplaysBothBitForBit)
 {
     const std::string name(io::solver_type_name(GetParam()));
-    const fs::path dir = fresh_dir(name);
+    const fs::path dir = fresh_dir("two_devices_" + name);
     const io::Scene scene = io::load_scene(write_scene(dir, name));
     DeviceOptions two;
     two.tools = {"left", "right"};
@@ -146,7 +138,7 @@ INSTANTIATE_TEST_SUITE_P(Methods, TwoDevicesOnEachMethod,
 
 TEST(TwoDevices, EachToolHasOneDevice)
 {
-    const fs::path dir = fresh_dir("refused");
+    const fs::path dir = fresh_dir("two_devices_refused");
     const io::Scene scene = io::load_scene(write_scene(dir, "dbg"));
     ToolPolicy tools(scene);
     DeviceOptions o;
