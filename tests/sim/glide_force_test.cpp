@@ -35,7 +35,7 @@ TEST_P(GlideOnEachMethod, TheForceChangesLittleFromTickToTickAsTheToolCrossesPar
 
 INSTANTIATE_TEST_SUITE_P(Methods, GlideOnEachMethod,
                          ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
-                         [](const auto& info) { return std::string(io::solver_type_name(info.param)); });
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 } // namespace
 } // namespace vox::sim

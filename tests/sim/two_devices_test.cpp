@@ -134,7 +134,7 @@ TEST_P(TwoDevicesOnEachMethod, EachDrivesItsToolAndTheRecordingReplaysBothBitFor
 
 INSTANTIATE_TEST_SUITE_P(Methods, TwoDevicesOnEachMethod,
                          ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem, io::SolverType::shape_matching),
-                         [](const auto& info) { return std::string(io::solver_type_name(info.param)); });
+                         [](const auto& method) { return std::string(io::solver_type_name(method.param)); });
 
 TEST(TwoDevices, EachToolHasOneDevice)
 {
