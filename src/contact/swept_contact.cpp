@@ -42,7 +42,10 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
         const double measured = known ? from_distance[i] : far;
         const double d0 = (measured < far ? measured : from.signed_distance(p)) - margin_mm + grip;
         if (keep) clearance[i] = d0 - grip <= 0.0 ? -far : d0 - grip;
-        if (d0 <= 0.0 || d0 > speed) continue;   // in the contact at the start, or out of reach
+        // In the contact at the start (to within the tolerance: a point the tool leaves from a
+        // micrometre deep, as a ball gliding over a surface leaves the points behind it, would
+        // otherwise be found touched at t = 0 and hold the tool for ticks), or out of reach.
+        if (d0 <= tolerance || d0 > speed) continue;
         const double d1 = to.signed_distance(p) - margin_mm;
         if (d1 <= 0.0) continue;                 // in the contact at the end: the discrete contact has it
         if (d0 + d1 + grip > speed) continue;    // too far to be reached in between

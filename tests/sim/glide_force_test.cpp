@@ -20,14 +20,14 @@ TEST_P(GlideOnEachMethod, TheForceChangesLittleFromTickToTickAsTheToolCrossesPar
     ASSERT_GT(g.ticks, 1000u);
     EXPECT_GT(g.mean_force_n, 0.05) << "the ball presses the block";
     // Measured: the force's own rise over a tick is a few mN; a new snapshot's move is spread
-    // over the frame (haptics/coupled_tool.hpp). p99 0.004 N on the finite-element methods,
-    // 0.0011 N on shape matching.
-    EXPECT_LT(g.p99_change_n, 0.01);
+    // over the frame (haptics/coupled_tool.hpp), and a point the ball leaves no longer stops it
+    // (contact/swept_contact.hpp). Largest change 0.0045 N on the branched grid, 0.0039 N on
+    // Is-XFEM (0.037 and 0.133 N before that), 0.0015 N on shape matching (SCPC: the material's
+    // own stiffness on the clusters' goal surface).
+    EXPECT_LT(g.p99_change_n, 0.006);
+    EXPECT_LT(g.largest_change_n, 0.01);
+    EXPECT_LT(g.largest_change_n, 0.1 * g.mean_force_n);
     if (GetParam() == io::SolverType::shape_matching) {
-        // SCPC: the material's own stiffness on the clusters' goal surface. Measured 0.0015 N
-        // (2 % of the force). The penalty contact of the finite-element methods catches now and
-        // then as the ball crosses the surface's triangles (0.04 - 0.13 N once or twice a glide:
-        // docs/shape-matching.md).
         EXPECT_LT(g.largest_change_n, 0.005);
         EXPECT_LT(g.largest_change_n, 0.05 * g.mean_force_n);
     }
