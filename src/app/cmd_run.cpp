@@ -116,7 +116,7 @@ void add_run_command(CLI::App& app)
         if (!args->replay.empty() && !args->devices.empty())
             throw InputError("--replay and --device: a replay drives the tools with the devices it recorded; give one or the other");
         const std::size_t device_count = args->replay.empty() ? args->devices.size() : 1;
-        if (args->tools.size() > std::max<std::size_t>(device_count, 1) || (device_count > 1 && args->tools.size() != device_count))
+        if (device_count > 1 ? args->tools.size() != device_count : args->tools.size() > 1)
             throw InputError("--tool: give one per --device, in the same order (" + std::to_string(args->devices.size()) + " device(s), " +
                              std::to_string(args->tools.size()) + " tool(s))");
         if (!args->resume.empty() && !std::filesystem::is_regular_file(args->resume)) // before the object is loaded

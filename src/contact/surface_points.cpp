@@ -12,8 +12,6 @@ void SurfacePoints::index()
     Eigen::AlignedBox3d box;
     box.setEmpty();
     for (const Eigen::Vector3d& p : positions) box.extend(p);
-    for (const Eigen::Vector2i& e : edges)
-        grid.longest_edge_mm = std::max(grid.longest_edge_mm, (positions_mm[static_cast<std::size_t>(e[0])] - positions_mm[static_cast<std::size_t>(e[1])]).norm());
     // Cells of 1 mm (a knife's reach covers a few hundred of them), fewer and larger on a snapshot
     // so large that there would be more than 2^18.
     const Eigen::Vector3d extent = box.sizes().cwiseMax(1e-6);
@@ -34,18 +32,21 @@ void SurfacePoints::index()
     grid.points.resize(count);
     std::vector<std::uint32_t> fill(grid.point_start.begin(), grid.point_start.end() - 1);
     for (std::size_t i = 0; i < count; ++i) grid.points[fill[point_cell[i]]++] = static_cast<std::uint32_t>(i);
+    // Each edge's ball (middle and half length) once; the longest edge bounds a query's growth.
+    std::vector<PointGrid::Edge> balls(edges.size());
     std::vector<std::size_t> edge_cell(edges.size());
-    for (std::size_t k = 0; k < edges.size(); ++k)
-        edge_cell[k] = cell_of(0.5 * (positions_mm[static_cast<std::size_t>(edges[k][0])] + positions_mm[static_cast<std::size_t>(edges[k][1])]));
     grid.edge_start.assign(cells + 1, 0);
-    for (const std::size_t c : edge_cell) ++grid.edge_start[c + 1];
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+        const Eigen::Vector3d &a = positions_mm[static_cast<std::size_t>(edges[k][0])], &b = positions_mm[static_cast<std::size_t>(edges[k][1])];
+        const double half = 0.5 * (b - a).norm();
+        balls[k] = {edges[k], (0.5 * (a + b)).cast<float>(), static_cast<float>(half)};
+        grid.longest_edge_mm = std::max(grid.longest_edge_mm, 2.0 * half);
+        ++grid.edge_start[(edge_cell[k] = cell_of(0.5 * (a + b))) + 1];
+    }
     for (std::size_t c = 0; c < cells; ++c) grid.edge_start[c + 1] += grid.edge_start[c];
     grid.edges.resize(edges.size());
     fill.assign(grid.edge_start.begin(), grid.edge_start.end() - 1);
-    for (std::size_t k = 0; k < edges.size(); ++k) {
-        const Eigen::Vector3d &a = positions_mm[static_cast<std::size_t>(edges[k][0])], &b = positions_mm[static_cast<std::size_t>(edges[k][1])];
-        grid.edges[fill[edge_cell[k]]++] = {edges[k], (0.5 * (a + b)).cast<float>(), static_cast<float>(0.5 * (b - a).norm())};
-    }
+    for (std::size_t k = 0; k < edges.size(); ++k) grid.edges[fill[edge_cell[k]]++] = balls[k];
 }
 
 } // namespace vox::contact
