@@ -42,14 +42,119 @@ bool point_penalty(const PlacedShape& tool, const PlacedShape* from, const Conta
 /// An edge of the object's surface against the pushing shape (the Is-XFEM sculpting paper's
 /// edge-edge penalty, its equation 19): both ends outside, at both poses, but the edge between
 /// them reaching in, as where a thin blade's edge lies across a face between two vertices. The
-/// deepest point p = w_a a + w_b b along the edge (the distance along a segment is convex for a
-/// convex shape: golden-section search), its depth there (integrated over the move as a point's),
+/// deepest point p = w_a a + w_b b along the edge, its depth there (integrated over the move as a point's),
 /// and the area it stands for: a third of its ends' mean area (a vertex has about three edges of
 /// its own) times the share of its length inside.
 struct EdgePenalty {
     double w_a = 0.0, depth = 0.0, stiffness = 0.0, area = 0.0, distance = 0.0;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero(), force = Eigen::Vector3d::Zero(), at = Eigen::Vector3d::Zero();
 };
+
+/// Where an edge a-b reaches deepest into a pushing shape of margin `margin` around `shape`: the
+/// parameter t of its deepest point along it, and the share of its length within the margin.
+struct EdgeReach {
+    double t = 0.0, share = 0.0;
+};
+
+/// A convex shape's signed distance is convex along the edge: f(t) = d(a + t (b - a)).
+struct Probe {
+    double t = 0.0, f = 0.0, slope = 0.0; ///< f and df/dt there
+};
+
+Probe probe(const PlacedShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t) noexcept
+{
+    Eigen::Vector3d gradient;
+    const double f = shape.signed_distance(a + t * (b - a), &gradient);
+    return {t, f, gradient.dot(b - a)};
+}
+
+/// A convex shape: its lowest point by cutting planes (the tangents at the bracket's two ends meet
+/// below the function, at a lower bound of it; probing there either proves the edge stays out,
+/// finds the lowest point to within a micrometre of that bound, or halves the work by narrowing
+/// the bracket: exact in as many probes as pieces for a box's piecewise-flat distance), then the
+/// crossings of the margin on each side by Newton's method from the ends (from the outside of a
+/// convex function it approaches the crossing without passing it). About ten distance
+/// evaluations an edge, where a golden-section search and bisections took about ninety.
+bool convex_reach(const PlacedShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double margin, EdgeReach& out) noexcept
+{
+    constexpr double tolerance = 1e-6; // mm of distance
+    const Probe end_a = probe(shape, a, b, 0.0), end_b = probe(shape, a, b, 1.0);
+    Probe lowest = end_a.f <= end_b.f ? end_a : end_b;
+    if (end_a.slope < 0.0 && end_b.slope > 0.0) { // the lowest point is between the ends
+        Probe lo = end_a, hi = end_b;
+        for (int k = 0; k < 40 && hi.t - lo.t > 1e-9; ++k) {
+            double t = (hi.f - lo.f + lo.slope * lo.t - hi.slope * hi.t) / (lo.slope - hi.slope);
+            const double bound = lo.f + lo.slope * (t - lo.t); // f >= bound over [lo.t, hi.t]
+            if (bound >= margin) return false;
+            if (lowest.f - bound <= tolerance) break;
+            // A cut hugging one end narrows slowly (a rounded distance's bottom): halve instead.
+            const double width = hi.t - lo.t;
+            if (t - lo.t < 0.05 * width || hi.t - t < 0.05 * width) t = 0.5 * (lo.t + hi.t);
+            const Probe at = probe(shape, a, b, t);
+            if (at.f < lowest.f) lowest = at;
+            (at.slope < 0.0 ? lo : hi) = at;
+            if (at.slope == 0.0) break;
+        }
+    }
+    if (!(lowest.f < margin)) return false;
+    auto crossing = [&](Probe p) { // from an end outside the margin towards the lowest point
+        for (int k = 0; k < 30 && p.f - margin > tolerance && p.slope != 0.0; ++k) {
+            const double t = std::clamp(p.t - (p.f - margin) / p.slope, std::min(p.t, lowest.t), std::max(p.t, lowest.t));
+            if (t == p.t) break;
+            p = probe(shape, a, b, t);
+        }
+        return p.t;
+    };
+    out.t = lowest.t;
+    out.share = crossing(end_b) - crossing(end_a);
+    return true;
+}
+
+/// Any shape (a mesh tool's distance need not be convex): halving the edge while the distance's
+/// Lipschitz bound leaves room, then a golden-section search for the deepest point and bisections
+/// for where the edge leaves the margin on each side.
+bool general_reach(const PlacedShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double f_a, double f_b, double margin,
+                   EdgeReach& out) noexcept
+{
+    const double length = (b - a).norm();
+    struct Span {
+        double t0, t1, f0, f1;
+    };
+    std::array<Span, 24> stack{};
+    int top = 0;
+    stack[top++] = {0.0, 1.0, f_a, f_b};
+    bool in = false;
+    while (top > 0 && !in) {
+        const Span s = stack[--top];
+        if (0.5 * (s.f0 + s.f1 - (s.t1 - s.t0) * length) >= margin) continue; // 1-Lipschitz: this span stays out
+        const double mid = 0.5 * (s.t0 + s.t1), fm = shape.signed_distance(a + mid * (b - a));
+        in = fm < margin;
+        if (top + 2 > static_cast<int>(stack.size()) || (s.t1 - s.t0) * length < 1e-4) continue; // finer than 0.1 um: out
+        stack[top++] = {s.t0, mid, s.f0, fm};
+        stack[top++] = {mid, s.t1, fm, s.f1};
+    }
+    if (!in) return false;
+    auto distance = [&](double t) { return shape.signed_distance(a + t * (b - a)); };
+    constexpr double golden = 0.6180339887498949;
+    double lo = 0.0, hi = 1.0, t1 = hi - golden * (hi - lo), t2 = lo + golden * (hi - lo), f1 = distance(t1), f2 = distance(t2);
+    for (int k = 0; k < 30 && (hi - lo) * length > 1e-4; ++k) {
+        if (f1 < f2) {
+            hi = t2, t2 = t1, f2 = f1, t1 = hi - golden * (hi - lo), f1 = distance(t1);
+        } else {
+            lo = t1, t1 = t2, f1 = f2, t2 = lo + golden * (hi - lo), f2 = distance(t2);
+        }
+    }
+    out.t = 0.5 * (lo + hi);
+    auto leaves = [&](double inside, double outside) {
+        for (int k = 0; k < 30 && std::abs(outside - inside) * length > 1e-4; ++k) {
+            const double mid = 0.5 * (inside + outside);
+            (distance(mid) < margin ? inside : outside) = mid;
+        }
+        return 0.5 * (inside + outside);
+    };
+    out.share = distance(out.t) < margin ? leaves(out.t, 1.0) - leaves(out.t, 0.0) : 0.0;
+    return true;
+}
 
 bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const ContactParameters& parameters, const Eigen::Vector3d& a,
                   const Eigen::Vector3d& b, double d_a, double d_b, double area_a, double area_b, const Eigen::Vector3d& n_a,
@@ -63,73 +168,22 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     if (from_a < margin || from_b < margin) return false; // a point contact has it, at the step's start
     if (out_of_reach(d_a, d_b) && out_of_reach(from_a, from_b)) return false;
 
-    // Whether any point of it is inside, at either pose. A convex shape's distance is convex along
-    // the edge, so it lies above its tangents at the two ends: where they meet above the margin,
-    // the edge is out (an edge of a crack wall alongside a blade, parallel to its face a hair
-    // beyond the margin, took dozens of halvings below, a tick's worth of time over a wall). Else
-    // halve the edge while the distance's Lipschitz bound leaves room.
+    // Where the edge reaches deepest, and the share of it inside, at the pose it reaches in at
+    // (the end's, if both).
     const bool convex = tool.shape && tool.shape->kind() != ToolShape::Kind::mesh;
-    auto above_tangents = [&](const PlacedShape& shape, double f0, double f1) {
-        Eigen::Vector3d g0, g1;
-        shape.signed_distance(a, &g0);
-        shape.signed_distance(b, &g1);
-        const double s0 = g0.dot(b - a), s1 = g1.dot(b - a); // slopes at the ends, per unit of t
-        if (s0 >= 0.0) return f0 >= margin;
-        if (s1 <= 0.0) return f1 >= margin;
-        const double t = std::clamp((f1 - s1 - f0) / (s0 - s1), 0.0, 1.0);
-        return f0 + s0 * t >= margin;
-    };
-    auto reaches_in = [&](const PlacedShape& shape, double f0, double f1) {
-        if (convex && above_tangents(shape, f0, f1)) return false;
-        struct Span {
-            double t0, t1, f0, f1;
-        };
-        std::array<Span, 24> stack{};
-        int top = 0;
-        stack[top++] = {0.0, 1.0, f0, f1};
-        while (top > 0) {
-            const Span s = stack[--top];
-            if (0.5 * (s.f0 + s.f1 - (s.t1 - s.t0) * length) >= margin) continue; // out_of_reach for this span
-            const double mid = 0.5 * (s.t0 + s.t1), fm = shape.signed_distance(a + mid * (b - a));
-            if (fm < margin) return true;
-            if (top + 2 > static_cast<int>(stack.size()) || (s.t1 - s.t0) * length < 1e-4) continue; // finer than 0.1 um: out
-            stack[top++] = {s.t0, mid, s.f0, fm};
-            stack[top++] = {mid, s.t1, fm, s.f1};
-        }
+    EdgeReach reach;
+    const bool in_now = convex ? convex_reach(tool, a, b, margin, reach) : general_reach(tool, a, b, d_a, d_b, margin, reach);
+    if (!in_now && !(from && (convex ? convex_reach(*from, a, b, margin, reach) : general_reach(*from, a, b, from_a, from_b, margin, reach))))
         return false;
-    };
-    // The deepest point is looked for at the pose the edge reaches in at (the end's, if both).
-    const bool in_now = reaches_in(tool, d_a, d_b);
-    if (!in_now && !(from && reaches_in(*from, from_a, from_b))) return false;
-    const PlacedShape& search = in_now ? tool : *from;
-    auto distance = [&](double t) { return search.signed_distance(a + t * (b - a)); };
-    constexpr double golden = 0.6180339887498949;
-    double lo = 0.0, hi = 1.0, t1 = hi - golden * (hi - lo), t2 = lo + golden * (hi - lo), f1 = distance(t1), f2 = distance(t2);
-    for (int k = 0; k < 30 && (hi - lo) * length > 1e-4; ++k) {
-        if (f1 < f2) {
-            hi = t2, t2 = t1, f2 = f1, t1 = hi - golden * (hi - lo), f1 = distance(t1);
-        } else {
-            lo = t1, t1 = t2, f1 = f2, t2 = lo + golden * (hi - lo), f2 = distance(t2);
-        }
-    }
-    const double t = 0.5 * (lo + hi);
+    const double t = reach.t;
     out.at = a + t * (b - a);
     out.distance = tool.signed_distance(out.at, &out.normal);
     out.depth = margin - out.distance;
     double inside = out.depth > 0.0 ? 1.0 : 0.0;
     if (from) out.depth = mean_penetration(margin - from->signed_distance(out.at), out.depth, inside);
     if (!(out.depth > 0.0)) return false;
-    // The share of the edge inside, at that pose: bisection for where it leaves on each side.
-    auto leaves = [&](double in, double outside) {
-        for (int k = 0; k < 30 && std::abs(outside - in) * length > 1e-4; ++k) {
-            const double mid = 0.5 * (in + outside);
-            (search.signed_distance(a + mid * (b - a)) < margin ? in : outside) = mid;
-        }
-        return 0.5 * (in + outside);
-    };
-    const double share = search.signed_distance(out.at) < margin ? leaves(t, 1.0) - leaves(t, 0.0) : 0.0;
     out.w_a = 1.0 - t;
-    out.area = std::max(share, 1e-3) * (area_a + area_b) / 6.0;
+    out.area = std::max(reach.share, 1e-3) * (area_a + area_b) / 6.0;
     const Eigen::Vector3d outward = out.w_a * n_a + t * n_b;
     if (outward.squaredNorm() > 0.0) out.normal = -outward.normalized(); // along the object's normal, as a point's
     const double k = parameters.stiffness_n_per_mm / 100.0 * out.area;

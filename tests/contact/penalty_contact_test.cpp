@@ -515,3 +515,39 @@ TEST(PenaltyTotals, TheSnapshotsGridVisitsEverythingThatTouches)
     }
     EXPECT_GT(touched, 20); // not vacuous: most poses touch the sheet
 }
+
+TEST(EdgePenaltySearch, AConvexToolsShortSearchFindsWhatTheGeneralSearchFindsOnTheSameShapeAsAMesh)
+{
+    // The same blade and scalpel twice: as themselves (their distance is convex along an edge,
+    // searched by cutting planes and Newton steps) and as their own triangle meshes (searched by
+    // halving, golden sections and bisections, which assume nothing). Random short edges around
+    // them, tilted poses, a margin: the same edges pressed, with the same forces and torques to
+    // the general search's own tolerance (0.1 um along the edge).
+    std::srand(7);
+    auto uniform = [](double lo, double hi) { return lo + (hi - lo) * std::rand() / RAND_MAX; };
+    const ContactParameters parameters{0.25, 5.0};
+    for (const ToolShape& convex : {ToolShape::box({16, 1, 8}), ToolShape::scalpel({2, 1.2, 8})}) {
+        const ToolShape as_mesh = ToolShape::from_mesh(convex.mesh(0.0, 1));
+        const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Vector3d(1, 2, 3).normalized()));
+        const PlacedShape a{&convex, Vector3d(0.3, -0.2, 0.1), turn}, b{&as_mesh, a.position, turn};
+        const Eigen::AlignedBox3d box = a.world_bounds(1.0);
+        int pressed = 0;
+        for (int trial = 0; trial < 400; ++trial) {
+            const Vector3d p(uniform(box.min().x(), box.max().x()), uniform(box.min().y(), box.max().y()), uniform(box.min().z(), box.max().z()));
+            const Vector3d q = p + Vector3d(uniform(-1.5, 1.5), uniform(-1.5, 1.5), uniform(-1.5, 1.5));
+            const std::vector<Vector3d> points{p, q, p + Vector3d(0, 0, 50)}, normals(3, Vector3d(0, 0, 1));
+            const std::vector<double> areas{1.0, 1.2, 1.0};
+            const std::vector<Eigen::Vector3i> triangle{Eigen::Vector3i(0, 1, 2)};
+            const ContactResult by_convex = penalty_contact(a, parameters, points, areas, normals, nullptr, triangle);
+            const ContactResult by_mesh = penalty_contact(b, parameters, points, areas, normals, nullptr, triangle);
+            ASSERT_EQ(by_convex.points.size(), by_mesh.points.size()) << "trial " << trial;
+            const double scale = std::max(by_mesh.force_on_tool_n.norm(), 1e-9);
+            EXPECT_NEAR((by_convex.force_on_tool_n - by_mesh.force_on_tool_n).norm(), 0.0, 1e-3 * scale) << "trial " << trial;
+            EXPECT_NEAR((by_convex.torque_on_tool_n_mm - by_mesh.torque_on_tool_n_mm).norm(), 0.0, 2e-2 * scale) << "trial " << trial;
+            const bool edge_only = by_mesh.points.size() == 2 && (points[0] - points[1]).norm() > 0.0 &&
+                                   a.signed_distance(p) >= parameters.margin_mm && a.signed_distance(q) >= parameters.margin_mm;
+            pressed += edge_only;
+        }
+        EXPECT_GT(pressed, 10); // the sample does press edges between their ends
+    }
+}
