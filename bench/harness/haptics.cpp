@@ -189,6 +189,7 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices, 
             const io::ToolSpec& spec = scene.tools[hand->tool];
             contact::SurfacePoints& out = hand->snapshots.write_slot();
             method->sample_surface(hand->pose.world_bounds(spec.push_margin_mm + 5.0), spec, out);
+            contact::measure_slack(hand->pose, spec.push_margin_mm, out);
             out.t_s = now_s();
             hand->snapshots.publish();
             points += static_cast<double>(out.count);

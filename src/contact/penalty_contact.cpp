@@ -54,6 +54,7 @@ struct EdgePenalty {
 /// parameter t of its deepest point along it, and the share of its length within the margin.
 struct EdgeReach {
     double t = 0.0, share = 0.0;
+    double lower = 0.0; ///< when it does not reach in: a lower bound of the distance along it (>= margin)
 };
 
 /// A convex shape's signed distance is convex along the edge: f(t) = d(a + t (b - a)).
@@ -80,11 +81,13 @@ bool convex_reach(const PlacedShape& shape, const Eigen::Vector3d& a, const Eige
     constexpr double tolerance = 1e-6; // mm of distance
     const Probe end_a = probe(shape, a, b, 0.0), end_b = probe(shape, a, b, 1.0);
     Probe lowest = end_a.f <= end_b.f ? end_a : end_b;
+    out.lower = lowest.f;
     if (end_a.slope < 0.0 && end_b.slope > 0.0) { // the lowest point is between the ends
         Probe lo = end_a, hi = end_b;
         for (int k = 0; k < 40 && hi.t - lo.t > 1e-9; ++k) {
             double t = (hi.f - lo.f + lo.slope * lo.t - hi.slope * hi.t) / (lo.slope - hi.slope);
             const double bound = lo.f + lo.slope * (t - lo.t); // f >= bound over [lo.t, hi.t]
+            out.lower = bound;
             if (bound >= margin) return false;
             if (lowest.f - bound <= tolerance) break;
             // A cut hugging one end narrows slowly (a rounded distance's bottom): halve instead.
@@ -190,6 +193,23 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     out.force = k * out.depth * out.normal;
     out.stiffness = k * inside;
     return true;
+}
+
+/// How far the tool may move from where it is before the edge a-b can be pressed (ends at
+/// distances d_a, d_b): while an end is inside the pushing shape the point contact has it, and an
+/// edge that stays out is out by a lower bound of the distance along it; 0 if it is pressed now.
+double edge_slack(const PlacedShape& tool, double margin, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double d_a, double d_b) noexcept
+{
+    if (d_a < margin || d_b < margin) return std::max(d_a < margin ? margin - d_a : 0.0, d_b < margin ? margin - d_b : 0.0);
+    double lower = 0.5 * (d_a + d_b - (b - a).norm()); // 1-Lipschitz
+    EdgeReach reach;
+    if (tool.shape->kind() != ToolShape::Kind::mesh) {
+        if (convex_reach(tool, a, b, margin, reach)) return 0.0;
+        lower = std::max(lower, reach.lower);
+    } else if (lower < margin && general_reach(tool, a, b, d_a, d_b, margin, reach)) {
+        return 0.0;
+    }
+    return std::max(0.0, lower - margin);
 }
 
 /// Whether a point force carries the load: within 60 degrees of the net force on the object (all
@@ -299,9 +319,14 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         if (own) at.stiffness_n_per_mm = 0.5 * (points.stiffness_n_per_mm[a] + points.stiffness_n_per_mm[b]);
         return at;
     };
-    // Only the points and edges near the tool are visited (the snapshot's grid); the others keep
+    // Only the points and edges near the tool are visited (the snapshot's grid), and of those only
+    // the ones whose slack the tool has used up since the snapshot was measured; the others keep
     // +infinity.
+    const double spent = points.slack_spent(tool, parameters.margin_mm);
+    const bool slack = spent < INFINITY && points.point_slack_mm.size() >= points.count;
+    auto left_out = [&](std::size_t i) { return slack && points.point_slack_mm[i] > spent; };
     points.for_each_point_near(reach, [&](std::size_t i) {
+        if (left_out(i)) return;
         const Eigen::Vector3d& p = points.positions_mm[i];
         const bool inside = point_penalty(tool, nullptr, parameters_of(i), reach, p, points.areas_mm2[i], points.normals[i], pp);
         if (keep && pp.measured) distance[i] = pp.distance;
@@ -334,9 +359,9 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     };
     // Calls visit(ep) for each edge pressed (both passes).
     auto for_each_pressed_edge = [&](auto&& visit) {
-        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
+        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge, float edge_slack) {
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-            if (b >= points.count || !may_reach_in(a, b)) return;
+            if ((slack && edge_slack > spent) || b >= points.count || !may_reach_in(a, b)) return;
             const double d_a = measured(a), d_b = measured(b);
             if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                              points.areas_mm2[b], points.normals[a], points.normals[b], ep))
@@ -355,7 +380,8 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     points.for_each_point_near(reach, [&](std::size_t i) {
-        if (!point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
+        if (left_out(i) ||
+            !point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
             return;
         if (!carries_load(pp.force, net)) return;
         magnitude += pp.force.norm();
@@ -368,6 +394,27 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     });
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;
+}
+
+void measure_slack(const PlacedShape& tool, double margin_mm, SurfacePoints& points)
+{
+    // Stored a hair short, in float: a slack is only ever an underestimate.
+    auto stored = [](double slack) { return static_cast<float>(std::max(0.0, slack - 1e-5)); };
+    std::vector<double> distance(points.count);
+    points.point_slack_mm.resize(points.count);
+    points.slack_radius_mm = 0.0;
+    for (std::size_t i = 0; i < points.count; ++i) {
+        const Eigen::Vector3d& p = points.positions_mm[i];
+        distance[i] = tool.signed_distance(p);
+        points.point_slack_mm[i] = stored(distance[i] - margin_mm);
+        points.slack_radius_mm = std::max(points.slack_radius_mm, (p - tool.position).norm());
+    }
+    for (PointGrid::Edge& e : points.grid.edges) {
+        const auto a = static_cast<std::size_t>(e.ends[0]), b = static_cast<std::size_t>(e.ends[1]);
+        e.slack_mm = b < points.count ? stored(edge_slack(tool, margin_mm, points.positions_mm[a], points.positions_mm[b], distance[a], distance[b])) : 0.0f;
+    }
+    points.slack_pose = tool;
+    points.slack_margin_mm = margin_mm;
 }
 
 } // namespace vox::contact

@@ -94,6 +94,13 @@ struct ContactTotals {
 [[nodiscard]] ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
                                            bool with_pressure = true, std::span<double> distance = {}) noexcept;
 
+/// Measures a snapshot's slack against `tool` where it is now, pushing with margin `margin_mm`
+/// (SurfacePoints::slack_pose; after index()), in the simulation thread: per point and edge, how
+/// far the tool may move before it can take part in penalty_totals' contact, so that the 1 kHz
+/// loop's ticks on this snapshot leave it out until then. Leaving out changes nothing the ticks
+/// compute.
+void measure_slack(const PlacedShape& tool, double margin_mm, SurfacePoints& points);
+
 /// Contact of `tool` (its inner shape, placed in the world) with surface points (world mm), each
 /// carrying `areas[i]` mm^2 of surface with outward unit normal `normals[i]` (a zero normal: the
 /// point is pushed along the tool's outward normal instead). Points outside the outer shape are skipped.

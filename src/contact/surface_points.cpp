@@ -8,6 +8,7 @@ void SurfacePoints::index()
     triangle_tree.rebuild(positions, positions, triangles);
     edges = surface_edges(triangles);
     grid = PointGrid{};
+    slack_pose = PlacedShape{}; // measured anew for these positions, if at all
     if (count == 0) return;
     Eigen::AlignedBox3d box;
     box.setEmpty();

@@ -5,6 +5,7 @@
 // and publishes it; the haptic thread only reads it, so it never allocates.
 
 #include "contact/mesh_ccd.hpp"
+#include "contact/tool_shape.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -48,6 +49,7 @@ struct PointGrid {
         Eigen::Vector2i ends;
         Eigen::Vector3f middle;
         float half_length;
+        float slack_mm = 0.0f; ///< SurfacePoints::slack_pose
     };
     std::vector<std::uint32_t> edge_start; ///< per cell (and one more) into `edges`
     std::vector<Edge> edges;               ///< cell by cell
@@ -75,6 +77,17 @@ struct SurfacePoints {
     /// The points' grid (index()).
     PointGrid grid;
 
+    /// What a tick of the 1 kHz loop may leave out (measure_slack, contact/penalty_contact.hpp,
+    /// after index()): the tool's pose and margin the snapshot was measured against, and per point
+    /// (here) and per edge (grid.edges) how far the tool may move from that pose before the point
+    /// or edge can take part in the contact; 0 where it does, or may. A tick moves the tool
+    /// micrometres, and a snapshot is new every few ticks, so most of a knife's crack walls, a
+    /// hair outside its margin, need not be measured again until the next snapshot.
+    PlacedShape slack_pose;                   ///< no shape: no slack (nothing is left out)
+    double slack_margin_mm = 0.0;
+    double slack_radius_mm = 0.0;             ///< farthest point from slack_pose.position
+    std::vector<float> point_slack_mm;
+
     explicit SurfacePoints(std::size_t capacity = 0)
         : positions_mm(capacity), normals(capacity), areas_mm2(capacity)
     {
@@ -84,6 +97,15 @@ struct SurfacePoints {
     /// After the points and triangles are filled (simulation thread): the triangles' tree, their
     /// edges and the points' grid.
     void index();
+
+    /// How far the points may have come nearer to `tool` (pushing margin `margin_mm`) than they
+    /// were to the tool at slack_pose: its move plus its turn times the farthest point's distance
+    /// (a distance is 1-Lipschitz); infinity when the slack is for another shape or margin.
+    [[nodiscard]] double slack_spent(const PlacedShape& tool, double margin_mm) const noexcept
+    {
+        if (!slack_pose.shape || slack_pose.shape != tool.shape || slack_margin_mm != margin_mm) return INFINITY;
+        return (tool.position - slack_pose.position).norm() + tool.orientation.angularDistance(slack_pose.orientation) * slack_radius_mm;
+    }
 
     /// Calls visit(i) for every point that may lie in `box` (at least those that do); never allocates.
     template <class Visit> void for_each_point_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
@@ -96,11 +118,12 @@ struct SurfacePoints {
             for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.points[k]));
         });
     }
-    /// Calls visit(edge) (its two ends) for every edge that may meet `box` (at least those that do).
+    /// Calls visit(edge) (its two ends) and its slack (0 without the grid) for every edge that may
+    /// meet `box` (at least those that do).
     template <class Visit> void for_each_edge_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
     {
         if (grid.cell_mm <= 0.0) {
-            for (const Eigen::Vector2i& e : edges) visit(e);
+            for (const Eigen::Vector2i& e : edges) visit(e, 0.0f);
             return;
         }
         // An edge meets the box only if its middle lies within half its length of the box.
@@ -112,7 +135,7 @@ struct SurfacePoints {
                 // A float's rounding is far below the 1e-3 mm slack.
                 const float h = e.half_length + 1e-3f;
                 if ((e.middle.array() + h < lo.array()).any() || (e.middle.array() - h > hi.array()).any()) continue;
-                visit(e.ends);
+                visit(e.ends, e.slack_mm);
             }
         });
     }

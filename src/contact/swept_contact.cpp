@@ -35,9 +35,13 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
     // its stiffness) from the next step on; a point touched only at depth zero would not resist.
     const double grip = 1e-3, tolerance = 1e-4; // mm
     double first = 1.0;
+    // A point whose slack (SurfacePoints::slack_pose) exceeds what the tool had spent of it at the
+    // start of the move by more than the move cannot be reached within it.
+    const double spent = points.slack_spent(from, margin_mm);
+    const bool slack = spent < far && points.point_slack_mm.size() >= points.count;
     for (std::size_t i = 0; i < points.count; ++i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!swept.contains(p)) continue;
+        if (!swept.contains(p) || (slack && points.point_slack_mm[i] - spent + grip > speed)) continue;
         // The end pose's distance only for points the motion can reach at all (few, for a tick).
         const double measured = known ? from_distance[i] : far;
         const double d0 = (measured < far ? measured : from.signed_distance(p)) - margin_mm + grip;

@@ -114,6 +114,7 @@ void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, doub
     for (const std::unique_ptr<Hand>& hand : m_hands) {
         const io::ToolSpec& spec = m_scene.tools[hand->tool];
         method.sample_surface(hand->coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), spec, hand->snapshot);
+        contact::measure_slack(hand->coupled->proxy(), spec.push_margin_mm, hand->snapshot);
         hand->snapshot.t_s = t0_s;
         if (hand->snapshot.truncated && !hand->warned_truncated) {
             log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name,

@@ -152,6 +152,7 @@ bool ViewSimulation::step(double now_s)
     Eigen::AlignedBox3d near = m_pose.world_bounds(held.push_margin_mm + 5.0);
     near.extend(contact::PlacedShape{m_pose.shape, m_heading, m_pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
     m_method->sample_surface(near, held, out);
+    contact::measure_slack(m_pose, held.push_margin_mm, out);
     out.t_s = now_s;
     m_channels.snapshots.publish();
     if (r.save_object.exchange(false)) save();

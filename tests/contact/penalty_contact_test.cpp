@@ -3,6 +3,7 @@
 // the derivative of the force with respect to the depth.
 
 #include "contact/penalty_contact.hpp"
+#include "contact/swept_contact.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -550,4 +551,70 @@ TEST(EdgePenaltySearch, AConvexToolsShortSearchFindsWhatTheGeneralSearchFindsOnT
         }
         EXPECT_GT(pressed, 10); // the sample does press edges between their ends
     }
+}
+
+TEST(PenaltyTotals, LeavingOutWhatTheSnapshotsSlackAllowsChangesNothing)
+{
+    // A snapshot measured against a blade or a ball (measure_slack), then touched by the same tool
+    // moved and turned a little, as the 1 kHz loop's ticks do between two snapshots, and moved
+    // farther than most of the slack: the same totals, the same distances where both measured
+    // them, and the same first contact of the continuous check, as the snapshot without slack.
+    const int n = 40;
+    SurfacePoints sheet(static_cast<std::size_t>(n * n));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j * n + i);
+            const double x = 0.6 * i - 12.0, y = 0.6 * j - 12.0;
+            sheet.positions_mm[k] = Vector3d(x, y, std::sin(0.3 * x) * std::cos(0.2 * y));
+            sheet.normals[k] = Vector3d(-0.3 * std::cos(0.3 * x) * std::cos(0.2 * y), 0.2 * std::sin(0.3 * x) * std::sin(0.2 * y), 1.0).normalized();
+            sheet.areas_mm2[k] = 0.36;
+        }
+    sheet.count = sheet.capacity();
+    for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+            const int a = j * n + i;
+            sheet.triangles.emplace_back(a, a + 1, a + n + 1);
+            sheet.triangles.emplace_back(a, a + n + 1, a + n);
+        }
+    sheet.index();
+    const ToolShape blade = ToolShape::box({8, 0.3, 4}), ball = ToolShape::sphere(2.0);
+    const ContactParameters parameters{0.25, 5.0};
+    std::srand(5);
+    auto uniform = [](double lo, double hi) { return lo + (hi - lo) * std::rand() / static_cast<double>(RAND_MAX); };
+    std::vector<double> d_slack(sheet.count), d_all(sheet.count);
+    int touched = 0, left_out = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+        const ToolShape& shape = trial % 2 ? ball : blade;
+        const PlacedShape measured{&shape, Vector3d(uniform(-8, 8), uniform(-8, 8), (trial % 2 ? 1.6 : 1.8) + uniform(-0.4, 0.1)),
+                                   Eigen::Quaterniond(Eigen::AngleAxisd(uniform(0, 3), Vector3d(0.2, 0.1, 1).normalized()))};
+        SurfacePoints with = sheet;
+        measure_slack(measured, parameters.margin_mm, with);
+        ASSERT_NEAR(with.slack_spent(measured, parameters.margin_mm), 0.0, 1e-12);
+        EXPECT_EQ(with.slack_spent(measured, 0.5), INFINITY); // another margin: no slack
+        for (int tick = 0; tick < 12; ++tick) {
+            const double reach = tick < 8 ? 0.05 : 1.0; // a tick's drift, then farther
+            PlacedShape tool = measured;
+            tool.position += Vector3d(uniform(-reach, reach), uniform(-reach, reach), uniform(-reach, reach));
+            tool.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(uniform(-0.01, 0.01), Vector3d::UnitX())) * tool.orientation;
+            const ContactTotals a = penalty_totals(tool, parameters, with, true, d_slack);
+            const ContactTotals b = penalty_totals(tool, parameters, sheet, true, d_all);
+            EXPECT_EQ(a.force_on_tool_n, b.force_on_tool_n) << trial << ", " << tick;
+            EXPECT_EQ(a.torque_on_tool_n_mm, b.torque_on_tool_n_mm) << trial << ", " << tick;
+            EXPECT_EQ(a.stiffness_n_per_mm, b.stiffness_n_per_mm) << trial << ", " << tick;
+            EXPECT_EQ(a.area_mm2, b.area_mm2) << trial << ", " << tick;
+            EXPECT_EQ(a.pressure_pa, b.pressure_pa) << trial << ", " << tick;
+            for (std::size_t k = 0; k < sheet.count; ++k) {
+                if (d_slack[k] < INFINITY) ASSERT_EQ(d_slack[k], d_all[k]) << trial << ", point " << k;
+                left_out += d_slack[k] == INFINITY && d_all[k] < INFINITY;
+            }
+            PlacedShape to = tool;
+            to.position += Vector3d(uniform(-0.3, 0.3), uniform(-0.3, 0.3), uniform(-0.6, 0.1));
+            EXPECT_EQ(first_missed_contact(tool, to, parameters.margin_mm, with, {}, d_slack),
+                      first_missed_contact(tool, to, parameters.margin_mm, sheet, {}, d_all))
+                << trial << ", " << tick;
+            touched += b.area_mm2 > 0.0;
+        }
+    }
+    EXPECT_GT(touched, 100); // not vacuous: most ticks touch the sheet,
+    EXPECT_GT(left_out, 10000); // and the slack does leave points out
 }
