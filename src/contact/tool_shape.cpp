@@ -242,7 +242,23 @@ double ToolShape::mesh_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradi
 double ToolShape::signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient) const noexcept
 {
     switch (m_kind) {
-    case Kind::box:
+    case Kind::box: {
+        // The prism's distance for a rectangular profile, in closed form (a blade's, at every
+        // 1 kHz tick for every point near it): q = |p| - half size per axis; inside, the nearest
+        // face; outside, the length of q's positive part.
+        const Eigen::Array3d sign = (p.array() >= 0.0).select(Eigen::Array3d::Ones(), -Eigen::Array3d::Ones());
+        const Eigen::Array3d q = p.array().abs() - 0.5 * m_size.array();
+        if ((q <= 0.0).all()) {
+            int axis = 0;
+            const double d = q.maxCoeff(&axis);
+            if (gradient) *gradient = sign[axis] * Eigen::Vector3d::Unit(axis);
+            return d;
+        }
+        const Eigen::Array3d out = q.max(0.0);
+        const double d = std::sqrt(out.matrix().squaredNorm());
+        if (gradient) *gradient = (out * sign / d).matrix();
+        return d;
+    }
     case Kind::scalpel:
         return prism_distance(p, gradient);
     case Kind::sphere: {
