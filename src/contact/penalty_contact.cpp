@@ -323,10 +323,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     // the ones whose slack the tool has used up since the snapshot was measured; the others keep
     // +infinity.
     const double spent = points.slack_spent(tool, parameters.margin_mm);
-    const bool slack = spent < INFINITY && points.point_slack_mm.size() >= points.count;
-    auto left_out = [&](std::size_t i) { return slack && points.point_slack_mm[i] > spent; };
     points.for_each_point_near(reach, [&](std::size_t i) {
-        if (left_out(i)) return;
         const Eigen::Vector3d& p = points.positions_mm[i];
         const bool inside = point_penalty(tool, nullptr, parameters_of(i), reach, p, points.areas_mm2[i], points.normals[i], pp);
         if (keep && pp.measured) distance[i] = pp.distance;
@@ -336,7 +333,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         out.stiffness_n_per_mm += pp.stiffness * pp.normal * pp.normal.transpose();
         out.area_mm2 += points.areas_mm2[i];
         out.inner_reaches_surface = out.inner_reaches_surface || pp.distance < 0.0;
-    });
+    }, spent);
     // The edges, as penalty_contact takes them (their ends' distances from the pass above when
     // kept, else measured again).
     EdgePenalty ep;
@@ -359,14 +356,14 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     };
     // Calls visit(ep) for each edge pressed (both passes).
     auto for_each_pressed_edge = [&](auto&& visit) {
-        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge, float edge_slack) {
+        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-            if ((slack && edge_slack > spent) || b >= points.count || !may_reach_in(a, b)) return;
+            if (b >= points.count || !may_reach_in(a, b)) return;
             const double d_a = measured(a), d_b = measured(b);
             if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                              points.areas_mm2[b], points.normals[a], points.normals[b], ep))
                 visit(ep);
-        });
+        }, spent);
     };
     for_each_pressed_edge([&](const EdgePenalty& e) {
         out.force_on_tool_n -= e.force;
@@ -380,13 +377,12 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     points.for_each_point_near(reach, [&](std::size_t i) {
-        if (left_out(i) ||
-            !point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
+        if (!point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
             return;
         if (!carries_load(pp.force, net)) return;
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
-    });
+    }, spent);
     for_each_pressed_edge([&](const EdgePenalty& e) {
         if (!carries_load(e.force, net)) return;
         magnitude += e.force.norm();
@@ -401,17 +397,19 @@ void measure_slack(const PlacedShape& tool, double margin_mm, SurfacePoints& poi
     // Stored a hair short, in float: a slack is only ever an underestimate.
     auto stored = [](double slack) { return static_cast<float>(std::max(0.0, slack - 1e-5)); };
     std::vector<double> distance(points.count);
-    points.point_slack_mm.resize(points.count);
     points.slack_radius_mm = 0.0;
     for (std::size_t i = 0; i < points.count; ++i) {
-        const Eigen::Vector3d& p = points.positions_mm[i];
-        distance[i] = tool.signed_distance(p);
-        points.point_slack_mm[i] = stored(distance[i] - margin_mm);
-        points.slack_radius_mm = std::max(points.slack_radius_mm, (p - tool.position).norm());
+        distance[i] = tool.signed_distance(points.positions_mm[i]);
+        points.slack_radius_mm = std::max(points.slack_radius_mm, (points.positions_mm[i] - tool.position).norm());
     }
-    for (PointGrid::Edge& e : points.grid.edges) {
-        const auto a = static_cast<std::size_t>(e.ends[0]), b = static_cast<std::size_t>(e.ends[1]);
-        e.slack_mm = b < points.count ? stored(edge_slack(tool, margin_mm, points.positions_mm[a], points.positions_mm[b], distance[a], distance[b])) : 0.0f;
+    PointGrid& grid = points.grid;
+    grid.point_slack.resize(grid.points.size());
+    for (std::size_t k = 0; k < grid.points.size(); ++k) grid.point_slack[k] = stored(distance[grid.points[k]] - margin_mm);
+    grid.edge_slack.resize(grid.edges.size());
+    for (std::size_t k = 0; k < grid.edges.size(); ++k) {
+        const auto a = static_cast<std::size_t>(grid.edges[k].ends[0]), b = static_cast<std::size_t>(grid.edges[k].ends[1]);
+        grid.edge_slack[k] =
+            b < points.count ? stored(edge_slack(tool, margin_mm, points.positions_mm[a], points.positions_mm[b], distance[a], distance[b])) : 0.0f;
     }
     points.slack_pose = tool;
     points.slack_margin_mm = margin_mm;

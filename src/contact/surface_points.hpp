@@ -49,10 +49,13 @@ struct PointGrid {
         Eigen::Vector2i ends;
         Eigen::Vector3f middle;
         float half_length;
-        float slack_mm = 0.0f; ///< SurfacePoints::slack_pose
     };
     std::vector<std::uint32_t> edge_start; ///< per cell (and one more) into `edges`
     std::vector<Edge> edges;               ///< cell by cell
+    /// The slack (SurfacePoints::slack_pose) of each entry of `points` and of `edges`, mm, in the
+    /// same order, so that a tick reads the slack of what it leaves out and nothing more; empty:
+    /// no slack.
+    std::vector<float> point_slack, edge_slack;
     double longest_edge_mm = 0.0;
 };
 
@@ -78,15 +81,14 @@ struct SurfacePoints {
     PointGrid grid;
 
     /// What a tick of the 1 kHz loop may leave out (measure_slack, contact/penalty_contact.hpp,
-    /// after index()): the tool's pose and margin the snapshot was measured against, and per point
-    /// (here) and per edge (grid.edges) how far the tool may move from that pose before the point
-    /// or edge can take part in the contact; 0 where it does, or may. A tick moves the tool
-    /// micrometres, and a snapshot is new every few ticks, so most of a knife's crack walls, a
-    /// hair outside its margin, need not be measured again until the next snapshot.
+    /// after index()): the tool's pose and margin the snapshot was measured against; per point
+    /// and per edge (grid.point_slack, grid.edge_slack), how far the tool may move from that pose
+    /// before the point or edge can take part in the contact, 0 where it does, or may. A tick
+    /// moves the tool micrometres, and a snapshot is new every few ticks, so most of a knife's
+    /// crack walls, a hair outside its margin, need not be measured again until the next one.
     PlacedShape slack_pose;                   ///< no shape: no slack (nothing is left out)
     double slack_margin_mm = 0.0;
     double slack_radius_mm = 0.0;             ///< farthest point from slack_pose.position
-    std::vector<float> point_slack_mm;
 
     explicit SurfacePoints(std::size_t capacity = 0)
         : positions_mm(capacity), normals(capacity), areas_mm2(capacity)
@@ -107,35 +109,40 @@ struct SurfacePoints {
         return (tool.position - slack_pose.position).norm() + tool.orientation.angularDistance(slack_pose.orientation) * slack_radius_mm;
     }
 
-    /// Calls visit(i) for every point that may lie in `box` (at least those that do); never allocates.
-    template <class Visit> void for_each_point_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
+    /// Calls visit(i) for every point that may lie in `box` (at least those that do), leaving out
+    /// those whose slack exceeds `spent` (none with the default); never allocates.
+    template <class Visit> void for_each_point_near(const Eigen::AlignedBox3d& box, Visit&& visit, double spent = INFINITY) const noexcept
     {
         if (grid.cell_mm <= 0.0) {
             for (std::size_t i = 0; i < count; ++i) visit(i);
             return;
         }
+        const bool slack = spent < INFINITY && grid.point_slack.size() == grid.points.size();
         for_each_cell(box, [&](std::size_t c) {
-            for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k) visit(static_cast<std::size_t>(grid.points[k]));
+            for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k)
+                if (!slack || grid.point_slack[k] <= spent) visit(static_cast<std::size_t>(grid.points[k]));
         });
     }
-    /// Calls visit(edge) (its two ends) and its slack (0 without the grid) for every edge that may
-    /// meet `box` (at least those that do).
-    template <class Visit> void for_each_edge_near(const Eigen::AlignedBox3d& box, Visit&& visit) const noexcept
+    /// Calls visit(edge) (its two ends) for every edge that may meet `box` (at least those that
+    /// do), leaving out those whose slack exceeds `spent` (none with the default).
+    template <class Visit> void for_each_edge_near(const Eigen::AlignedBox3d& box, Visit&& visit, double spent = INFINITY) const noexcept
     {
         if (grid.cell_mm <= 0.0) {
-            for (const Eigen::Vector2i& e : edges) visit(e, 0.0f);
+            for (const Eigen::Vector2i& e : edges) visit(e);
             return;
         }
+        const bool slack = spent < INFINITY && grid.edge_slack.size() == grid.edges.size();
         // An edge meets the box only if its middle lies within half its length of the box.
         const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.5 * grid.longest_edge_mm);
         const Eigen::Vector3f lo = box.min().cast<float>(), hi = box.max().cast<float>();
         for_each_cell(Eigen::AlignedBox3d(box.min() - grow, box.max() + grow), [&](std::size_t c) {
             for (std::uint32_t k = grid.edge_start[c]; k < grid.edge_start[c + 1]; ++k) {
+                if (slack && grid.edge_slack[k] > spent) continue;
                 const PointGrid::Edge& e = grid.edges[k];
                 // A float's rounding is far below the 1e-3 mm slack.
                 const float h = e.half_length + 1e-3f;
                 if ((e.middle.array() + h < lo.array()).any() || (e.middle.array() - h > hi.array()).any()) continue;
-                visit(e.ends, e.slack_mm);
+                visit(e.ends);
             }
         });
     }

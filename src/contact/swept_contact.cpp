@@ -35,13 +35,11 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
     // its stiffness) from the next step on; a point touched only at depth zero would not resist.
     const double grip = 1e-3, tolerance = 1e-4; // mm
     double first = 1.0;
-    // A point whose slack (SurfacePoints::slack_pose) exceeds what the tool had spent of it at the
-    // start of the move by more than the move cannot be reached within it.
-    const double spent = points.slack_spent(from, margin_mm);
-    const bool slack = spent < far && points.point_slack_mm.size() >= points.count;
-    for (std::size_t i = 0; i < points.count; ++i) {
+    // The points near the move, leaving out those whose slack (SurfacePoints::slack_pose) exceeds
+    // what the tool had spent of it at the move's start by more than the move: out of its reach.
+    points.for_each_point_near(swept, [&](std::size_t i) {
         const Eigen::Vector3d& p = points.positions_mm[i];
-        if (!swept.contains(p) || (slack && points.point_slack_mm[i] - spent + grip > speed)) continue;
+        if (!swept.contains(p)) return;
         // The end pose's distance only for points the motion can reach at all (few, for a tick).
         const double measured = known ? from_distance[i] : far;
         const double d0 = (measured < far ? measured : from.signed_distance(p)) - margin_mm + grip;
@@ -49,10 +47,10 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
         // In the contact at the start (to within the tolerance: a point the tool leaves from a
         // micrometre deep, as a ball gliding over a surface leaves the points behind it, would
         // otherwise be found touched at t = 0 and hold the tool for ticks), or out of reach.
-        if (d0 <= tolerance || d0 > speed) continue;
+        if (d0 <= tolerance || d0 > speed) return;
         const double d1 = to.signed_distance(p) - margin_mm;
-        if (d1 <= 0.0) continue;                 // in the contact at the end: the discrete contact has it
-        if (d0 + d1 + grip > speed) continue;    // too far to be reached in between
+        if (d1 <= 0.0) return;                 // in the contact at the end: the discrete contact has it
+        if (d0 + d1 + grip > speed) return;    // too far to be reached in between
         double t = d0 / speed;
         for (int step = 0; step < 64 && t < first; ++step) {
             const double d = at(t).signed_distance(p) - margin_mm + grip;
@@ -62,7 +60,7 @@ double first_missed_contact(const PlacedShape& from, const PlacedShape& to, doub
             }
             t += d / speed;
         }
-    }
+    }, points.slack_spent(from, margin_mm) + speed - grip);
     return first;
 }
 
