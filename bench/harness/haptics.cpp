@@ -47,6 +47,28 @@ Percentiles percentiles(const std::vector<double>& v)
     return {quantile(v, 0.5), quantile(v, 0.99), quantile(v, 1.0)};
 }
 
+/// The machine's own noise, to read the force times by: a fixed computation of about 20 us (a
+/// heavy tick's length) timed 2,000 times. A virtual machine's interruptions land on a tick as
+/// often as on it, and add to its p99 what they add here.
+Percentiles machine_noise_us()
+{
+    using clock = std::chrono::steady_clock;
+    volatile double sink = 0.0;
+    auto timed = [&](int n) {
+        const auto t0 = clock::now();
+        double sum = 0.0;
+        for (int k = 0; k < n; ++k) sum += std::sqrt(k + 0.5);
+        sink = sum;
+        return std::chrono::duration<double, std::micro>(clock::now() - t0).count();
+    };
+    std::vector<double> us;
+    for (int k = 0; k < 50; ++k) us.push_back(timed(10000));
+    const int n = std::max(1, static_cast<int>(10000 * 20.0 / std::max(quantile(us, 0.5), 1e-3)));
+    us.clear();
+    for (int k = 0; k < 2000; ++k) us.push_back(timed(n));
+    return percentiles(us);
+}
+
 /// Presses into the block, one a second, each 1.5 mm further along x, starting over every 16; and
 /// after each press a jab 0.75 mm beside it, 7.5 mm down in 2 ms (3.75 mm a tick: the jumps that
 /// make the loop sweep the tool's mesh against the surface).
@@ -223,7 +245,9 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices, 
             mesh_stops += stopped_by_mesh[i];
         }
     const Percentiles mesh_force = percentiles(mesh_force_us);
-    std::printf("machine: %s\n\n", machine_description().c_str());
+    const Percentiles noise = machine_noise_us();
+    std::printf("machine: %s; its noise, a fixed computation timed 2,000 times: p50 %.1f / p99 %.1f / max %.1f us\n\n",
+                machine_description().c_str(), noise.p50, noise.p99, noise.max);
     const std::size_t ticks = force_us.size();
     std::printf("| ticks | simulation frames (median) | cutting frames | snapshot points, all devices (median) | device ticks on a stale snapshot | "
                 "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | ticks that swept the knife's mesh (stopped by it) | "
