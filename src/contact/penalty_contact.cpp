@@ -219,6 +219,15 @@ bool carries_load(const Eigen::Vector3d& force, const Eigen::Vector3d& net) noex
     return net.norm() <= 1e-12 || force.dot(net) >= 0.5 * force.norm() * net.norm();
 }
 
+/// The load-carrying area, at most the pushing shape's shadow across the net force: a blade
+/// narrower than the surface's sampling, lying between two rows of points that both carry it,
+/// would otherwise spread its force over both rows' area and press at half what it does.
+double within_shadow(const PlacedShape& tool, double margin, const Eigen::Vector3d& net, double load_area) noexcept
+{
+    if (!(net.norm() > 1e-12) || !tool.shape) return load_area;
+    return std::min(load_area, tool.shape->shadow_area(tool.orientation.conjugate() * net, margin));
+}
+
 } // namespace
 
 double mean_penetration(double d0, double d1, double& inside) noexcept
@@ -295,6 +304,7 @@ ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& 
         magnitude += c.force_n.norm();
         out.load_area_mm2 += c.area_mm2;
     }
+    out.load_area_mm2 = within_shadow(tool, parameters.margin_mm, net, out.load_area_mm2);
     // N / mm^2 = 1e6 Pa.
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;
@@ -388,6 +398,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         magnitude += e.force.norm();
         out.load_area_mm2 += e.area;
     });
+    out.load_area_mm2 = within_shadow(tool, parameters.margin_mm, net, out.load_area_mm2);
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;
 }

@@ -9,7 +9,9 @@
 // k the scene's contact_stiffness_n_per_mm: a flat face pressed 1 mm into the object over 1 cm^2
 // pushes with k newtons, whatever the mesh resolution. The contact pressure is the mean over the
 // part of the contact that carries the load, sum |f| / sum a over the points whose force points
-// within 60 degrees of the net force: what decides a cut. A broad tool spreads its force over a
+// within 60 degrees of the net force, that area taken at most as large as the pushing shape's
+// shadow across the net force (a blade narrower than the points' spacing cannot press over the
+// area of two rows of points): what decides a cut. A broad tool spreads its force over a
 // large area, a sharp one concentrates it; the walls of a slit rubbing a blade's sides carry no
 // load and do not dilute the pressure at its edge. The force follows the object's normal, not the tool's:
 // once a thin blade is inside the material the nearest tool face says nothing about which side a
@@ -61,7 +63,7 @@ struct ContactResult {
     Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();       ///< the reaction: minus the sum of the point forces
     Eigen::Vector3d torque_on_tool_n_mm = Eigen::Vector3d::Zero();   ///< about the tool's origin
     double area_mm2 = 0.0;                   ///< surface area in contact
-    double load_area_mm2 = 0.0;              ///< the part of it that carries the load
+    double load_area_mm2 = 0.0;              ///< the part of it that carries the load (at most the shape's shadow)
     double pressure_pa = 0.0;                ///< sum |f| / area over the load-carrying part (0 without contact)
     [[nodiscard]] bool inner_reaches_surface() const
     {

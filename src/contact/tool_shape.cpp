@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -113,6 +114,7 @@ ToolShape ToolShape::box(const Eigen::Vector3d& size)
     const double hx = size.x() / 2, hz = size.z() / 2;
     s.set_profile({{-hx, -hz}, {hx, -hz}, {hx, hz}, {-hx, hz}});
     s.m_bounds = Eigen::AlignedBox3d(-size / 2, size / 2);
+    s.set_outline();
     return s;
 }
 
@@ -130,6 +132,7 @@ ToolShape ToolShape::scalpel(const Eigen::Vector3d& size)
         s.set_profile({{-hx, -hz}, {hx, -hz}, {-hx, top}});
         s.m_bounds.max().z() = top;
     }
+    s.set_outline();
     return s;
 }
 
@@ -149,6 +152,7 @@ ToolShape ToolShape::cylinder(double radius, double length)
     s.m_radius = radius;
     s.m_length = length;
     s.m_bounds = Eigen::AlignedBox3d(Eigen::Vector3d(-radius, -radius, -length / 2), Eigen::Vector3d(radius, radius, length / 2));
+    s.set_outline();
     return s;
 }
 
@@ -160,7 +164,71 @@ ToolShape ToolShape::from_mesh(TriangleMesh mesh)
     s.m_bounds.setEmpty();
     for (const Eigen::Vector3d& p : mesh.positions) s.m_bounds.extend(p);
     s.m_mesh = std::move(mesh);
+    s.set_outline();
     return s;
+}
+
+namespace {
+constexpr std::size_t k_max_outline = 256;
+constexpr int k_circle_sides = 48;
+} // namespace
+
+void ToolShape::set_outline()
+{
+    m_outline.clear();
+    switch (m_kind) {
+    case Kind::box:
+    case Kind::scalpel:
+        for (const Eigen::Vector2d& q : m_profile)
+            for (const double y : {-0.5 * m_size.y(), 0.5 * m_size.y()}) m_outline.emplace_back(q.x(), y, q.y());
+        break;
+    case Kind::cylinder: {
+        const double r = m_radius / std::cos(M_PI / k_circle_sides); // circumscribed: never smaller than the circle
+        for (int k = 0; k < k_circle_sides; ++k) {
+            const double a = 2.0 * M_PI * k / k_circle_sides;
+            for (const double z : {-0.5 * m_length, 0.5 * m_length}) m_outline.emplace_back(r * std::cos(a), r * std::sin(a), z);
+        }
+        break;
+    }
+    case Kind::mesh:
+        if (m_mesh.positions.size() <= k_max_outline) m_outline = m_mesh.positions;
+        break;
+    case Kind::sphere:
+        break;
+    }
+}
+
+double ToolShape::shadow_area(const Eigen::Vector3d& along, double margin) const noexcept
+{
+    if (m_kind == Kind::sphere) return M_PI * (m_radius + margin) * (m_radius + margin);
+    if (m_outline.empty() || !(along.squaredNorm() > 0.0)) return std::numeric_limits<double>::infinity();
+    // The outline projected on a plane across `along`, its convex hull (Andrew's monotone chain,
+    // in fixed buffers), and the hull grown by the margin (Steiner: area + perimeter r + pi r^2).
+    const Eigen::Vector3d n = along.normalized(), u = n.unitOrthogonal(), v = n.cross(u);
+    std::array<Eigen::Vector2d, k_max_outline> p;
+    const std::size_t count = m_outline.size();
+    for (std::size_t k = 0; k < count; ++k) p[k] = {u.dot(m_outline[k]), v.dot(m_outline[k])};
+    std::sort(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(count),
+              [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+    auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+        return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+    };
+    std::array<Eigen::Vector2d, 2 * k_max_outline> hull;
+    std::size_t h = 0;
+    for (std::size_t k = 0; k < count; ++k) { // lower chain
+        while (h >= 2 && turn(hull[h - 2], hull[h - 1], p[k]) <= 0.0) --h;
+        hull[h++] = p[k];
+    }
+    for (std::size_t k = count - 1, lower = h + 1; k-- > 0;) { // upper chain
+        while (h >= lower && turn(hull[h - 2], hull[h - 1], p[k]) <= 0.0) --h;
+        hull[h++] = p[k];
+    }
+    double area = 0.0, perimeter = 0.0;
+    for (std::size_t k = 0; k + 1 < h; ++k) {
+        area += 0.5 * (hull[k].x() * hull[k + 1].y() - hull[k + 1].x() * hull[k].y());
+        perimeter += (hull[k + 1] - hull[k]).norm();
+    }
+    return std::abs(area) + perimeter * margin + M_PI * margin * margin;
 }
 
 void ToolShape::set_profile(std::vector<Eigen::Vector2d> profile)

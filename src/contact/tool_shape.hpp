@@ -50,6 +50,12 @@ public:
     /// of the nearest surface point).
     [[nodiscard]] double signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const noexcept;
 
+    /// The area (mm^2) of the shape grown by `margin` as seen along `along` (tool frame): what
+    /// the contact across that direction can cover at most. Exact for the analytic shapes (a
+    /// cylinder's round outline taken as a circumscribed 48-gon); a mesh tool's is its vertices'
+    /// hull's, or infinity beyond 256 vertices. Never allocates.
+    [[nodiscard]] double shadow_area(const Eigen::Vector3d& along, double margin = 0.0) const noexcept;
+
     /// Bounds of the shape grown by `margin` (mm), tool frame.
     [[nodiscard]] Eigen::AlignedBox3d bounds(double margin = 0.0) const;
 
@@ -83,6 +89,9 @@ private:
     std::vector<ProfileEdge> m_edges;
     void set_profile(std::vector<Eigen::Vector2d> profile);
     TriangleMesh m_mesh; ///< mesh tools
+    /// Points whose convex hull is the inner shape (a sphere's: none): its shadow's outline.
+    std::vector<Eigen::Vector3d> m_outline;
+    void set_outline();
     Eigen::AlignedBox3d m_bounds;
 };
 

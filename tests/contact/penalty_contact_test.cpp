@@ -618,3 +618,27 @@ TEST(PenaltyTotals, LeavingOutWhatTheSnapshotsSlackAllowsChangesNothing)
     EXPECT_GT(touched, 100); // not vacuous: most ticks touch the sheet,
     EXPECT_GT(left_out, 10000); // and the slack does leave points out
 }
+
+TEST(PenaltyContact, ABladeBetweenTwoRowsOfPointsPressesOverNoMoreThanItsOwnShadow)
+{
+    // A blade 1 mm thick whose faces lie on two rows of points 1 mm apart, its edge 0.3 mm under
+    // them: every point sits on a face, a margin deep, and carries the load. The two rows stand
+    // for 30 mm^2, more than the blade itself covers seen from above (16 x 1 mm grown by the
+    // margin: 16 + 2 x 17 x 0.25 + pi 0.25^2 mm^2), which is the area the pressure is taken over.
+    const ToolShape blade = ToolShape::box({16, 1, 8});
+    const ContactParameters parameters{0.25, 5.0};
+    Patch rows(100.0); // its 10 x 10 grid far away: only the rows below are near
+    for (int i = -7; i <= 7; ++i)
+        for (const double y : {-0.5, 0.5}) rows.add(Vector3d(i, y, 0.0), Vector3d(0, 0, 1), 1.0);
+    const PlacedShape pressed{&blade, Vector3d(0, 0, 4.0 - 0.3), Eigen::Quaterniond::Identity()};
+    const ContactResult c = rows.contact(pressed, parameters);
+    ASSERT_EQ(c.points.size(), 30u);
+    const double force = 30 * 5.0 / 100.0 * 1.0 * 0.25, shadow = 16.0 + 2.0 * 17.0 * 0.25 + M_PI * 0.0625;
+    EXPECT_NEAR(-c.force_on_tool_n.z(), -force, 1e-12);
+    EXPECT_NEAR(c.area_mm2, 30.0, 1e-12);
+    EXPECT_NEAR(c.load_area_mm2, shadow, 1e-9);
+    EXPECT_NEAR(c.pressure_pa, 1e6 * force / shadow, 1e-6); // 15.2 kPa, not the rows' 12.5 kPa
+    // A broad plate over the same rows: its shadow is larger, the rows' own area stands.
+    const ContactResult broad = rows.contact(plate_pressing(0.25, parameters), parameters);
+    EXPECT_NEAR(broad.load_area_mm2, 30.0, 1e-12);
+}

@@ -60,6 +60,23 @@ TEST_P(EachMethod, ABladeCutsOnlyWhereAndWhileItsPressureReachesTheThreshold)
     EXPECT_EQ(pushed.method->piece_count(), 1u);
 }
 
+TEST_P(EachMethod, AKnifeCutsWhereverItLiesBetweenTheSurfacesPoints)
+{
+    // The knife of two_hands.json (1 mm thick, on a block of 1 mm voxels whose surface points lie
+    // on whole millimetres) drawn down centred on a row of points, and centred between two rows,
+    // its faces on both: between them it pressed at 12.5 kPa against a 15 kPa threshold and slid
+    // down without cutting, the two rows' area diluting its force. It cuts at both.
+    for (const double y : {12.0, 11.5}) {
+        io::Scene scene = bundled("two_hands.json", GetParam());
+        for (io::ScriptEntry& e : scene.script)
+            if (e.tool == "knife") e.position_mm.y() = y;
+        const Simulated r = simulate(scene, 100);
+        int cut_frames = 0;
+        for (const FrameStats& f : r.frames) cut_frames += f.tools.tools[1].cut;
+        EXPECT_GE(cut_frames, 1) << "knife at y = " << y << ", " << r.method->name();
+    }
+}
+
 TEST_P(EachMethod, ATwoPhaseKnifeHoldsTheObjectWhileItMarksThenCutsOnceAndLetsItMove)
 {
     const io::Scene scene = bundled("press_and_cut_two_phase.json", GetParam());
