@@ -36,10 +36,9 @@ ToolSweep::ToolSweep(const ToolShape& shape, double margin_mm, std::size_t point
 
 bool ToolSweep::reachable(const Eigen::Vector3i& triangle, const PlacedShape& from, const SurfacePoints& points, double speed) noexcept
 {
-    // A triangle with a corner in the contact at the start of the tick is the penalty's (the
-    // tool is already against it). One farther from the tool than the move plus its own size
-    // cannot be reached: the distance is 1-Lipschitz, and a corner's distance to the tool is its
-    // clearance (to the pushing shape) plus the margin.
+    // One farther from the tool than the move plus its own size cannot be reached: the distance
+    // is 1-Lipschitz, and a corner's distance to the tool is its clearance (to the pushing shape)
+    // plus the margin.
     constexpr double far = std::numeric_limits<double>::infinity();
     double nearest = far, size = 0.0;
     for (int c = 0; c < 3; ++c) {
@@ -49,7 +48,7 @@ bool ToolSweep::reachable(const Eigen::Vector3i& triangle, const PlacedShape& fr
         nearest = std::min(nearest, clearance);
         size = std::max(size, (points.positions_mm[v] - points.positions_mm[static_cast<std::size_t>(triangle[(c + 1) % 3])]).norm());
     }
-    return nearest != -far && nearest + m_margin <= speed + size;
+    return nearest + m_margin <= speed + size;
 }
 
 double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, const SurfacePoints& points,
@@ -99,10 +98,18 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
             if ((h0 > 0.0) != (h1 > 0.0) || std::abs(h1) <= tolerance) t = std::min(t, std::max(0.0, h0 / (h0 - h1) - 1e-9));
         return t;
     };
+    // A triangle with a corner in the contact at the start of the tick is the penalty's (the tool
+    // is already against it), left out before anything is computed for it: a knife deep in its
+    // cut lies against hundreds.
+    auto held = [&](const Eigen::Vector3i& f) {
+        return m_clearance[static_cast<std::size_t>(f[0])] == -INFINITY || m_clearance[static_cast<std::size_t>(f[1])] == -INFINITY ||
+               m_clearance[static_cast<std::size_t>(f[2])] == -INFINITY;
+    };
     for (std::size_t v = 0; v < m_start.size(); ++v) {
         const Eigen::AlignedBox3d sweep = Eigen::AlignedBox3d(m_start[v]).extend(m_end[v]);
         points.triangle_tree.query(sweep.min(), sweep.max(), [&](std::uint32_t t) {
             const Eigen::Vector3i& f = points.triangles[t];
+            if (held(f)) return;
             const Eigen::Vector3d &a = p[static_cast<std::size_t>(f[0])], &b = p[static_cast<std::size_t>(f[1])], &c = p[static_cast<std::size_t>(f[2])];
             const Eigen::Vector3d normal = (b - a).cross(c - a);
             const auto [h0, h1] = heights(normal, a, v);
@@ -115,6 +122,7 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
         const Eigen::AlignedBox3d sweep = Eigen::AlignedBox3d(m_start[v0]).extend(m_end[v0]).extend(m_start[v1]).extend(m_end[v1]);
         points.triangle_tree.query(sweep.min(), sweep.max(), [&](std::uint32_t t) {
             const Eigen::Vector3i& f = points.triangles[t];
+            if (held(f)) return;
             const Eigen::Vector3d& origin = p[static_cast<std::size_t>(f[0])];
             const Eigen::Vector3d normal = (p[static_cast<std::size_t>(f[1])] - origin).cross(p[static_cast<std::size_t>(f[2])] - origin);
             const auto [a0, a1] = heights(normal, origin, v0);

@@ -47,8 +47,8 @@ public:
     [[nodiscard]] bool stopped_by_mesh() const { return m_stopped_by_mesh; }
 
 private:
-    /// Whether surface triangle `triangle` takes part: no corner in the contact, and near enough
-    /// for a move of `speed` mm to reach it. Measures corners the point test left unmeasured.
+    /// Whether surface triangle `triangle` (no corner in the contact) is near enough for a move
+    /// of `speed` mm to reach it. Measures corners the point test left unmeasured.
     bool reachable(const Eigen::Vector3i& triangle, const PlacedShape& from, const SurfacePoints& points, double speed) noexcept;
 
     double m_margin;
