@@ -461,21 +461,21 @@ TEST_F(EdgePenalty, AnEdgeLeftWithinTheStepPushesForThePartOfTheStepItWasIn)
     EXPECT_NEAR(-c.force_on_tool_n.z(), -expected, 1e-3 * expected);
 }
 
-TEST(PenaltyTotals, TheSnapshotsGridVisitsEverythingThatTouches)
+namespace {
+
+/// A wavy sheet of n x n points `spacing` mm apart, centred on the origin, each standing for
+/// spacing^2 of area, triangulated and indexed (SurfacePoints::index: its grid of cells).
+SurfacePoints wavy_sheet(int n, double spacing)
 {
-    // A wavy sheet of 0.7 mm triangles, indexed (SurfacePoints::index: its grid of cells), against
-    // the same sheet without a grid (every point and edge visited): the same totals and the same
-    // distances for the continuous check, for a blade and a ball at random poses, the blade's
-    // edge often lying across faces between points (the edge penalty's case).
-    const int n = 44;
     SurfacePoints sheet(static_cast<std::size_t>(n * n));
+    const double half = 0.5 * spacing * (n - 1);
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             const std::size_t k = static_cast<std::size_t>(j * n + i);
-            const double x = 0.7 * i - 15.0, y = 0.7 * j - 15.0;
+            const double x = spacing * i - half, y = spacing * j - half;
             sheet.positions_mm[k] = Vector3d(x, y, std::sin(0.3 * x) * std::cos(0.2 * y));
             sheet.normals[k] = Vector3d(-0.3 * std::cos(0.3 * x) * std::cos(0.2 * y), 0.2 * std::sin(0.3 * x) * std::sin(0.2 * y), 1.0).normalized();
-            sheet.areas_mm2[k] = 0.49;
+            sheet.areas_mm2[k] = spacing * spacing;
         }
     sheet.count = sheet.capacity();
     for (int j = 0; j + 1 < n; ++j)
@@ -485,6 +485,18 @@ TEST(PenaltyTotals, TheSnapshotsGridVisitsEverythingThatTouches)
             sheet.triangles.emplace_back(a, a + n + 1, a + n);
         }
     sheet.index();
+    return sheet;
+}
+
+} // namespace
+
+TEST(PenaltyTotals, TheSnapshotsGridVisitsEverythingThatTouches)
+{
+    // A wavy sheet of 0.7 mm triangles, indexed (SurfacePoints::index: its grid of cells), against
+    // the same sheet without a grid (every point and edge visited): the same totals and the same
+    // distances for the continuous check, for a blade and a ball at random poses, the blade's
+    // edge often lying across faces between points (the edge penalty's case).
+    const SurfacePoints sheet = wavy_sheet(44, 0.7);
     ASSERT_GT(sheet.grid.cell_mm, 0.0);
     SurfacePoints flat = sheet;
     flat.grid = PointGrid{};
@@ -559,24 +571,7 @@ TEST(PenaltyTotals, LeavingOutWhatTheSnapshotsSlackAllowsChangesNothing)
     // moved and turned a little, as the 1 kHz loop's ticks do between two snapshots, and moved
     // farther than most of the slack: the same totals, the same distances where both measured
     // them, and the same first contact of the continuous check, as the snapshot without slack.
-    const int n = 40;
-    SurfacePoints sheet(static_cast<std::size_t>(n * n));
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const std::size_t k = static_cast<std::size_t>(j * n + i);
-            const double x = 0.6 * i - 12.0, y = 0.6 * j - 12.0;
-            sheet.positions_mm[k] = Vector3d(x, y, std::sin(0.3 * x) * std::cos(0.2 * y));
-            sheet.normals[k] = Vector3d(-0.3 * std::cos(0.3 * x) * std::cos(0.2 * y), 0.2 * std::sin(0.3 * x) * std::sin(0.2 * y), 1.0).normalized();
-            sheet.areas_mm2[k] = 0.36;
-        }
-    sheet.count = sheet.capacity();
-    for (int j = 0; j + 1 < n; ++j)
-        for (int i = 0; i + 1 < n; ++i) {
-            const int a = j * n + i;
-            sheet.triangles.emplace_back(a, a + 1, a + n + 1);
-            sheet.triangles.emplace_back(a, a + n + 1, a + n);
-        }
-    sheet.index();
+    const SurfacePoints sheet = wavy_sheet(40, 0.6);
     const ToolShape blade = ToolShape::box({8, 0.3, 4}), ball = ToolShape::sphere(2.0);
     const ContactParameters parameters{0.25, 5.0};
     std::srand(5);
