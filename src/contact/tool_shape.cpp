@@ -1,5 +1,6 @@
 #include "contact/tool_shape.hpp"
 
+#include "contact/convex_hull.hpp"
 #include "core/error.hpp"
 
 #include <algorithm>
@@ -202,31 +203,19 @@ double ToolShape::shadow_area(const Eigen::Vector3d& along, double margin) const
 {
     if (m_kind == Kind::sphere) return M_PI * (m_radius + margin) * (m_radius + margin);
     if (m_outline.empty() || !(along.squaredNorm() > 0.0)) return std::numeric_limits<double>::infinity();
-    // The outline projected on a plane across `along`, its convex hull (Andrew's monotone chain,
-    // in fixed buffers), and the hull grown by the margin (Steiner: area + perimeter r + pi r^2).
+    // The outline projected on a plane across `along`, its convex hull (in fixed buffers), and
+    // the hull grown by the margin (Steiner: area + perimeter r + pi r^2).
     const Eigen::Vector3d n = along.normalized(), u = n.unitOrthogonal(), v = n.cross(u);
     std::array<Eigen::Vector2d, k_max_outline> p;
     const std::size_t count = m_outline.size();
     for (std::size_t k = 0; k < count; ++k) p[k] = {u.dot(m_outline[k]), v.dot(m_outline[k])};
-    std::sort(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(count),
-              [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-    auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-        return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
-    };
     std::array<Eigen::Vector2d, 2 * k_max_outline> hull;
-    std::size_t h = 0;
-    for (std::size_t k = 0; k < count; ++k) { // lower chain
-        while (h >= 2 && turn(hull[h - 2], hull[h - 1], p[k]) <= 0.0) --h;
-        hull[h++] = p[k];
-    }
-    for (std::size_t k = count - 1, lower = h + 1; k-- > 0;) { // upper chain
-        while (h >= lower && turn(hull[h - 2], hull[h - 1], p[k]) <= 0.0) --h;
-        hull[h++] = p[k];
-    }
+    const std::size_t h = convex_hull(std::span<Eigen::Vector2d>(p.data(), count), std::span<Eigen::Vector2d>(hull));
     double area = 0.0, perimeter = 0.0;
-    for (std::size_t k = 0; k + 1 < h; ++k) {
-        area += 0.5 * (hull[k].x() * hull[k + 1].y() - hull[k + 1].x() * hull[k].y());
-        perimeter += (hull[k + 1] - hull[k]).norm();
+    for (std::size_t k = 0; k < h; ++k) {
+        const Eigen::Vector2d &a = hull[k], &b = hull[(k + 1) % h];
+        area += 0.5 * (a.x() * b.y() - b.x() * a.y());
+        perimeter += (b - a).norm();
     }
     return std::abs(area) + perimeter * margin + M_PI * margin * margin;
 }
