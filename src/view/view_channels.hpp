@@ -1,8 +1,9 @@
 #pragma once
 // What the three threads of a viewer session share, and nothing else: triple buffers (the newest
-// complete value, no lock) for the surface near the tool (simulation -> haptics), the proxy's pose
-// (haptics -> simulation) and the picture (simulation -> window); and the requests the window
-// queues for the simulation thread as atomics it takes once each.
+// complete value, no lock) for each device's hand, the surface near its tool (simulation ->
+// haptics) and its proxy's pose (haptics -> simulation); the picture (simulation -> window); the
+// simulation's time (for scripted devices); and the requests the window queues for the simulation
+// thread as atomics it takes once each.
 
 #include "contact/surface_points.hpp"
 #include "contact/tool_shape.hpp"
@@ -11,6 +12,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,16 +49,30 @@ struct ViewRequests {
     /// Resume the earlier session the journal offered (J).
     std::atomic<bool> resume{false};
     std::atomic<bool> picture_taken{true}; ///< the window has the last picture: make the next
-    std::atomic<int> active{0};            ///< the tool the device drives
+    /// The tool the keys act on; with one device, also the tool it drives (TAB moves it).
+    std::atomic<int> active{0};
     std::atomic<int> level_change{0};      ///< +1 coarser, -1 finer
     std::atomic<int> set_action{-1};       ///< 0 push, 1 cut, 2 wet for the active tool
     std::atomic<std::uint64_t> ticks{0}, frames{0}; ///< counts for the rates the window shows
 };
 
-struct ViewChannels {
-    explicit ViewChannels(std::size_t snapshot_capacity) : snapshots(contact::SurfacePoints(snapshot_capacity)) {}
+/// One device's exchange with the simulation.
+struct HandChannel {
+    explicit HandChannel(std::size_t snapshot_capacity) : snapshots(contact::SurfacePoints(snapshot_capacity)) {}
     haptics::TripleBuffer<contact::SurfacePoints> snapshots;
     haptics::TripleBuffer<ProxyPose> proxies;
+};
+
+struct ViewChannels {
+    /// `devices`: hands, one per device the haptic loop serves.
+    explicit ViewChannels(std::size_t snapshot_capacity, std::size_t devices = 1)
+    {
+        for (std::size_t d = 0; d < devices; ++d) hands.push_back(std::make_unique<HandChannel>(snapshot_capacity));
+    }
+    [[nodiscard]] HandChannel& hand(std::size_t d = 0) { return *hands[d]; }
+    std::vector<std::unique_ptr<HandChannel>> hands;
+    /// The simulated time of the last frame: scripted devices follow it (view/paced_device.hpp).
+    std::atomic<double> simulation_t_s{0.0};
     haptics::TripleBuffer<RenderState> pictures;
     ViewRequests requests;
 };

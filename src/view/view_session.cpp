@@ -6,6 +6,7 @@
 #include "haptics/haptic_loop.hpp"
 #include "haptics/hid_devices.hpp"
 #include "haptics/pointer_device.hpp"
+#include "haptics/recording.hpp"
 #include "haptics/spacemouse_device.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
@@ -15,12 +16,14 @@
 #include "sim/journal.hpp"
 #include "sim/method_factory.hpp"
 #include "view/scene_pictures.hpp"
+#include "view/paced_device.hpp"
 #include "view/view_channels.hpp"
 #include "view/view_simulation.hpp"
 #include "view/view_window.hpp"
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -28,6 +31,39 @@
 #include <thread>
 
 namespace vox::view {
+namespace {
+
+/// The tool each device drives (ViewOptions::devices, ::tools); InputError naming the option.
+std::vector<std::size_t> driven_tools(const io::Scene& scene, const ViewOptions& options)
+{
+    const std::size_t devices = options.devices.size();
+    if (devices == 0) throw InputError("--device: give at least one");
+    if (devices > static_cast<std::size_t>(haptics::k_max_devices))
+        throw InputError("--device: at most " + std::to_string(haptics::k_max_devices) + " devices, " + std::to_string(devices) + " given");
+    if (devices > 1 ? options.tools.size() != devices : options.tools.size() > 1)
+        throw InputError("--tool: give one per --device, in the same order (" + std::to_string(devices) + " device(s), " +
+                         std::to_string(options.tools.size()) + " tool(s))");
+    if (std::count(options.devices.begin(), options.devices.end(), "mouse") > 1) throw InputError("--device: the mouse can drive one tool only");
+    std::vector<std::size_t> driven;
+    for (std::size_t d = 0; d < devices; ++d) {
+        std::size_t k = 0;
+        if (!options.tools.empty()) {
+            const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == options.tools[d]; });
+            if (found == scene.tools.end()) {
+                std::string names;
+                for (const io::ToolSpec& t : scene.tools) names += (names.empty() ? "" : ", ") + t.name;
+                throw InputError("--tool: the scene has no tool named \"" + options.tools[d] + "\" (it has: " + names + ")");
+            }
+            k = static_cast<std::size_t>(found - scene.tools.begin());
+        }
+        if (std::find(driven.begin(), driven.end(), k) != driven.end())
+            throw InputError("--tool: tool \"" + scene.tools[k].name + "\" is driven by two devices; give each device its own --tool");
+        driven.push_back(k);
+    }
+    return driven;
+}
+
+} // namespace
 
 void run_view(const std::string& scene_path, const ViewOptions& options)
 {
@@ -40,6 +76,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     io::Scene scene = loaded;
     scene.script.clear();
     if (!options.solver.empty()) io::use_method(scene, io::solver_type_named(options.solver));
+    const std::vector<std::size_t> driven = driven_tools(scene, options); // before the object is loaded
     render::CameraSpec spec = render::parse_camera(options.camera);
     spec.up = scene_up(scene);
     spec.orthographic = false; // the viewer orbits in perspective
@@ -90,70 +127,114 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         }
     }
 
-    // Where the first tool starts: where the scene's script puts it, else above the object.
+    // Where each device's tool starts: where the scene's script puts it, else above the object
+    // (several devices side by side).
     render::DrawMesh first = surface_picture(*method, 0);
     Eigen::AlignedBox3d bounds;
     bounds.setEmpty();
     for (const std::uint32_t i : first.indices) bounds.extend(first.positions[i].cast<double>());
     const double radius = 0.5 * bounds.diagonal().norm();
-    const io::ToolPose scripted = io::tool_pose(loaded, 0, 0.0);
-    const Eigen::Vector3d start = scripted.placed ? scripted.position_mm : Eigen::Vector3d(bounds.center() + (radius + 10.0) * spec.up);
-    const Eigen::Quaterniond start_orientation = scripted.placed ? scripted.orientation : Eigen::Quaterniond::Identity();
-    haptics::PointerDevice pointer(start, start_orientation);
-    // The device: a 6-DoF controller when there is one (the mouse then only moves the camera),
-    // else the mouse as a pointer.
-    std::unique_ptr<haptics::SpaceMouseDevice> controller;
-    if (options.device != "mouse") {
-        std::vector<haptics::HidDevice> found;
+    // TAB moves a lone device to the next tool (not a script: it follows one tool's entries).
+    const bool single = driven.size() == 1 && options.devices.front() != "script";
+    std::vector<io::ToolPose> starts;
+    for (std::size_t d = 0; d < driven.size(); ++d) {
+        io::ToolPose pose = io::tool_pose(loaded, driven[d], 0.0);
+        if (!pose.placed)
+            pose.position_mm = bounds.center() + (radius + 10.0) * spec.up + (static_cast<double>(d) * 0.5 * radius) * spec.up.unitOrthogonal();
+        starts.push_back(pose);
+    }
+    constexpr std::size_t snapshot_capacity = 50000;
+    ViewChannels channels(snapshot_capacity, driven.size());
+    // The devices. The mouse is one pointer: it drives at most one tool (else it only moves the camera).
+    const auto mouse_hand = std::find(options.devices.begin(), options.devices.end(), "mouse") - options.devices.begin();
+    const io::ToolPose& pointed = starts[static_cast<std::size_t>(mouse_hand) < starts.size() ? static_cast<std::size_t>(mouse_hand) : 0];
+    haptics::PointerDevice pointer(pointed.position_mm, pointed.orientation);
+    std::vector<std::unique_ptr<haptics::Device>> owned; // controllers and scripts
+    std::vector<haptics::Device*> devices;
+    std::vector<haptics::HidDevice> controllers; // 6-DoF controllers that can be opened, taken in turn
+    if (std::any_of(options.devices.begin(), options.devices.end(), [](const std::string& d) { return d == "auto" || d == "hid"; })) {
         try {
-            found = haptics::enumerate_hid_devices();
+            for (const haptics::HidDevice& d : haptics::enumerate_hid_devices())
+                if (d.six_dof && d.openable) controllers.push_back(d);
         } catch (const InputError& e) {
-            if (options.device == "hid") throw;
+            if (std::find(options.devices.begin(), options.devices.end(), "hid") != options.devices.end()) throw;
             log::info("no HID devices ({}); the mouse drives the tool", e.what());
         }
-        for (const haptics::HidDevice& d : found)
-            if (d.six_dof && d.openable) {
-                controller = std::make_unique<haptics::SpaceMouseDevice>(d.path, d.product, start, start_orientation);
-                break;
-            }
-        if (!controller && options.device == "hid")
-            throw InputError("--device hid: no 6-DoF controller can be opened. " +
-                             (found.empty() ? haptics::explain_no_hid_devices() : haptics::udev_rule_advice()));
     }
-    haptics::Device& device = controller ? static_cast<haptics::Device&>(*controller) : static_cast<haptics::Device&>(pointer);
-    log::info("the tool is driven by: {}", device.name());
+    bool mouse_taken = false;
+    for (std::size_t d = 0; d < driven.size(); ++d) {
+        const std::string& kind = options.devices[d];
+        const io::ToolPose& at = starts[d];
+        if (kind == "script") {
+            std::vector<haptics::KeyFrame> frames;
+            for (const io::ScriptEntry& e : loaded.script)
+                if (e.tool_index == driven[d]) frames.push_back({e.t_s, e.position_mm, e.orientation});
+            if (frames.empty())
+                throw loaded.error("script", "--device script follows the script of tool \"" + scene.tools[driven[d]].name + "\", which has no entry");
+            owned.push_back(std::make_unique<PacedDevice>(std::move(frames), channels.simulation_t_s, scene.solver.dt_s));
+        } else if (kind == "hid" || (kind == "auto" && !controllers.empty())) {
+            if (controllers.empty())
+                throw InputError("--device hid: no " + std::string(d ? "further " : "") + "6-DoF controller can be opened. " +
+                                 (d ? haptics::udev_rule_advice() : haptics::explain_no_hid_devices()));
+            const haptics::HidDevice c = controllers.front();
+            controllers.erase(controllers.begin());
+            owned.push_back(std::make_unique<haptics::SpaceMouseDevice>(c.path, c.product, at.position_mm, at.orientation));
+        } else { // the mouse
+            if (mouse_taken) throw InputError("--device: the mouse can drive one tool only (device " + std::to_string(d + 1) + ")");
+            mouse_taken = true;
+            devices.push_back(&pointer);
+            continue;
+        }
+        devices.push_back(owned.back().get());
+    }
+    for (std::size_t d = 0; d < driven.size(); ++d)
+        log::info("tool \"{}\" is driven by: {}", scene.tools[driven[d]].name, devices[d]->name());
 
-    // The haptic side: one coupled tool per scene tool, the active one used.
-    constexpr std::size_t snapshot_capacity = 50000;
+    // The haptic side: one coupled tool per scene tool (one device: the active one's is used), one
+    // loop serving every device, each with its own coupling and safety stage.
     std::vector<std::unique_ptr<haptics::CoupledTool>> coupled;
-    for (std::size_t k = 0; k < scene.tools.size(); ++k)
+    for (std::size_t k = 0; k < scene.tools.size(); ++k) {
+        haptics::CouplingSettings coupling;
+        for (std::size_t d = 0; d < driven.size(); ++d) // a device's own limits where it declares them
+            if (driven[d] == k && devices[d]->limits().max_stiffness_n_per_mm > 0.0)
+                coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, devices[d]->limits().max_stiffness_n_per_mm);
         coupled.push_back(std::make_unique<haptics::CoupledTool>(
-            tools.shape(k), contact::ContactParameters{scene.tools[k].push_margin_mm, scene.tools[k].contact_stiffness_n_per_mm},
-            haptics::CouplingSettings{}, snapshot_capacity));
-    ViewChannels channels(snapshot_capacity);
+            tools.shape(k), contact::ContactParameters{scene.tools[k].push_margin_mm, scene.tools[k].contact_stiffness_n_per_mm}, coupling,
+            snapshot_capacity));
+    }
     ViewRequests& requests = channels.requests;
     const auto t0 = std::chrono::steady_clock::now();
     auto now_s = [t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-    haptics::HapticLoop loop(
-        device,
-        [&](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
-            const contact::SurfacePoints& surface = channels.snapshots.latest();
-            age = now_s() - surface.t_s;
-            const int k = requests.active.load(std::memory_order_relaxed);
-            const Eigen::Vector3d f = coupled[static_cast<std::size_t>(k)]->update(s, surface, 1e-3);
-            channels.proxies.write_slot() = {k, coupled[static_cast<std::size_t>(k)]->proxy(), controller ? s.position_mm : pointer.target()};
-            channels.proxies.publish();
-            requests.ticks.fetch_add(1, std::memory_order_relaxed);
-            return f;
-        },
-        haptics::SafetySettings{});
+    std::vector<haptics::HapticChannel> served;
+    for (std::size_t d = 0; d < driven.size(); ++d) {
+        haptics::SafetySettings safety;
+        const haptics::DeviceLimits& limits = devices[d]->limits();
+        if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
+        const bool mouse = devices[d] == &pointer;
+        served.push_back({devices[d],
+                          [&, d, mouse](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
+                              HandChannel& hand = channels.hand(d);
+                              const contact::SurfacePoints& surface = hand.snapshots.latest();
+                              age = now_s() - surface.t_s;
+                              const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
+                              haptics::CoupledTool& tool = *coupled[static_cast<std::size_t>(k)];
+                              const Eigen::Vector3d f = tool.update(s, surface, 1e-3);
+                              hand.proxies.write_slot() = {k, tool.proxy(), mouse ? pointer.target() : s.position_mm};
+                              hand.proxies.publish();
+                              if (d == 0) requests.ticks.fetch_add(1, std::memory_order_relaxed);
+                              return f;
+                          },
+                          safety});
+    }
+    haptics::HapticLoop loop(std::move(served));
 
     log::info("viewer: {} ({}), tools: {}; press H for the keys", scene_path, method->description(), scene.tools.size());
     ViewSimulationOptions sim_options;
     sim_options.grid_levels = grid_levels;
     sim_options.smooth = options.smooth;
     sim_options.out_dir = options.out_dir;
-    sim_options.start_mm = start;
+    sim_options.hands.clear();
+    for (std::size_t d = 0; d < driven.size(); ++d) sim_options.hands.push_back({driven[d], starts[d].position_mm, options.devices[d]});
     sim_options.scene_file = scene_path;
     sim_options.journal = session_journal;
     sim_options.offered = std::move(offered);
@@ -199,6 +280,11 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     if (simulation_thread.joinable()) simulation_thread.join(); // before reading what it left
     loop.stop();
     if (!failure.empty()) throw InputError(scene_path + ": the simulation stopped: " + failure);
+    for (std::size_t d = 0; d < driven.size(); ++d) { // where each device left its tool
+        const std::size_t k = single ? static_cast<std::size_t>(requests.active.load()) : driven[d];
+        const Eigen::Vector3d at = coupled[k]->proxy().position;
+        log::info("tool \"{}\" ({}) ended at ({:.2f}, {:.2f}, {:.2f}) mm", scene.tools[k].name, options.devices[d], at.x(), at.y(), at.z());
+    }
 }
 
 } // namespace vox::view

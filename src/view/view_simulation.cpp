@@ -8,6 +8,7 @@
 #include "view/scene_pictures.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace vox::view {
 
@@ -22,8 +23,14 @@ ViewSimulation::ViewSimulation(io::Scene& scene, std::unique_ptr<sim::Method> me
         m_loop.govern_levels(std::move(*m_options.governor));
         m_options.governor.reset();
     }
-    m_pose.shape = &tools.shape(0);
-    m_pose.position = m_heading = options.start_mm;
+    if (options.hands.size() != channels.hands.size())
+        throw std::logic_error("ViewSimulation: one hand per channel: " + std::to_string(options.hands.size()) + " against " +
+                               std::to_string(channels.hands.size()));
+    for (const ViewHand& h : options.hands) {
+        Hand& hand = m_hands.emplace_back();
+        hand.pose.shape = &tools.shape(h.tool);
+        hand.pose.position = hand.heading = h.start_mm;
+    }
     start_journal();
 }
 
@@ -66,8 +73,10 @@ void ViewSimulation::now_at_level(const std::string& why)
 void ViewSimulation::let_go()
 {
     m_tools.reset();
-    if (m_driven >= 0) m_tools.release(static_cast<std::size_t>(m_driven));
-    m_driven = -1;
+    for (Hand& hand : m_hands) {
+        if (hand.driven >= 0) m_tools.release(static_cast<std::size_t>(hand.driven));
+        hand.driven = -1;
+    }
 }
 
 void ViewSimulation::take_requests()
@@ -123,17 +132,21 @@ bool ViewSimulation::step(double now_s)
     m_now_s = now_s;
     take_requests();
     if (r.paused.load() && !r.step_once.exchange(false)) return false;
-    if (m_channels.proxies.update()) {
-        const ProxyPose& p = m_channels.proxies.read_slot();
-        if (p.tool != m_driven && m_driven >= 0) m_tools.release(static_cast<std::size_t>(m_driven));
-        m_driven = p.tool;
-        m_pose = p.pose;
-        m_heading = p.heading;
+    for (std::size_t d = 0; d < m_hands.size(); ++d) {
+        Hand& hand = m_hands[d];
+        HandChannel& channel = m_channels.hand(d);
+        if (!channel.proxies.update()) continue;
+        const ProxyPose& p = channel.proxies.read_slot();
+        if (p.tool != hand.driven && hand.driven >= 0) m_tools.release(static_cast<std::size_t>(hand.driven));
+        hand.driven = p.tool;
+        hand.pose = p.pose;
+        hand.heading = p.heading;
     }
     // A stroke's checkpoint before any of its cuts: the window flags the stroke before it moves
     // the pointer, so a pose read above that belongs to the stroke sees the flag.
     if (r.stroke_started.exchange(false)) m_history.before_stroke(*m_method);
-    if (m_driven >= 0) m_tools.drive(static_cast<std::size_t>(m_driven), m_pose.position, m_pose.orientation);
+    for (const Hand& hand : m_hands)
+        if (hand.driven >= 0) m_tools.drive(static_cast<std::size_t>(hand.driven), hand.pose.position, hand.pose.orientation);
     try {
         const sim::FrameStats frame = m_loop.next();
         if (frame.level_change) now_at_level(frame.level_change->reason);
@@ -146,15 +159,21 @@ bool ViewSimulation::step(double now_s)
         r.paused = true;
         if (m_journal) m_journal->end_stroke(*m_method, m_loop.frames(), m_loop.frames() * m_scene.solver.dt_s);
     }
-    // The surface near the tool and where the device is heading, for the haptic thread.
-    contact::SurfacePoints& out = m_channels.snapshots.write_slot();
-    const io::ToolSpec& held = m_scene.tools[static_cast<std::size_t>(std::max(m_driven, 0))];
-    Eigen::AlignedBox3d near = m_pose.world_bounds(held.push_margin_mm + 5.0);
-    near.extend(contact::PlacedShape{m_pose.shape, m_heading, m_pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
-    m_method->sample_surface(near, held, out);
-    contact::measure_slack(m_pose, held.push_margin_mm, out);
-    out.t_s = now_s;
-    m_channels.snapshots.publish();
+    // For each device, the surface near its tool and where it is heading; and the simulation's
+    // time for the scripted ones.
+    for (std::size_t d = 0; d < m_hands.size(); ++d) {
+        const Hand& hand = m_hands[d];
+        HandChannel& channel = m_channels.hand(d);
+        contact::SurfacePoints& out = channel.snapshots.write_slot();
+        const io::ToolSpec& held = m_scene.tools[hand.driven >= 0 ? static_cast<std::size_t>(hand.driven) : m_options.hands[d].tool];
+        Eigen::AlignedBox3d near = hand.pose.world_bounds(held.push_margin_mm + 5.0);
+        near.extend(contact::PlacedShape{hand.pose.shape, hand.heading, hand.pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
+        m_method->sample_surface(near, held, out);
+        contact::measure_slack(hand.pose, held.push_margin_mm, out);
+        out.t_s = now_s;
+        channel.snapshots.publish();
+    }
+    m_channels.simulation_t_s.store(m_loop.frames() * m_scene.solver.dt_s, std::memory_order_relaxed);
     if (r.save_object.exchange(false)) save();
     if (r.picture_taken.exchange(false)) make_picture();
     r.frames.fetch_add(1, std::memory_order_relaxed);
@@ -204,12 +223,22 @@ void ViewSimulation::make_picture()
                          " stroke(s) in its journal: press J to resume them"
                : m_now_s < m_level_notice_until_s ? m_level_notice
                                                   : std::string();
-    const io::ToolSpec& tool = m_scene.tools[static_cast<std::size_t>(q.active.load())];
-    r.tool = tool.name + " (" +
-             (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")
-              : tool.action == io::ToolAction::wet ? std::string("wet")
-                                                   : std::string("push")) +
-             ")";
+    const auto described = [&](std::size_t k) {
+        const io::ToolSpec& tool = m_scene.tools[k];
+        return tool.name + " (" +
+               (tool.action == io::ToolAction::cut ? std::string(tool.cut_mode == io::CutMode::remove ? "cut, removing" : "cut, separating")
+                : tool.action == io::ToolAction::wet ? std::string("wet")
+                                                     : std::string("push")) +
+               ")";
+    };
+    const auto active = static_cast<std::size_t>(q.active.load());
+    r.tool = described(active);
+    if (m_hands.size() > 1) { // each device's tool, and the one the keys act on
+        r.tool.clear();
+        for (std::size_t d = 0; d < m_hands.size(); ++d)
+            r.tool += (d ? ",  " : "") + described(m_options.hands[d].tool) + " by " + m_options.hands[d].device;
+        r.tool += "   keys: " + m_scene.tools[active].name;
+    }
     m_channels.pictures.publish();
 }
 

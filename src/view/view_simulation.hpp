@@ -1,8 +1,8 @@
 #pragma once
 // The simulation thread of a viewer session: takes the window's requests (tool actions, cut mode,
-// levels, undo, save), puts the device's tool where the haptic thread left it, steps the frame loop
-// (sim/frame_loop.hpp), publishes the surface near the tool for the haptic thread and the next
-// picture for the window. It touches the method, the tools and the scene's tool settings alone.
+// levels, undo, save), puts each device's tool where the haptic thread left it, steps the frame
+// loop (sim/frame_loop.hpp), publishes the surface near each device's tool and its own clock for
+// the haptic thread and the next picture for the window. It touches the method, the tools and the scene's tool settings alone.
 // step() is one iteration, so a test can drive it without threads or a window.
 
 #include "sim/frame_loop.hpp"
@@ -18,11 +18,19 @@
 
 namespace vox::view {
 
+/// One device of the session, as the simulation sees it.
+struct ViewHand {
+    std::size_t tool = 0;     ///< the tool it starts on (one device: TAB moves it; several: fixed)
+    Eigen::Vector3d start_mm = Eigen::Vector3d::Zero(); ///< where its tool is until the haptic thread reports
+    std::string device;       ///< its name, for the window's status line
+};
+
 struct ViewSimulationOptions {
     int grid_levels = 6;                ///< the coarsest level the level keys reach
     int smooth = 4;                     ///< display smoothing the window gives the surface
     std::filesystem::path out_dir = "."; ///< where S saves
-    Eigen::Vector3d start_mm = Eigen::Vector3d::Zero(); ///< where the tool is until the haptic thread reports
+    /// One per device, in the order of the channels' hands.
+    std::vector<ViewHand> hands = {ViewHand{}};
     /// The session journal (sim/journal.hpp): written here, for the scene file `scene_file`; empty:
     /// none (tests).
     std::filesystem::path journal;
@@ -54,7 +62,7 @@ public:
 
 private:
     void take_requests();
-    /// The device lets go of its tool (after the object changed under it).
+    /// The devices let go of their tools (after the object changed under them).
     void let_go();
     void save() const;
     void make_picture();
@@ -78,9 +86,14 @@ private:
     std::string m_level_notice; ///< the last move between levels, shown for a few seconds
     double m_level_notice_until_s = 0.0;
     double m_now_s = 0.0;
-    int m_driven = -1; ///< the tool the device drives (-1: none yet)
-    contact::PlacedShape m_pose;
-    Eigen::Vector3d m_heading = Eigen::Vector3d::Zero();
+    /// Per device: the tool it drives (-1: none yet), where the haptic thread put it and where
+    /// the device is heading.
+    struct Hand {
+        int driven = -1;
+        contact::PlacedShape pose;
+        Eigen::Vector3d heading = Eigen::Vector3d::Zero();
+    };
+    std::vector<Hand> m_hands;
 };
 
 template <class Clock> void ViewSimulation::run(Clock now_s)

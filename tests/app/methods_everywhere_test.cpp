@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -151,6 +152,31 @@ TEST_P(EachMethodEndToEnd, TheViewerShowsThreeScenesInAWindow)
         }
         EXPECT_GT(object, w * h / 30) << scene_name;
     }
+}
+
+TEST_P(EachMethodEndToEnd, TheViewerDrivesTwoToolsByTwoDevicesAtOnce)
+{
+    // A scripted finger presses the block (its script: down to z = 14.5 by 0.4 s; a 5 mm sphere
+    // touches the top, z = 12, at 17) while the mouse holds the knife above it, where it starts.
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+    const fs::path d = fresh_dir(std::string("view_two_hands_") + GetParam());
+    const std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " + quote(VOX_VOXSCULPT_EXE) + " view " +
+                                quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/two_hands.json") + " --solver " + GetParam() +
+                                " --device script --tool finger --device mouse --tool knife --size 480x360 --exit-after 4 --out " +
+                                quote(d.string()) + " > " + quote((d / "log.txt").string()) + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command << "\n" << slurp(d / "log.txt");
+    const std::string log = slurp(d / "log.txt");
+    EXPECT_NE(log.find("tool \"finger\" is driven by: script"), std::string::npos) << log;
+    EXPECT_NE(log.find("tool \"knife\" (mouse) ended at (33.50, 12.00, 22.00) mm"), std::string::npos) << log;
+    const std::string finger = "tool \"finger\" (script) ended at (";
+    const auto at = log.find(finger);
+    ASSERT_NE(at, std::string::npos) << log;
+    double x = 0, y = 0, z = 0;
+    ASSERT_EQ(std::sscanf(log.c_str() + at + finger.size(), "%lf, %lf, %lf", &x, &y, &z), 3) << log;
+    EXPECT_NEAR(x, 11.5, 0.05);
+    EXPECT_NEAR(y, 11.5, 0.05);
+    EXPECT_LT(z, 16.9) << "the finger pressed into the block";
+    EXPECT_GE(z, 14.5) << "held on the surface, not through it";
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, EachMethodEndToEnd, ::testing::Values("dbg", "isxfem", "shape_matching"),

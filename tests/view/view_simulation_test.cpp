@@ -9,6 +9,7 @@
 #include "sim/journal.hpp"
 #include "sim/level_governor.hpp"
 #include "test_support.hpp"
+#include "view/paced_device.hpp"
 #include "view/view_simulation.hpp"
 
 #include <gtest/gtest.h>
@@ -43,13 +44,13 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeCutsUndoPutsItBackAndTheKeysAreTaken)
     keys.stroke_started = true;
     const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
     for (int f = 0; f < 30; ++f) {
-        channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
-        channels.proxies.publish();
+        channels.hand().proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
+        channels.hand().proxies.publish();
         ASSERT_TRUE(simulation.step(0.01 * f));
     }
     EXPECT_GT(simulation.method().dof_count(), dofs) << "the stroke cut";
     EXPECT_EQ(simulation.history().size(), 1u);
-    EXPECT_GT(channels.snapshots.latest().count, 0u) << "the surface near the blade went to the haptic thread";
+    EXPECT_GT(channels.hand().snapshots.latest().count, 0u) << "the surface near the blade went to the haptic thread";
     EXPECT_TRUE(channels.pictures.update());
     EXPECT_FALSE(channels.pictures.read_slot().meshes.empty());
 
@@ -104,8 +105,8 @@ TEST_P(ViewSimulationOnEachMethod, AStrokeIsJournaledWhenTheButtonGoesUpAndANewS
         channels.requests.stroke_started = true;
         const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
         for (int f = 0; f < 30; ++f) {
-            channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
-            channels.proxies.publish();
+            channels.hand().proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned}, Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f)};
+            channels.hand().proxies.publish();
             if (f == 29) channels.requests.stroke_ended = true; // the button goes up
             ASSERT_TRUE(simulation.step(0.01 * f));
         }
@@ -164,8 +165,8 @@ TEST(ViewSimulationLevels, ASessionOverBudgetMovesCoarserCarryingTheObjectAndSay
     int moved_at = 0;
     for (int f = 0; f < 2 * frames_per_second && !moved_at; ++f) {
         const double depth = std::min(f, 12) * 1.2;
-        channels.proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - depth), turned}, Eigen::Vector3d(50.3, 5, 20.5 - depth)};
-        channels.proxies.publish();
+        channels.hand().proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - depth), turned}, Eigen::Vector3d(50.3, 5, 20.5 - depth)};
+        channels.hand().proxies.publish();
         keys.picture_taken = true;
         ASSERT_TRUE(simulation.step(0.01 * f));
         if (simulation.level() == 2) moved_at = f + 1;
@@ -187,6 +188,65 @@ TEST(ViewSimulationLevels, ASessionOverBudgetMovesCoarserCarryingTheObjectAndSay
     ASSERT_TRUE(simulation.step(3.0));
     EXPECT_EQ(simulation.level(), 1);
     EXPECT_EQ(simulation.method().cut_count(), 0u);
+}
+
+TEST(ViewSimulationHands, TwoDevicesEachDriveTheirOwnToolAndGetTheSurfaceNearIt)
+{
+    // data/scenes/two_hands.json: a finger presses the block's left while a knife cuts its right,
+    // each through its own hand's channel, as the haptic thread reports them.
+    io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/two_hands.json");
+    scene.script.clear();
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    sim::ToolPolicy tools(scene);
+    ViewChannels channels(20000, 2);
+    ViewSimulationOptions options;
+    options.grid_levels = 2;
+    options.out_dir = vox::test::fresh_dir("view_simulation_hands");
+    options.hands = {{0, Eigen::Vector3d(11.5, 11.5, 19), "script"}, {1, Eigen::Vector3d(33.5, 12, 22), "mouse"}};
+    ViewSimulation simulation(scene, std::make_unique<sim::DbgMethod>(scene, labels, 1, 2), tools, channels, options);
+    for (int f = 0; f < 60; ++f) {
+        const Eigen::Vector3d finger(11.5, 11.5, std::max(19.0 - 0.25 * f, 14.5)), knife(33.5, 12, std::max(22.0 - 0.3 * f, 6.0));
+        channels.hand(0).proxies.write_slot() = {0, {&tools.shape(0), finger, Eigen::Quaterniond::Identity()}, finger};
+        channels.hand(0).proxies.publish();
+        channels.hand(1).proxies.write_slot() = {1, {&tools.shape(1), knife, Eigen::Quaterniond::Identity()}, knife};
+        channels.hand(1).proxies.publish();
+        ASSERT_TRUE(simulation.step(0.01 * f));
+    }
+    EXPECT_EQ(tools.placed(0).position.z(), 14.5);
+    EXPECT_EQ(tools.placed(1).position.z(), 6.0);
+    EXPECT_GT(simulation.method().cut_count(), 0u) << "the knife cut";
+    // The finger pressed the top (z = 12 at rest) down under it.
+    double lowest = INFINITY;
+    const surface::SurfaceMesh mesh = simulation.method().surface_mesh();
+    for (const Eigen::Vector3d& p : mesh.positions)
+        if (std::abs(p.x() - 11.5) < 1.5 && std::abs(p.y() - 11.5) < 1.5 && p.z() > 6.0) lowest = std::min(lowest, p.z());
+    EXPECT_LT(lowest, 11.5);
+    // Each hand's snapshot is the surface near its own tool, and the clock the scripted ones follow moved on.
+    for (std::size_t d = 0; d < 2; ++d) {
+        const contact::SurfacePoints& snapshot = channels.hand(d).snapshots.latest();
+        ASSERT_GT(snapshot.count, 0u) << "hand " << d;
+        const double x = tools.placed(d).position.x();
+        for (std::size_t i = 0; i < snapshot.count; ++i) EXPECT_LT(std::abs(snapshot.positions_mm[i].x() - x), 20.0) << "hand " << d;
+    }
+    EXPECT_NEAR(channels.simulation_t_s.load(), 0.6, 1e-9);
+}
+
+TEST(PacedDevice, FollowsItsScriptInSimulatedTimeRunningOnAtMostOneFrame)
+{
+    std::atomic<double> simulated{0.0};
+    PacedDevice device({{0.0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity()}, {1.0, Eigen::Vector3d(10, 0, 0), Eigen::Quaterniond::Identity()}},
+                       simulated, 0.01);
+    haptics::DeviceState s;
+    device.read(5.0, s); // the loop's clock is not the simulation's
+    EXPECT_NEAR(s.position_mm.x(), 0.0, 1e-12);
+    EXPECT_EQ(s.t_s, 5.0);
+    device.read(5.004, s); // runs on with the loop between frames
+    EXPECT_NEAR(s.position_mm.x(), 0.04, 1e-9);
+    device.read(5.5, s); // but not past one frame while the simulation stands still (paused, slow)
+    EXPECT_NEAR(s.position_mm.x(), 0.1, 1e-9);
+    simulated = 0.5;
+    device.read(5.501, s);
+    EXPECT_NEAR(s.position_mm.x(), 5.0, 1e-9);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, ViewSimulationOnEachMethod, ::testing::Values(io::SolverType::dbg, io::SolverType::isxfem),
