@@ -637,6 +637,11 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
     }
     if (m_preconditioner && !same_system) {
         update_node_rotations();
+        std::vector<std::uint32_t> contacts;
+        for (const NodeContact& c : m_contact) contacts.push_back(c.node);
+        for (const PairContact& p : m_pairs.pairs())
+            for (const BlockWeight& t : p.terms) contacts.push_back(t.block);
+        m_preconditioner->set_contact_blocks(std::move(contacts));
         m_preconditioner->update(m_matrix_current ? &m_matrix : nullptr, m_fixed, m_node_rotation);
         if (m_preconditioner->failed()) { // e.g. a factor of a singular K: nothing holds the object
             m_fallback_note = std::string(m_preconditioner->name()) +

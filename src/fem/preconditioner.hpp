@@ -47,6 +47,10 @@ public:
     virtual void blocks_changed(const std::vector<std::uint32_t>& /*blocks*/) { invalidate(); }
     /// The jump blocks of the system (see JumpBlock); ignored unless the preconditioner warps.
     virtual void set_jump_blocks(std::vector<JumpBlock> /*jumps*/) {}
+    /// The dof blocks whose rows carry contact terms in the next update()'s matrix (a tool's
+    /// penalty, pieces pressed together): terms that move on with the tool from step to step, so
+    /// a preconditioner kept across steps knows which rows it took them in.
+    virtual void set_contact_blocks(std::vector<std::uint32_t> /*blocks*/) {}
     [[nodiscard]] virtual const char* name() const = 0;
     /// True when the last update could not build the preconditioner (a singular matrix).
     [[nodiscard]] virtual bool failed() const { return false; }

@@ -1,6 +1,7 @@
 #include "fem/supernodal_factor.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Dense>
 
 #include <cholmod.h>
 #include <tbb/global_control.h>
@@ -84,6 +85,8 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     copy(l->px, l->nsuper + 1, m_px);
     copy(l->s, l->ssize, m_s);
     copy(l->Perm, l->n, m_perm);
+    m_inverse_perm.resize(m_perm.size());
+    for (std::size_t i = 0; i < m_perm.size(); ++i) m_inverse_perm[static_cast<std::size_t>(m_perm[i])] = static_cast<int>(i);
     const double* x = static_cast<const double*>(l->x);
     m_values.assign(x, x + l->xsize);
     double smallest = INFINITY, largest = 0.0;
@@ -106,14 +109,16 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
 void SupernodalFactor::schedule(std::size_t groups)
 {
     const int supernodes = static_cast<int>(m_super.size()) - 1;
-    std::vector<int> column_super(static_cast<std::size_t>(m_super.back()));
+    std::vector<int>& column_super = m_column_super;
+    column_super.assign(static_cast<std::size_t>(m_super.back()), 0);
     for (int k = 0; k < supernodes; ++k)
         for (int c = m_super[k]; c < m_super[k + 1]; ++c) column_super[static_cast<std::size_t>(c)] = k;
     // The supernodal tree: a supernode's parent holds its first row below the diagonal block.
     // Work is counted in factor entries (what a solve streams).
     std::vector<std::vector<int>> children(static_cast<std::size_t>(supernodes));
     std::vector<double> work(static_cast<std::size_t>(supernodes)), subtree(static_cast<std::size_t>(supernodes), 0.0);
-    std::vector<int> parent(static_cast<std::size_t>(supernodes), -1);
+    std::vector<int>& parent = m_parent;
+    parent.assign(static_cast<std::size_t>(supernodes), -1);
     std::vector<int> frontier; // the roots, then the subtrees left below the top
     bool postordered = true;
     for (int k = 0; k < supernodes; ++k) {
@@ -127,6 +132,7 @@ void SupernodalFactor::schedule(std::size_t groups)
         postordered = postordered && p > k;
         children[static_cast<std::size_t>(p)].push_back(k);
     }
+    m_postordered = postordered;
     for (int k = 0; k < supernodes && postordered; ++k) {
         subtree[static_cast<std::size_t>(k)] += work[static_cast<std::size_t>(k)];
         if (parent[static_cast<std::size_t>(k)] >= 0) subtree[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])] += subtree[static_cast<std::size_t>(k)];
@@ -232,32 +238,81 @@ void SupernodalFactor::backward(int k, float* b, float* tmp) const
     block.topRows(nc).transpose().triangularView<Eigen::Upper>().solveInPlace(x);
 }
 
-void SupernodalFactor::solve(Eigen::VectorXd& v) const
+void SupernodalFactor::forward_all(float* b) const
 {
-    const int n = static_cast<int>(m_perm.size());
-    for (int i = 0; i < n; ++i) m_b[static_cast<std::size_t>(i)] = static_cast<float>(v[m_perm[static_cast<std::size_t>(i)]]);
-    float* b = m_b.data();
-    auto groups = [&](auto&& body) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_groups.size(), 1),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t g = r.begin(); g != r.end(); ++g) body(g);
-                          },
-                          tbb::simple_partitioner());
-    };
-    // Up: the groups' subtrees in parallel, their updates to the top summed, then the top.
-    groups([&](std::size_t g) {
-        std::fill(m_delta[g].begin(), m_delta[g].end(), 0.0f);
-        for (int k : m_groups[g]) forward(k, b, m_tmp[g].data(), m_delta[g].data());
-    });
+    // The groups' subtrees in parallel, their updates to the top summed, then the top.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_groups.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t g = r.begin(); g != r.end(); ++g) {
+                              std::fill(m_delta[g].begin(), m_delta[g].end(), 0.0f);
+                              for (int k : m_groups[g]) forward(k, b, m_tmp[g].data(), m_delta[g].data());
+                          }
+                      },
+                      tbb::simple_partitioner());
     for (const std::vector<float>& delta : m_delta)
         for (std::size_t j = 0; j < delta.size(); ++j) b[m_top_rows[j]] -= delta[j];
     for (int k : m_top) forward(k, b, m_tmp.front().data(), nullptr);
-    // Down: the top, then the groups in parallel.
+}
+
+void SupernodalFactor::backward_all(float* b) const
+{
+    // The top, then the groups in parallel.
     for (auto k = m_top.rbegin(); k != m_top.rend(); ++k) backward(*k, b, m_tmp.front().data());
-    groups([&](std::size_t g) {
-        for (auto k = m_groups[g].rbegin(); k != m_groups[g].rend(); ++k) backward(*k, b, m_tmp[g].data());
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m_groups.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t g = r.begin(); g != r.end(); ++g)
+                              for (auto k = m_groups[g].rbegin(); k != m_groups[g].rend(); ++k) backward(*k, b, m_tmp[g].data());
+                      },
+                      tbb::simple_partitioner());
+}
+
+void SupernodalFactor::solve(Eigen::VectorXd& v) const { solve(v, {}); }
+
+void SupernodalFactor::solve(Eigen::VectorXd& v, const std::function<void(std::span<float>)>& between) const
+{
+    const int n = static_cast<int>(m_perm.size());
+    for (int i = 0; i < n; ++i) m_b[static_cast<std::size_t>(i)] = static_cast<float>(v[m_perm[static_cast<std::size_t>(i)]]);
+    forward_all(m_b.data());
+    if (between) between(std::span<float>(m_b.data(), m_b.size()));
+    backward_all(m_b.data());
     for (int i = 0; i < n; ++i) v[m_perm[static_cast<std::size_t>(i)]] = m_b[static_cast<std::size_t>(i)];
+}
+
+double SupernodalFactor::forward_columns(std::span<const int> dofs, std::vector<int>& rows, Eigen::MatrixXf& columns) const
+{
+    // The supernodes on the dofs' paths to the root, in ascending order (a child before its
+    // parent, CHOLMOD's postorder), and their rows.
+    if (!m_postordered) throw std::logic_error("SupernodalFactor::forward_columns: the supernodal tree is not in postorder");
+    const auto supernodes = m_parent.size();
+    std::vector<unsigned char> on(supernodes, 0);
+    for (const int d : dofs)
+        for (int k = m_column_super[static_cast<std::size_t>(row_of(d))]; k >= 0 && !on[static_cast<std::size_t>(k)]; k = m_parent[static_cast<std::size_t>(k)])
+            on[static_cast<std::size_t>(k)] = 1;
+    rows.clear();
+    std::vector<int> place(m_perm.size(), -1);
+    for (std::size_t k = 0; k < supernodes; ++k)
+        if (on[k])
+            for (int c = m_super[k]; c < m_super[k + 1]; ++c) {
+                place[static_cast<std::size_t>(c)] = static_cast<int>(rows.size());
+                rows.push_back(c);
+            }
+    columns.setZero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(dofs.size()));
+    for (std::size_t j = 0; j < dofs.size(); ++j) columns(place[static_cast<std::size_t>(row_of(dofs[j]))], static_cast<Eigen::Index>(j)) = 1.0f;
+    Eigen::MatrixXf below_update;
+    double flops = 0.0;
+    for (std::size_t k = 0; k < supernodes; ++k) {
+        if (!on[k]) continue;
+        const int c0 = m_super[k], nc = m_super[k + 1] - c0, nr = m_pi[k + 1] - m_pi[k], below = nr - nc;
+        flops += 2.0 * static_cast<double>(nr) * nc * static_cast<double>(dofs.size());
+        const Eigen::Map<const Eigen::MatrixXf> block(m_values.data() + m_px[k], nr, nc);
+        auto y = columns.middleRows(place[static_cast<std::size_t>(c0)], nc); // the supernode's rows are consecutive there
+        block.topRows(nc).triangularView<Eigen::Lower>().solveInPlace(y);
+        if (below == 0) continue;
+        below_update.noalias() = block.bottomRows(below) * y;
+        const int* below_rows = m_s.data() + m_pi[k] + nc; // all in ancestors: on the path
+        for (int i = 0; i < below; ++i) columns.row(place[static_cast<std::size_t>(below_rows[i])]) -= below_update.row(i);
+    }
+    return flops;
 }
 
 } // namespace vox::fem

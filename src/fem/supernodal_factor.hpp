@@ -13,7 +13,9 @@
 
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace vox::fem {
@@ -36,6 +38,19 @@ public:
     [[nodiscard]] static std::size_t solve_threads();
     /// x = A^-1 x, in single precision.
     void solve(Eigen::VectorXd& x) const;
+    /// The same, calling `between` on y = L^-1 P x (the factor's order) between the forward and
+    /// the backward solve: a low-rank correction of the factored matrix acts there
+    /// (fem/factor_correction.hpp).
+    void solve(Eigen::VectorXd& x, const std::function<void(std::span<float>)>& between) const;
+    /// Rows (and columns) of the factored matrix.
+    [[nodiscard]] Eigen::Index size() const { return static_cast<Eigen::Index>(m_perm.size()); }
+    /// The columns L^-1 P e_d for the dofs `dofs` (single precision). Each is non-zero only on the
+    /// rows of the supernodes from the dof's own up to the root of the supernodal tree: `rows`
+    /// gets the union of those rows (factor order, ascending), `columns` one column per dof over
+    /// them. Solved together, from the leaves up. Returns the flops it took.
+    double forward_columns(std::span<const int> dofs, std::vector<int>& rows, Eigen::MatrixXf& columns) const;
+    /// The factor's row (its order) of a dof of the matrix.
+    [[nodiscard]] int row_of(int dof) const { return m_inverse_perm[static_cast<std::size_t>(dof)]; }
     /// Entries of the factor (its supernodes' dense blocks).
     [[nodiscard]] std::size_t entries() const { return m_values.size(); }
     /// Floating-point operations of one numerical factorisation (CHOLMOD's count from the analysis).
@@ -50,10 +65,15 @@ private:
     void schedule(std::size_t groups);
     void forward(int k, float* b, float* tmp, float* top_delta) const;
     void backward(int k, float* b, float* tmp) const;
+    void forward_all(float* b) const;
+    void backward_all(float* b) const;
 
     std::unique_ptr<Cholmod> m_cholmod;
     std::vector<float> m_values;                      ///< supernodes' blocks, column-major
     std::vector<int> m_super, m_pi, m_px, m_s, m_perm; ///< CHOLMOD's supernodal layout
+    std::vector<int> m_inverse_perm;                    ///< dof -> factor row
+    std::vector<int> m_column_super, m_parent;         ///< factor row -> its supernode; supernode -> parent (-1: a root)
+    bool m_postordered = false;                        ///< a child's number below its parent's (CHOLMOD's)
     double m_factor_flops = 0.0;
     std::vector<std::vector<int>> m_groups; ///< per group, its supernodes in ascending order
     std::vector<int> m_top;                 ///< supernodes solved serially, ascending

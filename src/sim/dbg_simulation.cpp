@@ -180,10 +180,26 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     const std::vector<std::uint32_t>& new_nodes = m_model->grid_node();
     if (m_choice == io::PreconditionerChoice::cholesky && old_choice == m_choice && m_level >= 1 && new_nodes.size() >= old_nodes.size() &&
         std::equal(old_nodes.begin(), old_nodes.end(), new_nodes.begin())) {
-        // Every node kept its number (new ones come after them): the factor goes on, patched where
-        // elements changed and over the new nodes (fem/rest_cholesky.hpp).
+        // Every node kept its number (new ones come after them): the factor goes on, corrected for
+        // the rows that changed, the nodes of the elements changed before and after the cut (one
+        // whose material went entirely is among the old ones only), and over the new nodes
+        // (fem/rest_cholesky.hpp).
         const std::vector<unsigned char> changed = changed_elements(grid, m_level, report);
+        std::vector<unsigned char> changed_before; // per element of the grid before the cut
+        const auto mark = [&](std::uint32_t e) {
+            if (e >= changed_before.size()) changed_before.resize(e + 1, 0);
+            changed_before[e] = 1;
+        };
+        if (static_cast<std::size_t>(m_level) < report.levels.size()) {
+            const grid::LevelChange& c = report.levels[static_cast<std::size_t>(m_level)];
+            for (const std::uint32_t e : c.removed) mark(e);
+            for (const std::uint32_t e : c.updated) mark(e);
+            for (const auto& [e, from] : c.created)
+                for (const std::uint32_t f : from) mark(f);
+        }
         std::vector<std::uint32_t> nodes;
+        for (const fem::HexElement& el : old_model->elements())
+            if (el.grid_element < changed_before.size() && changed_before[el.grid_element]) nodes.insert(nodes.end(), el.dof_node.begin(), el.dof_node.end());
         for (const fem::HexElement& el : m_model->elements())
             if (changed[el.grid_element]) nodes.insert(nodes.end(), el.dof_node.begin(), el.dof_node.end());
         std::sort(nodes.begin(), nodes.end());
@@ -399,7 +415,7 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
         solver.set_integrator(std::move(integrator));
     } else switch (choice) {
     case io::PreconditionerChoice::cholesky:
-        solver.set_preconditioner(std::make_unique<fem::RestCholesky>(model.frame()));
+        solver.set_preconditioner(std::make_unique<fem::RestCholesky>(model.frame(), 25, fem::RestCholesky::background_flops_here()));
         m_linear_solver = "CG, warped Cholesky preconditioner";
         break;
     case io::PreconditionerChoice::multigrid: {

@@ -300,7 +300,7 @@ TEST(XfemSolver, ACutKeepsTheWarpedFactorAndSolvesThePatchBesideIt)
     p.blocks_changed({});
     p.update(&op.matrix(), fixed, rotation);
     EXPECT_EQ(p.factorizations(), 1);
-    EXPECT_GT(p.patch_dofs(), 3 * r.new_blocks);
+    EXPECT_GT(p.correction_dofs(), 3 * r.new_blocks);
 
     const Eigen::MatrixXd a(op.matrix());
     const Eigen::Index n = a.rows();
