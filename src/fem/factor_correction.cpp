@@ -21,7 +21,7 @@ void FactorCorrection::clear()
 
 bool FactorCorrection::build(const SupernodalFactor& factor, const SystemMatrix& factored, const SystemMatrix& a,
                              std::span<const std::uint32_t> blocks, const std::vector<Eigen::Matrix3d>& warp,
-                             const std::vector<unsigned char>& fixed, std::size_t max_dofs, double& flops)
+                             const std::vector<unsigned char>& fixed, std::size_t max_dofs, double max_flops, double& flops)
 {
     flops = 0.0;
     if (m_factor != &factor) {
@@ -51,7 +51,9 @@ bool FactorCorrection::build(const SupernodalFactor& factor, const SystemMatrix&
             if (d >= n) m_new.push_back(d);
             else if (!known[static_cast<std::size_t>(d)]) joining.push_back(d);
         }
-    if (m_old.size() + joining.size() + m_new.size() > max_dofs) {
+    const double s_estimate = static_cast<double>(m_old.size() + joining.size() + m_new.size());
+    if (s_estimate > static_cast<double>(max_dofs) ||
+        (joining.empty() ? 0.0 : factor.forward_columns_flops(joining)) + 2.0 / 3.0 * s_estimate * s_estimate * s_estimate > max_flops) {
         clear();
         return false;
     }

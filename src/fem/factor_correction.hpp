@@ -49,10 +49,12 @@ public:
     /// `blocks` changed since (every block beyond the factored ones included; the old blocks
     /// coupled to new ones are added here). `warp`: per factored block, the rotation from the
     /// factored state to now. Columns of X are kept from earlier builds with the same factor.
-    /// False (and empty) when S would exceed `max_dofs` or C is singular. `flops` gets what the
-    /// build cost (new columns of X, G's new entries, C's LU).
+    /// False (and empty) when S would exceed `max_dofs`, the build would cost more than
+    /// `max_flops` (a cut through many elements at once: a new factor is then the better buy), or
+    /// C is singular. `flops` gets what the build cost (new columns of X, G's new entries, C's LU).
     bool build(const SupernodalFactor& factor, const SystemMatrix& factored, const SystemMatrix& a, std::span<const std::uint32_t> blocks,
-               const std::vector<Eigen::Matrix3d>& warp, const std::vector<unsigned char>& fixed, std::size_t max_dofs, double& flops);
+               const std::vector<Eigen::Matrix3d>& warp, const std::vector<unsigned char>& fixed, std::size_t max_dofs, double max_flops,
+               double& flops);
 
     /// Between the factor's forward and backward solves (SupernodalFactor::solve): corrects the
     /// forward result `y` of the factored dofs, and writes z over the new dofs of S from the

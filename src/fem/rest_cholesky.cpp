@@ -99,6 +99,7 @@ void RestCholesky::start_stretch(std::vector<unsigned char> changed, bool dirty)
     m_correction_dirty = dirty;
     m_covered_blocks = m_current->rotation.size();
     m_correction.clear();
+    m_patch.clear();
     // A CG iteration streams the factor twice (2 flops an entry each way) and multiplies by
     // the matrix once (2 flops a non-zero). The factorisation's flops run in small dense
     // blocks at about half the solve's rate per flop (measured on the liver at level 4: 380
@@ -162,15 +163,25 @@ bool RestCholesky::recorrect(const SystemMatrix& a, const std::vector<unsigned c
     std::vector<std::uint32_t> seeds;
     for (std::uint32_t b = 0; b < blocks; ++b)
         if (b >= m_changed.size() || m_changed[b]) seeds.push_back(b);
+    const std::size_t cut_seeds = seeds.size();
     seeds.insert(seeds.end(), m_current->contact_blocks.begin(), m_current->contact_blocks.end());
     seeds.insert(seeds.end(), m_contact_blocks.begin(), m_contact_blocks.end());
     m_correction_dirty = false;
     m_covered_blocks = blocks;
+    m_patch.clear();
+    // Exact while that costs at most a factorisation (or about a millisecond) and
+    // covers at most an eighth of the system.
     double flops = 0.0;
-    const bool built = m_correction.build(m_current->factor, m_current->matrix, a, seeds, m_warp, fixed,
-                                          static_cast<std::size_t>(a.rows() / 8), flops); // fails past an eighth of the system
+    const bool built = m_exact_cuts && m_correction.build(m_current->factor, m_current->matrix, a, seeds, m_warp, fixed, static_cast<std::size_t>(a.rows() / 8),
+                                          std::max(m_current->factor.factor_flops(), 1e7), flops);
     m_excess += flops / m_iteration_flops; // the rent-or-buy rule counts it as iterations
-    return built;
+    if (built) return true;
+    // Past that (a cut through many elements at once) a new factor is the better buy; until it
+    // comes, an exact solve on the patch of the changed blocks with one ring is added to the
+    // factor (additive Schwarz: sound, not exact).
+    if (m_exact_cuts && !m_running.valid()) m_stale = true; // else one is on its way
+    seeds.resize(cut_seeds); // the patch holds the cut's blocks and their ring
+    return m_patch.build(a, seeds, a.rows() / 8);
 }
 
 void RestCholesky::blocks_changed(const std::vector<std::uint32_t>& blocks)
@@ -225,8 +236,10 @@ void RestCholesky::report_iterations(int iterations)
         return;
     }
     if (m_baseline < 0 || iterations < m_baseline) m_baseline = iterations;
-    const double correction = m_correction.apply_flops() / m_iteration_flops;
-    m_excess += iterations * (1.0 + correction) - m_baseline;
+    // A patch solve streams its double-precision factor twice per iteration: 8 flop-equivalents
+    // an entry against the float factor's 4.
+    const double extra = (m_correction.apply_flops() + 8.0 * static_cast<double>(m_patch.entries())) / m_iteration_flops;
+    m_excess += iterations * (1.0 + extra) - m_baseline;
     m_stale = m_stale || iterations > m_refactor_iterations || m_excess >= m_refactor_cost;
 }
 
@@ -255,6 +268,7 @@ void RestCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const
     for (const auto& [jump, j] : m_jump_warp)
         z.segment<3>(3 * static_cast<Eigen::Index>(jump.block)) += j * m_scratch.segment<3>(3 * static_cast<Eigen::Index>(jump.node));
     if (!m_correction.empty()) m_correction.add_new(m_new_z, z);
+    if (!m_patch.empty()) m_patch.add_to(r, z);
     for (std::size_t i = 0; i < fixed.size(); ++i)
         if (fixed[i]) z[static_cast<Eigen::Index>(i)] = 0.0;
 }

@@ -21,7 +21,11 @@
 // over those rows by the Woodbury identity (fem/factor_correction.hpp): the factor preconditions
 // the cut system as a new factor of it would, until the rent-or-buy rule says a new factor pays
 // (the correction's build and its extra work in each application count as extra iterations) or
-// the corrected rows pass an eighth of the system. The rows whose contact terms moved are
+// the corrected rows pass an eighth of the system. A correction whose build would cost more than
+// a factorisation (a cut through many elements at once) is not built: an exact solve on the patch
+// of changed blocks with one ring is added to the factor instead (additive Schwarz,
+// fem/patch_solve.hpp: sound, not exact) until a new factor comes, as it is for systems whose cuts
+// change more rows than they name (set_exact_cuts). The rows whose contact terms moved are
 // corrected with them (set_contact_blocks: those of the factor's snapshot and this step's; the tool
 // presses where it cuts). Measured on the liver incision (docs/benchmarks/cutting.md): CG takes
 // 3 - 5 iterations while cutting, where an exact solve on the patch of changed blocks added to the
@@ -54,6 +58,7 @@
 #include "fem/preconditioner.hpp"
 
 #include "fem/factor_correction.hpp"
+#include "fem/patch_solve.hpp"
 #include "fem/supernodal_factor.hpp"
 
 #include <future>
@@ -78,6 +83,11 @@ public:
     /// background thread would take the frames' own core in slices of a few milliseconds, landing
     /// in a dozen frames instead of one.
     [[nodiscard]] static double background_flops_here();
+    /// Whether a cut is corrected for exactly (the default), or only by the patch solve: for a
+    /// system whose cuts change rows beyond those blocks_changed() names (Is-XFEM: a cut's
+    /// enriched blocks change the rows of everything they couple to), where an exact correction
+    /// over the named rows alone would not be positive definite.
+    void set_exact_cuts(bool exact) { m_exact_cuts = exact; }
     ~RestCholesky() override;
     RestCholesky(const RestCholesky&) = delete;
     RestCholesky& operator=(const RestCholesky&) = delete;
@@ -100,6 +110,8 @@ public:
     void blocks_changed(const std::vector<std::uint32_t>& blocks) override;
     /// Dofs whose rows the factor is corrected for (0 when the factor fits the system).
     [[nodiscard]] std::size_t correction_dofs() const { return m_correction.dofs(); }
+    /// Dofs of the patch solved beside the factor instead, when the correction cost too much.
+    [[nodiscard]] std::size_t patch_dofs() const { return m_patch.dofs(); }
     [[nodiscard]] const char* name() const override { return "warped Cholesky"; }
 
     /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
@@ -168,6 +180,8 @@ private:
     bool m_correction_dirty = false;
     std::size_t m_covered_blocks = 0; ///< blocks the factor and its correction were built for
     FactorCorrection m_correction;
+    PatchSolve m_patch; ///< when the correction would cost more than it is worth, or is not asked for
+    bool m_exact_cuts = true;
     // The background factorisation into m_next: swapped in once the iterations reported since its
     // launch reach the cost; cuts since its snapshot, for its correction.
     std::future<void> m_running;

@@ -278,6 +278,18 @@ void SupernodalFactor::solve(Eigen::VectorXd& v, const std::function<void(std::s
     for (int i = 0; i < n; ++i) v[m_perm[static_cast<std::size_t>(i)]] = m_b[static_cast<std::size_t>(i)];
 }
 
+double SupernodalFactor::forward_columns_flops(std::span<const int> dofs) const
+{
+    std::vector<unsigned char> on(m_parent.size(), 0);
+    double entries = 0.0;
+    for (const int d : dofs)
+        for (int k = m_column_super[static_cast<std::size_t>(row_of(d))]; k >= 0 && !on[static_cast<std::size_t>(k)]; k = m_parent[static_cast<std::size_t>(k)]) {
+            on[static_cast<std::size_t>(k)] = 1;
+            entries += static_cast<double>(m_pi[k + 1] - m_pi[k]) * (m_super[k + 1] - m_super[k]);
+        }
+    return 2.0 * entries * static_cast<double>(dofs.size());
+}
+
 double SupernodalFactor::forward_columns(std::span<const int> dofs, std::vector<int>& rows, Eigen::MatrixXf& columns) const
 {
     // The supernodes on the dofs' paths to the root, in ascending order (a child before its

@@ -49,6 +49,8 @@ public:
     /// gets the union of those rows (factor order, ascending), `columns` one column per dof over
     /// them. Solved together, from the leaves up. Returns the flops it took.
     double forward_columns(std::span<const int> dofs, std::vector<int>& rows, Eigen::MatrixXf& columns) const;
+    /// What forward_columns() would cost for these dofs, in flops.
+    [[nodiscard]] double forward_columns_flops(std::span<const int> dofs) const;
     /// The factor's row (its order) of a dof of the matrix.
     [[nodiscard]] int row_of(int dof) const { return m_inverse_perm[static_cast<std::size_t>(dof)]; }
     /// Entries of the factor (its supernodes' dense blocks).

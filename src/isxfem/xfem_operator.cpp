@@ -136,16 +136,6 @@ std::vector<std::uint32_t> XfemOperator::model_changed()
     build_pattern();
     m_slots.resize(m_slot_start.back());
     m_force = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * blocks));
-    // A block whose enrichment changed changes its couplings, so the rows of the blocks it couples
-    // to change too: they are reported with it. (A factor corrected for fewer rows than changed,
-    // fem/factor_correction.hpp, is no longer positive definite: CG broke down on the curved
-    // incision of data/scenes/slab_flap_cut_isxfem.json.)
-    const std::size_t seeds = changed.size();
-    for (std::size_t i = 0; i < seeds; ++i)
-        for (const std::uint32_t b : neighbours[changed[i]])
-            if (b < old_blocks) changed.push_back(b);
-    std::sort(changed.begin(), changed.end());
-    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
     return changed;
 }
 
