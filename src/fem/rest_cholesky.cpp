@@ -1,9 +1,8 @@
 #include "fem/rest_cholesky.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -169,11 +168,12 @@ bool RestCholesky::recorrect(const SystemMatrix& a, const std::vector<unsigned c
     m_correction_dirty = false;
     m_covered_blocks = blocks;
     m_patch.clear();
-    // Exact while that costs at most a factorisation (or about a millisecond) and
-    // covers at most an eighth of the system.
+    // Exact while that costs at most a factorisation (or about a millisecond) and covers at most
+    // an eighth of the system.
     double flops = 0.0;
-    const bool built = m_exact_cuts && m_correction.build(m_current->factor, m_current->matrix, a, seeds, m_warp, fixed, static_cast<std::size_t>(a.rows() / 8),
-                                          std::max(m_current->factor.factor_flops(), 1e7), flops);
+    const auto max_dofs = static_cast<std::size_t>(a.rows() / 8);
+    const double max_flops = std::max(m_current->factor.factor_flops(), 1e7);
+    const bool built = m_exact_cuts && m_correction.build(m_current->factor, m_current->matrix, a, seeds, m_warp, fixed, max_dofs, max_flops, flops);
     m_excess += flops / m_iteration_flops; // the rent-or-buy rule counts it as iterations
     if (built) return true;
     // Past that (a cut through many elements at once) a new factor is the better buy; until it
@@ -223,7 +223,7 @@ void RestCholesky::set_warps(const std::vector<Eigen::Quaterniond>& node_rotatio
     m_warp.resize(blocks);
     for (std::size_t n = 0; n < blocks; ++n)
         m_warp[n] = m_frame * (node_rotation[n] * factored[n].conjugate()).toRotationMatrix() * m_frame.transpose();
-    // The jumps the factor holds (newer ones are the identity's, corrected).
+    // The jumps the factor holds (newer ones are left to the correction or the patch).
     m_jump_warp.clear();
     for (const JumpBlock& jump : m_jumps)
         if (jump.block < blocks && jump.node < blocks) m_jump_warp.push_back({jump, jump.sign * (m_warp[jump.block] - m_warp[jump.node])});
