@@ -92,6 +92,7 @@ bool FactorCorrection::build(const SupernodalFactor& factor, const SystemMatrix&
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(s, s);
     const auto turn = [&](std::size_t b) -> Eigen::Matrix3d { return b < warp.size() ? warp[b] : Eigen::Matrix3d::Identity(); };
     std::vector<Eigen::Matrix3d> row_blocks(block_count, Eigen::Matrix3d::Zero());
+    std::vector<unsigned char> listed(block_count, 0);
     std::vector<std::size_t> touched;
     for (std::size_t b = 0; b < block_count; ++b) {
         if (!in_s[b]) continue;
@@ -100,12 +101,16 @@ bool FactorCorrection::build(const SupernodalFactor& factor, const SystemMatrix&
             for (SystemMatrix::InnerIterator it(a, static_cast<Eigen::Index>(3 * b) + i); it; ++it) {
                 const auto c = static_cast<std::size_t>(it.col() / 3);
                 if (!in_s[c]) continue;
-                if (row_blocks[c].isZero(0.0) && std::find(touched.begin(), touched.end(), c) == touched.end()) touched.push_back(c);
+                if (!listed[c]) {
+                    listed[c] = 1;
+                    touched.push_back(c);
+                }
                 row_blocks[c](i, it.col() % 3) += it.value();
             }
         for (const std::size_t c : touched) {
             const Eigen::Matrix3d turned = turn(b).transpose() * row_blocks[c] * turn(c);
             row_blocks[c].setZero();
+            listed[c] = 0;
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j) {
                     const int p = m_place[3 * b + static_cast<std::size_t>(i)], q = m_place[3 * c + static_cast<std::size_t>(j)];

@@ -278,15 +278,22 @@ void SupernodalFactor::solve(Eigen::VectorXd& v, const std::function<void(std::s
     for (int i = 0; i < n; ++i) v[m_perm[static_cast<std::size_t>(i)]] = m_b[static_cast<std::size_t>(i)];
 }
 
+std::vector<unsigned char> SupernodalFactor::on_paths(std::span<const int> dofs) const
+{
+    if (!m_postordered) throw std::logic_error("SupernodalFactor::forward_columns: the supernodal tree is not in postorder");
+    std::vector<unsigned char> on(m_parent.size(), 0);
+    for (const int d : dofs)
+        for (int k = m_column_super[static_cast<std::size_t>(row_of(d))]; k >= 0 && !on[static_cast<std::size_t>(k)]; k = m_parent[static_cast<std::size_t>(k)])
+            on[static_cast<std::size_t>(k)] = 1;
+    return on;
+}
+
 double SupernodalFactor::forward_columns_flops(std::span<const int> dofs) const
 {
-    std::vector<unsigned char> on(m_parent.size(), 0);
+    const std::vector<unsigned char> on = on_paths(dofs);
     double entries = 0.0;
-    for (const int d : dofs)
-        for (int k = m_column_super[static_cast<std::size_t>(row_of(d))]; k >= 0 && !on[static_cast<std::size_t>(k)]; k = m_parent[static_cast<std::size_t>(k)]) {
-            on[static_cast<std::size_t>(k)] = 1;
-            entries += static_cast<double>(m_pi[k + 1] - m_pi[k]) * (m_super[k + 1] - m_super[k]);
-        }
+    for (std::size_t k = 0; k < on.size(); ++k)
+        if (on[k]) entries += static_cast<double>(m_pi[k + 1] - m_pi[k]) * (m_super[k + 1] - m_super[k]);
     return 2.0 * entries * static_cast<double>(dofs.size());
 }
 
@@ -294,12 +301,8 @@ double SupernodalFactor::forward_columns(std::span<const int> dofs, std::vector<
 {
     // The supernodes on the dofs' paths to the root, in ascending order (a child before its
     // parent, CHOLMOD's postorder), and their rows.
-    if (!m_postordered) throw std::logic_error("SupernodalFactor::forward_columns: the supernodal tree is not in postorder");
-    const auto supernodes = m_parent.size();
-    std::vector<unsigned char> on(supernodes, 0);
-    for (const int d : dofs)
-        for (int k = m_column_super[static_cast<std::size_t>(row_of(d))]; k >= 0 && !on[static_cast<std::size_t>(k)]; k = m_parent[static_cast<std::size_t>(k)])
-            on[static_cast<std::size_t>(k)] = 1;
+    const std::vector<unsigned char> on = on_paths(dofs);
+    const auto supernodes = on.size();
     rows.clear();
     std::vector<int> place(m_perm.size(), -1);
     for (std::size_t k = 0; k < supernodes; ++k)

@@ -68,6 +68,8 @@ private:
     void forward(int k, float* b, float* tmp, float* top_delta) const;
     void backward(int k, float* b, float* tmp) const;
     void forward_all(float* b) const;
+    /// Per supernode: on the path from one of `dofs`' supernodes to the root.
+    [[nodiscard]] std::vector<unsigned char> on_paths(std::span<const int> dofs) const;
     void backward_all(float* b) const;
 
     std::unique_ptr<Cholmod> m_cholmod;

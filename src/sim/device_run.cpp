@@ -25,15 +25,38 @@ constexpr double k_snapshot_margin_mm = 5.0;
 
 } // namespace
 
+std::size_t tool_named(const io::Scene& scene, const std::string& name)
+{
+    if (name.empty()) return 0;
+    const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == name; });
+    if (found != scene.tools.end()) return static_cast<std::size_t>(found - scene.tools.begin());
+    std::string names;
+    for (const io::ToolSpec& t : scene.tools) names += (names.empty() ? "" : ", ") + t.name;
+    throw InputError("--tool: the scene has no tool named \"" + name + "\" (it has: " + names + ")");
+}
+
+void check_device_tools(const io::Scene& scene, const std::vector<std::size_t>& tools)
+{
+    if (tools.size() > static_cast<std::size_t>(haptics::k_max_devices))
+        throw InputError("--device: at most " + std::to_string(haptics::k_max_devices) + " devices, " + std::to_string(tools.size()) + " given");
+    for (std::size_t i = 0; i < tools.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (tools[i] == tools[j])
+                throw InputError("--tool: tool \"" + scene.tools[tools[i]].name + "\" is driven by two devices; give each device its own --tool");
+}
+
+std::vector<haptics::KeyFrame> script_key_frames(const io::Scene& scene, std::size_t tool)
+{
+    std::vector<haptics::KeyFrame> frames;
+    for (const io::ScriptEntry& e : scene.script)
+        if (e.tool_index == tool) frames.push_back({e.t_s, e.position_mm, e.orientation});
+    if (frames.empty()) throw scene.error("script", "the device follows the script of tool \"" + scene.tools[tool].name + "\", which has no entry");
+    return frames;
+}
+
 DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options) : m_scene(scene)
 {
     if (scene.tools.empty()) throw scene.error("tools", "a device needs a tool to drive; the scene has none");
-    auto tool_named = [&](const std::string& name) -> std::size_t {
-        if (name.empty()) return 0;
-        const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == name; });
-        if (found == scene.tools.end()) throw InputError("--tool: the scene has no tool named \"" + name + "\"");
-        return static_cast<std::size_t>(found - scene.tools.begin());
-    };
     if (options.replay) {
         m_replayed = haptics::read_recording(*options.replay);
         const int devices = haptics::recorded_devices(m_replayed);
@@ -42,29 +65,20 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const Devi
             if (ticks.empty()) throw file_error(options.replay->string(), "holds no tick of device " + std::to_string(d));
             // Recordings made before several devices name no tool: the one asked for, else the first.
             const std::string& recorded = ticks.front().tool;
-            const std::size_t tool = recorded.empty() ? tool_named(options.tools.empty() ? std::string() : options.tools.front())
-                                                      : tool_named(recorded);
+            const std::size_t tool = recorded.empty() ? tool_named(scene, options.tools.empty() ? std::string() : options.tools.front())
+                                                      : tool_named(scene, recorded);
             add_hand(tool, std::make_unique<haptics::ReplayDevice>(std::move(ticks)), tools);
         }
     } else {
         const std::vector<std::string> names = options.tools.empty() ? std::vector<std::string>{std::string()} : options.tools;
         for (const std::string& name : names) {
-            const std::size_t tool = tool_named(name);
-            std::vector<haptics::KeyFrame> frames;
-            for (const io::ScriptEntry& e : scene.script)
-                if (e.tool_index == tool) frames.push_back({e.t_s, e.position_mm, e.orientation});
-            if (frames.empty())
-                throw scene.error("script", "the device follows the script of tool \"" + scene.tools[tool].name + "\", which has no entry");
-            add_hand(tool, std::make_unique<haptics::VirtualDevice>(std::move(frames)), tools);
+            const std::size_t tool = tool_named(scene, name);
+            add_hand(tool, std::make_unique<haptics::VirtualDevice>(script_key_frames(scene, tool)), tools);
         }
     }
-    if (m_hands.size() > static_cast<std::size_t>(haptics::k_max_devices))
-        throw InputError("--device: at most " + std::to_string(haptics::k_max_devices) + " devices, " + std::to_string(m_hands.size()) +
-                         " given");
-    for (std::size_t i = 0; i < m_hands.size(); ++i)
-        for (std::size_t j = 0; j < i; ++j)
-            if (m_hands[i]->tool == m_hands[j]->tool)
-                throw InputError("--tool: tool \"" + scene.tools[m_hands[i]->tool].name + "\" is driven by two devices; give each device its own --tool");
+    std::vector<std::size_t> driven;
+    for (const std::unique_ptr<Hand>& hand : m_hands) driven.push_back(hand->tool);
+    check_device_tools(scene, driven);
     // One loop serves every device, each through its own coupling and safety stage.
     std::vector<haptics::HapticChannel> channels;
     for (const std::unique_ptr<Hand>& owned : m_hands) {

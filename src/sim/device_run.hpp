@@ -13,6 +13,7 @@
 #include "haptics/coupled_tool.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/recording.hpp"
+#include "haptics/virtual_device.hpp"
 
 #include <filesystem>
 #include <memory>
@@ -92,6 +93,15 @@ private:
     bool m_started = false;
     double m_tick_s = 1e-3;
 };
+
+/// The scene tool named `name` (empty: the first); InputError naming --tool and the scene's tools
+/// when there is none.
+[[nodiscard]] std::size_t tool_named(const io::Scene& scene, const std::string& name);
+/// InputError for more devices than haptics::k_max_devices, or a tool driven by two of them
+/// (`tools`: the tool each device drives).
+void check_device_tools(const io::Scene& scene, const std::vector<std::size_t>& tools);
+/// The key frames of `tool`'s script, for a scripted device; InputError when it has none.
+[[nodiscard]] std::vector<haptics::KeyFrame> script_key_frames(const io::Scene& scene, std::size_t tool);
 
 /// Writes NAME.csv (t_s, x_mm, y_mm, z_mm, fx_n, fy_n, fz_n) and NAME.svg (the force's magnitude
 /// against time) into `dir`.

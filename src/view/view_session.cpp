@@ -6,12 +6,12 @@
 #include "haptics/haptic_loop.hpp"
 #include "haptics/hid_devices.hpp"
 #include "haptics/pointer_device.hpp"
-#include "haptics/recording.hpp"
 #include "haptics/spacemouse_device.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 #include "io/tool_script.hpp"
 #include "sim/dbg_method.hpp"
+#include "sim/device_run.hpp"
 #include "sim/isxfem_method.hpp"
 #include "sim/journal.hpp"
 #include "sim/method_factory.hpp"
@@ -38,28 +38,13 @@ std::vector<std::size_t> driven_tools(const io::Scene& scene, const ViewOptions&
 {
     const std::size_t devices = options.devices.size();
     if (devices == 0) throw InputError("--device: give at least one");
-    if (devices > static_cast<std::size_t>(haptics::k_max_devices))
-        throw InputError("--device: at most " + std::to_string(haptics::k_max_devices) + " devices, " + std::to_string(devices) + " given");
     if (devices > 1 ? options.tools.size() != devices : options.tools.size() > 1)
         throw InputError("--tool: give one per --device, in the same order (" + std::to_string(devices) + " device(s), " +
                          std::to_string(options.tools.size()) + " tool(s))");
     if (std::count(options.devices.begin(), options.devices.end(), "mouse") > 1) throw InputError("--device: the mouse can drive one tool only");
     std::vector<std::size_t> driven;
-    for (std::size_t d = 0; d < devices; ++d) {
-        std::size_t k = 0;
-        if (!options.tools.empty()) {
-            const auto found = std::find_if(scene.tools.begin(), scene.tools.end(), [&](const io::ToolSpec& t) { return t.name == options.tools[d]; });
-            if (found == scene.tools.end()) {
-                std::string names;
-                for (const io::ToolSpec& t : scene.tools) names += (names.empty() ? "" : ", ") + t.name;
-                throw InputError("--tool: the scene has no tool named \"" + options.tools[d] + "\" (it has: " + names + ")");
-            }
-            k = static_cast<std::size_t>(found - scene.tools.begin());
-        }
-        if (std::find(driven.begin(), driven.end(), k) != driven.end())
-            throw InputError("--tool: tool \"" + scene.tools[k].name + "\" is driven by two devices; give each device its own --tool");
-        driven.push_back(k);
-    }
+    for (std::size_t d = 0; d < devices; ++d) driven.push_back(sim::tool_named(scene, options.tools.empty() ? std::string() : options.tools[d]));
+    sim::check_device_tools(scene, driven);
     return driven;
 }
 
@@ -166,12 +151,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         const std::string& kind = options.devices[d];
         const io::ToolPose& at = starts[d];
         if (kind == "script") {
-            std::vector<haptics::KeyFrame> frames;
-            for (const io::ScriptEntry& e : loaded.script)
-                if (e.tool_index == driven[d]) frames.push_back({e.t_s, e.position_mm, e.orientation});
-            if (frames.empty())
-                throw loaded.error("script", "--device script follows the script of tool \"" + scene.tools[driven[d]].name + "\", which has no entry");
-            owned.push_back(std::make_unique<PacedDevice>(std::move(frames), channels.simulation_t_s, scene.solver.dt_s));
+            owned.push_back(std::make_unique<PacedDevice>(sim::script_key_frames(loaded, driven[d]), channels.simulation_t_s, scene.solver.dt_s));
         } else if (kind == "hid" || (kind == "auto" && !controllers.empty())) {
             if (controllers.empty())
                 throw InputError("--device hid: no " + std::string(d ? "further " : "") + "6-DoF controller can be opened. " +
