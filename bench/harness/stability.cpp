@@ -193,7 +193,7 @@ std::vector<StabilityResult> run_stability(bool quick)
     const double beam_length = quick ? 40.0 : 200.0;
     objects.push_back({"beam " + number(beam_length) + " x 10 x 10 mm, level 1",
                        base_scene({{"phantom", {{"shape", "beam"}, {"size_mm", {beam_length, 10, 10}}}}}, 1,
-                                  {{-1e3, -1e3, -1e3}, {-0.5, 1e3, 1e3}}),
+                                  {{-1e3, -1e3, -1e3}, {0, 1e3, 1e3}}),
                        beam_length, {-0.5, 4.5, 4.5}, {beam_length - 2.5, -1e3, -1e3}, {1e3, 1e3, 1e3}});
     if (!quick) {
         nlohmann::json liver_object{{"volume", VOX_DATA_DIR "/liver.inr.gz"}, {"select", {{"label", {255}}}}};

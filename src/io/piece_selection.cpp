@@ -47,21 +47,19 @@ std::vector<bool> pieces_in_boxes(const grid::LabelGrid& labels, const grid::Vox
 {
     std::vector<bool> in(pieces.size(), false);
     if (boxes.empty()) return in;
-    const Eigen::Matrix4d m = labels.index_to_world();
-    // Half the world extent of a voxel along each axis (exact for axis-aligned grids, a bound for
-    // turned ones).
-    const Eigen::Vector3d half = 0.5 * m.topLeftCorner<3, 3>().cwiseAbs().rowwise().sum();
+    // A constraint holds the material whose voxel centres lie in its box (sim/supports.hpp).
     const auto& coords = pieces.voxels();
     const auto& which = pieces.voxel_pieces();
     for (std::size_t v = 0; v < coords.size(); ++v) {
         if (in[which[v]]) continue;
         const Eigen::Vector3d c = labels.index_to_world(coords[v].cast<double>());
-        const Eigen::AlignedBox3d voxel(c - half, c + half);
-        for (const Eigen::AlignedBox3d& b : boxes)
-            if (b.intersects(voxel)) {
+        for (const Eigen::AlignedBox3d& b : boxes) {
+            const double tol = 1e-9 * (1.0 + b.min().cwiseAbs().maxCoeff() + b.max().cwiseAbs().maxCoeff());
+            if ((c.array() >= b.min().array() - tol).all() && (c.array() <= b.max().array() + tol).all()) {
                 in[which[v]] = true;
                 break;
             }
+        }
     }
     return in;
 }

@@ -34,8 +34,8 @@ struct PieceSelection {
     [[nodiscard]] std::string describe() const;
 };
 
-/// Per piece: whether one of its voxels reaches into one of `boxes` (world mm, closed; a voxel
-/// is its full extent, centre +- half a voxel).
+/// Per piece: whether the centre of one of its voxels lies in one of `boxes` (world mm, closed):
+/// the material a constraint with that box holds.
 [[nodiscard]] std::vector<bool> pieces_in_boxes(const grid::LabelGrid& labels, const grid::VoxelPieces& pieces,
                                                 const std::vector<Eigen::AlignedBox3d>& boxes);
 

@@ -190,8 +190,9 @@ enum class ConstraintType {
     slide, ///< the nodes are held along the listed world axes and move freely along the others
 };
 
-/// Boundary condition on the nodes whose rest position lies in an axis-aligned box, boundary
-/// included. A box that catches no node is an error found when the grid exists.
+/// Boundary condition on the material whose voxel centres lie in an axis-aligned box, boundary
+/// included, the same at every level (sim/supports.hpp: each such voxel holds the corner of its
+/// element nearest to it). A box that holds no voxel centre is an error.
 struct Constraint {
     ConstraintType type = ConstraintType::fixed;
     /// Box corner with the smallest coordinates, world mm.
@@ -242,15 +243,16 @@ struct PieceContactSettings {
     double stiffness_n_per_mm = 10.0;
 };
 
-/// An external point force: a total force, world frame, shared equally by the nodes whose rest
-/// position lies in an axis-aligned box, boundary included. A box that catches no node is an
-/// error found when the grid exists.
+/// An external force on the material whose voxel centres lie in an axis-aligned box, boundary
+/// included: a total force, world frame, shared equally by those voxels, each share going to its
+/// element's corners by the trilinear weights at its centre (the same force and moment at every
+/// level). A box that holds no voxel centre is an error found when the grid exists.
 struct Load {
     /// Box corner with the smallest coordinates, world mm.
     Eigen::Vector3d box_min_mm = Eigen::Vector3d::Zero();
     /// Box corner with the largest coordinates, world mm (>= box_min_mm on every axis).
     Eigen::Vector3d box_max_mm = Eigen::Vector3d::Zero();
-    /// Total force on the box's nodes, N, world frame (each of n nodes gets force_n / n).
+    /// Total force on the box's material, N, world frame.
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
 };
 
@@ -405,7 +407,7 @@ struct Scene {
     /// The material of voxels carrying `label`.
     [[nodiscard]] const Material& material(std::int32_t label) const;
     /// An error about this scene found after reading it (e.g. a constraint or load box that
-    /// catches no node): "SOURCE: KEY_PATH: PROBLEM", key_path as "constraints[0].box_mm" or
+    /// holds no voxel centre): "SOURCE: KEY_PATH: PROBLEM", key_path as "constraints[0].box_mm" or
     /// "loads[0].box_mm".
     [[nodiscard]] InputError error(std::string_view key_path, std::string_view problem) const;
 };

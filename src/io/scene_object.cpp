@@ -5,6 +5,8 @@
 #include "grid/phantom.hpp"
 #include "io/object_import.hpp"
 
+#include <Eigen/Geometry>
+
 #include <sstream>
 
 namespace vox::io {
@@ -75,32 +77,26 @@ grid::LabelGrid build_object_voxels(const Scene& scene)
 void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
 {
     if (scene.constraints.empty()) return;
-    // "auto": the run checks again at the level it picks; here the voxel corners (level 0).
-    const int level = scene.object.auto_levels ? 0 : scene.object.levels;
-    const std::vector<grid::Coord> cells = grid::occupied_cells(labels, level);
-    for (std::size_t c = 0; c < scene.constraints.size(); ++c) {
-        const Constraint& con = scene.constraints[c];
-        const double tol = 1e-9 * (1.0 + con.box_max_mm.cwiseAbs().maxCoeff() + con.box_min_mm.cwiseAbs().maxCoeff());
-        bool caught = false;
-        for (const grid::Coord& cell : cells) {
-            for (int corner = 0; corner < 8 && !caught; ++corner) {
-                const Eigen::Vector3d p = grid::cell_corner_world(labels, cell, level, corner);
-                caught = (p.array() >= con.box_min_mm.array() - tol).all() &&
-                         (p.array() <= con.box_max_mm.array() + tol).all();
-            }
-            if (caught) break;
+    // A support holds the material whose voxel centres lie in its box, at every level alike.
+    const std::size_t n = scene.constraints.size();
+    std::vector<unsigned char> holds(n, 0);
+    Eigen::AlignedBox3d span;
+    labels.for_each_active([&](const grid::Coord& ijk, std::int32_t) {
+        const Eigen::Vector3d p = labels.index_to_world(ijk.cast<double>());
+        span.extend(p);
+        for (std::size_t c = 0; c < n; ++c) {
+            const Constraint& con = scene.constraints[c];
+            const double tol = 1e-9 * (1.0 + con.box_max_mm.cwiseAbs().maxCoeff() + con.box_min_mm.cwiseAbs().maxCoeff());
+            holds[c] = holds[c] || ((p.array() >= con.box_min_mm.array() - tol).all() && (p.array() <= con.box_max_mm.array() + tol).all());
         }
-        if (!caught) {
-            const grid::IndexBox box = labels.index_bounds();
-            const grid::Coord lo(box.min.x() >> level, box.min.y() >> level, box.min.z() >> level);
-            const grid::Coord hi(box.max.x() >> level, box.max.y() >> level, box.max.z() >> level);
-            std::ostringstream os;
-            const Eigen::Vector3d a = grid::cell_corner_world(labels, lo, level, 0);
-            const Eigen::Vector3d b = grid::cell_corner_world(labels, hi, level, 7);
-            os << "catches no node at level " << level << " (nodes sit at element corners, from (" << a.x() << ", "
-               << a.y() << ", " << a.z() << ") to (" << b.x() << ", " << b.y() << ", " << b.z() << ") mm)";
-            throw scene.error("constraints[" + std::to_string(c) + "].box_mm", os.str());
-        }
+    });
+    for (std::size_t c = 0; c < n; ++c) {
+        if (holds[c]) continue;
+        std::ostringstream os;
+        os << "holds no voxel centre of the object (a support holds the material whose voxel centres lie in its box; they span ("
+           << span.min().x() << ", " << span.min().y() << ", " << span.min().z() << ") to (" << span.max().x() << ", "
+           << span.max().y() << ", " << span.max().z() << ") mm)";
+        throw scene.error("constraints[" + std::to_string(c) + "].box_mm", os.str());
     }
 }
 

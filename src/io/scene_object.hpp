@@ -16,8 +16,8 @@ namespace vox::io {
 /// The same without the scene's name in front of errors.
 [[nodiscard]] grid::LabelGrid build_scene_object(const Scene& scene);
 
-/// Throws the scene's InputError ("constraints[2].box_mm: catches no node ...") when a constraint
-/// box holds no element corner node at the scene's level.
+/// Throws the scene's InputError ("constraints[2].box_mm: holds no voxel centre ...") when a
+/// constraint box holds no material: no voxel centre of the object lies in it.
 void check_constraints(const Scene& scene, const grid::LabelGrid& labels);
 
 /// Labels that appear in the object but have no material of their own, and material labels the

@@ -29,7 +29,7 @@ class DbgMethod final : public Method {
 public:
     /// Builds the grid of `labels` with levels up to `grid_levels` (at least `level`; coarser ones
     /// serve the multigrid preconditioner) and the simulation at `level`. Throws the scene's
-    /// InputError when a constraint or load box catches no node.
+    /// InputError when a constraint or load box holds no voxel centre.
     DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, int level, int grid_levels);
     /// The same, on a grid already built (levels chosen by "levels": "auto" were measured on it).
     DbgMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, std::unique_ptr<grid::BranchedGrid> grid, int level);

@@ -21,12 +21,6 @@ namespace {
 /// liver: at level 3, 29 k DOFs, the factor's solves make each step 2.4 times slower than Jacobi).
 constexpr std::size_t k_cholesky_dofs = 20000;
 
-bool in_box(const Eigen::Vector3d& p_mm, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
-{
-    const double tol = 1e-9 * (1.0 + lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff());
-    return (p_mm.array() >= lo.array() - tol).all() && (p_mm.array() <= hi.array() + tol).all();
-}
-
 fem::SolverOptions solver_options(const io::SolverSettings& s)
 {
     fem::SolverOptions o;
@@ -96,34 +90,6 @@ void smooth_scene_surface(const io::Scene& scene, const grid::BranchedGrid& grid
 {
     if (!io::smooths_surface(scene.object, scene.solver.type)) return;
     surface.smooth_windowed_sinc(grid, k_smoothing_iterations, k_smoothing_passband);
-}
-
-std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
-                                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
-{
-    std::vector<unsigned char> kept(model.node_count(), 0);
-    const Eigen::Vector3d half = 0.5e3 * grid.voxels().voxel_size_m();
-    for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
-        bool touches = true;
-        if (level >= 1) {
-            const grid::Level& lv = grid.level(level);
-            const grid::Element& ge = lv.elements[model.elements()[e].grid_element];
-            if (lv.cell_elements(ge.code).size() > 1) { // superimposed: only where its material reaches
-                touches = false;
-                for (std::uint32_t v : ge.voxels)
-                    if (in_box(grid.voxels().world_mm(grid.voxels().coord(v).cast<double>()), lo - half, hi + half)) {
-                        touches = true;
-                        break;
-                    }
-            }
-        }
-        if (touches)
-            for (std::uint32_t n : model.elements()[e].dof_node) kept[n] = 1;
-    }
-    std::vector<std::uint32_t> out;
-    for (std::uint32_t n = 0; n < model.node_count(); ++n)
-        if (kept[n] && in_box(model.rest_positions()[n] * 1e3, lo, hi)) out.push_back(n);
-    return out;
 }
 
 DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
@@ -349,9 +315,11 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     const io::Scene& scene = m_scene;
     const grid::BranchedGrid& grid = *m_grid;
     const int level = m_level;
+    std::vector<unsigned char> changed; // per grid element of the level: touched by the cut
     if (previous && level >= 1) {
         // The elements the change touched; all others keep their matrices.
-        m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed_elements(grid, level, *report));
+        changed = changed_elements(grid, level, *report);
+        m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);
     } else {
         m_model = std::make_unique<fem::HexModel>(grid, level);
     }
@@ -359,20 +327,26 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
 
     // Which axes of which nodes are held, before the solver exists: the preconditioner is chosen
     // by the degrees of freedom left free (a rigid skull leaves none).
-    auto box_nodes = [&](const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) { return nodes_in_box(grid, model, level, lo, hi); };
+    // The material each box holds: measured afresh, or after a cut in the elements it changed.
+    const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty();
+    if (!after_cut) {
+        m_boxes.clear();
+        for (const io::Constraint& c : scene.constraints) m_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
+        for (const io::Load& l : scene.loads) m_boxes.emplace_back(l.box_min_mm, l.box_max_mm);
+    }
+    for (BoxMaterial& b : m_boxes) b.update(grid, level, after_cut ? &changed : nullptr);
     std::vector<unsigned> held_axes(model.node_count(), 0u);
     std::vector<unsigned char> constrained(model.node_count(), 0);
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
-        bool caught = false;
-        for (std::uint32_t n : box_nodes(c.box_min_mm, c.box_max_mm)) {
+        const std::vector<std::uint32_t> nodes = m_boxes[k].supported_nodes(model);
+        for (std::uint32_t n : nodes) {
             held_axes[n] |= axes;
             constrained[n] = 1;
-            caught = true;
         }
-        if (!caught && kind != Build::cut)
-            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
+        if (nodes.empty() && kind != Build::cut)
+            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "holds no voxel centre of the object");
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
     const std::vector<std::uint32_t> piece = cut::element_pieces(model);
@@ -457,11 +431,11 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     solver.set_gravity(scene.gravity_m_s2);
     for (std::size_t k = 0; k < scene.loads.size(); ++k) {
         const io::Load& load = scene.loads[k];
-        const std::vector<std::uint32_t> caught = box_nodes(load.box_min_mm, load.box_max_mm);
-        if (caught.empty() && kind == Build::cut) continue; // the cut took the loaded material
-        if (caught.empty())
-            throw scene.error("loads[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
-        for (std::uint32_t n : caught) solver.external_forces()[n] += load.force_n / static_cast<double>(caught.size());
+        const BoxMaterial& box = m_boxes[scene.constraints.size() + k];
+        const bool empty = box.voxel_count(model) == 0;
+        if (empty && kind == Build::cut) continue; // the cut took the loaded material
+        if (empty) throw scene.error("loads[" + std::to_string(k) + "].box_mm", "holds no voxel centre of the object");
+        for (const auto& [n, share] : box.load_shares(model)) solver.external_forces()[n] += share * load.force_n;
     }
     find_pieces(piece);
 }

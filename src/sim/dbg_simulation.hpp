@@ -10,6 +10,7 @@
 #include "fem/rigid_body.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
+#include "sim/supports.hpp"
 
 #include <memory>
 #include <span>
@@ -26,13 +27,6 @@ namespace vox::sim {
 /// needs the grid's coarser levels; without it a grid up to `level` is enough (and cuts update
 /// fewer levels).
 [[nodiscard]] bool wants_multigrid(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
-
-/// The nodes of `model` (at `level` of `grid`) inside the box [lo, hi] (world mm) that a scene's
-/// constraint or load box holds. Superimposed elements share their cell's corner positions: a box
-/// catches a node of one only when that element's own material reaches into the box, so holding
-/// one arm of a U-tube does not hold the other arm's element in the same cell.
-[[nodiscard]] std::vector<std::uint32_t> nodes_in_box(const grid::BranchedGrid& grid, const fem::HexModel& model, int level,
-                                                      const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
 /// The smoothing of "smooth_surface" (on by default): a windowed-sinc filter of this degree and
 /// pass band (surface/embedded_surface.hpp), strong enough to take out the terraces of 1.5 mm
@@ -60,7 +54,7 @@ struct CutTimings {
 
 class DbgSimulation {
 public:
-    /// Throws the scene's InputError when a constraint or load box catches no node at `level`.
+    /// Throws the scene's InputError when a constraint or load box holds no voxel centre.
     /// Keeps a reference to `grid`.
     DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
     /// The simulation `from` at another level of the same grid, with `preconditioner` (the scene's
@@ -68,7 +62,7 @@ public:
     /// plastic strain (cut/state_transfer.hpp), the surface with its cuts and smoothing
     /// (re-embedded), and the pieces "unheld_pieces": "hold" holds. `from` gives its surface up and
     /// is left only to be destroyed. Throws the scene's InputError when a constraint or load box
-    /// catches no node at `level`, or the multigrid has no coarser level there; `from` is then
+    /// holds no voxel centre, or the multigrid has no coarser level there; `from` is then
     /// unchanged.
     DbgSimulation(DbgSimulation& from, int level, io::PreconditionerChoice preconditioner);
 
@@ -101,7 +95,7 @@ public:
 
 private:
     /// What a build starts from: the scene (the wet regions are applied and the pieces to hold
-    /// found), another level's simulation, or the same level before a cut. Boxes that catch no node
+    /// found), another level's simulation, or the same level before a cut. Boxes that hold no material
     /// are errors except after a cut (it may have taken their material).
     enum class Build { first, level_change, cut };
     /// Model, solver, preconditioner, materials, constraints and loads at m_level. After a cut,
@@ -120,6 +114,7 @@ private:
     std::vector<unsigned char> m_rigid_material; ///< per grid material (sim/rigid_parts.hpp)
     std::vector<unsigned char> m_held_voxels; ///< per fine voxel slot: held by "unheld_pieces": "hold"
     std::size_t m_held_pieces = 0;
+    std::vector<BoxMaterial> m_boxes; ///< what each constraint box, then each load box, holds at m_level
     int m_level;
     std::unique_ptr<fem::HexModel> m_model;
     std::unique_ptr<fem::ImplicitSolver> m_solver;

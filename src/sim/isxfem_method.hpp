@@ -26,7 +26,7 @@ void check_isxfem_scene(const io::Scene& scene);
 class IsxfemMethod final : public Method {
 public:
     /// Throws the scene's InputError for what Is-XFEM cannot simulate, or when a constraint box
-    /// catches no node.
+    /// holds no voxel centre.
     IsxfemMethod(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels, int level);
     ~IsxfemMethod() override;
 

@@ -8,6 +8,7 @@
 #include "cut/piece_contact.hpp"
 #include "cut/pieces.hpp"
 #include "sim/rigid_parts.hpp"
+#include "sim/supports.hpp"
 #include "fem/hex_model.hpp"
 #include "fem/rest_cholesky.hpp"
 
@@ -51,9 +52,10 @@ IsxfemSimulation::IsxfemSimulation(const io::Scene& scene, const grid::BranchedG
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
         const io::Constraint& c = scene.constraints[k];
         const unsigned axes = (c.held_axes[0] ? 1u : 0u) | (c.held_axes[1] ? 2u : 0u) | (c.held_axes[2] ? 4u : 0u);
-        const std::vector<std::uint32_t> nodes = nodes_in_box(grid, hex, level, c.box_min_mm, c.box_max_mm);
-        if (nodes.empty())
-            throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "catches no node at level " + std::to_string(level));
+        BoxMaterial box(c.box_min_mm, c.box_max_mm);
+        box.update(grid, level, nullptr);
+        const std::vector<std::uint32_t> nodes = box.supported_nodes(hex);
+        if (nodes.empty()) throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "holds no voxel centre of the object");
         for (std::uint32_t n : nodes) m_fixed.emplace_back(n, axes);
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.

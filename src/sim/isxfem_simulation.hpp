@@ -24,7 +24,7 @@ namespace vox::sim {
 
 class IsxfemSimulation {
 public:
-    /// Throws the scene's InputError when a constraint or load box catches no node.
+    /// Throws the scene's InputError when a constraint or load box holds no voxel centre.
     IsxfemSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level);
     ~IsxfemSimulation();
     /// The pieces no constraint reached, held in place ("unheld_pieces": "hold").

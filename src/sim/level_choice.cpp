@@ -125,7 +125,7 @@ LevelChoice by_budget(const io::Scene& scene, const grid::BranchedGrid& grid, st
                                                                        : std::string("frames at rest (no tool touches the object)"));
                     method = std::make_unique<DbgMethod>(dynamic, labels, std::make_unique<grid::BranchedGrid>(grid.copy()), level);
                 }
-            } catch (const InputError& e) { // a scene whose boxes catch nothing at a coarse level can still run at a finer one
+            } catch (const InputError& e) { // a scene a coarse level cannot run (a wet region holding no element's centre there) may run at a finer one
                 log::info("levels auto: level {} skipped: {}", level, e.what());
                 out.unusable.push_back(level);
                 break;

@@ -37,7 +37,7 @@ struct LevelChoice {
     io::PreconditionerChoice preconditioner = io::PreconditionerChoice::automatic;
     std::string reason;
     std::vector<LevelTrial> trials;
-    std::vector<int> unusable; ///< levels the scene cannot be simulated at (a box catching no node there)
+    std::vector<int> unusable; ///< levels the scene cannot be simulated at (a wet region holding no element's centre there)
 };
 
 /// `grid` must hold levels up to 6 (or its object's coarsest). Throws the scene's InputError when

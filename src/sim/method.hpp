@@ -169,7 +169,7 @@ public:
     /// plastic strain, cuts and surface (a run whose frames miss their budget moves coarser:
     /// sim/level_governor.hpp). `preconditioner` as the scene's key says. False where the method
     /// cannot (Is-XFEM: its cracks live in one level's tetrahedra) or has no such level. Throws
-    /// InputError when the object cannot be simulated there (a constraint box catching no node),
+    /// InputError when the object cannot be simulated there (a wet region holding no element's centre there),
     /// changing nothing.
     virtual bool move_to_level(int /*level*/, io::PreconditionerChoice /*preconditioner*/) { return false; }
     /// The coarsest level move_to_level() reaches.

@@ -19,7 +19,7 @@ struct OpenedMethod {
     std::optional<LevelChoice> choice; ///< how "levels": "auto" chose
 };
 
-/// Throws the scene's InputError for what the method cannot simulate, or a box that catches no node.
+/// Throws the scene's InputError for what the method cannot simulate, or a box that holds no voxel centre.
 [[nodiscard]] OpenedMethod open_method(const io::Scene& scene, std::shared_ptr<const grid::LabelGrid> labels);
 
 } // namespace vox::sim

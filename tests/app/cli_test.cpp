@@ -113,7 +113,7 @@ TEST(Cli, RunWritesStatsAndDeformedSurfaces)
     {
         std::ofstream scene(d / "block.json");
         scene << R"({"object": {"phantom": {"shape": "block", "size_mm": [8, 4, 4]}, "levels": 1},
-                    "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 4, 4]]}],
+                    "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [0, 4, 4]]}],
                     "output": {"dir": "results", "mesh_every_n_frames": 2}})";
     }
     const auto r = run_voxsculpt("run " + quote((d / "block.json").string()) + " --frames 5");
@@ -151,7 +151,7 @@ TEST(Cli, RunAtLevelZeroAndWithAutomaticLevels)
 {
     const fs::path d = fresh_dir("cli_run_levels");
     const std::string object = R"("phantom": {"shape": "block", "size_mm": [8, 4, 4]})";
-    const std::string rest = R"(, "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 9, 9]]}]})";
+    const std::string rest = R"(, "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [0, 9, 9]]}]})";
     const nlohmann::json zero = run_scene(d, "zero", "{\"object\": {" + object + R"(, "levels": 0})" + rest, "--frames 3");
     EXPECT_EQ(zero["level"], 0);
     EXPECT_EQ(zero["elements"], 128); // every voxel an element
@@ -179,7 +179,7 @@ TEST(Cli, AWetObjectSagsByItsSofteningLaw)
     const std::string scene = R"({"object": {"phantom": {"shape": "block", "size_mm": [16, 4, 4]}, "levels": 1},
         "materials": {"default": {"youngs_modulus_pa": 1e7, "wetting": {"stiffness_ratio": 0.2}}},
         "solver": {"mode": "static", "cg_tolerance": 1e-9},
-        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [-0.5, 9, 9]]}])";
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [0, 9, 9]]}])";
     const nlohmann::json dry = run_scene(d, "dry", scene + "}", "--frames 1");
     const nlohmann::json wet =
         run_scene(d, "wet", scene + R"(, "wet_regions": [{"box_mm": [[-1, -1, -1], [16, 4, 4]]}]})", "--frames 1");

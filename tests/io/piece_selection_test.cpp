@@ -128,9 +128,9 @@ TEST(PieceSelection, KeepsLargestCountSizeSeedsAndHeld)
     seeded.seeds_mm = {{40.4, 0.5, -0.5}};
     EXPECT_EQ(kept_voxels(seeded), 28u);
 
-    PieceSelection held; // a box reaching 0.5 mm into the 2^3 cube's outer voxel face (x = 19)
+    PieceSelection held; // a box reaching the centres of the 2^3 cube's outer voxels (x = 20)
     held.components = PieceSelection::Components::held;
-    held.held_boxes = {Eigen::AlignedBox3d(Eigen::Vector3d(15, 0, 0), Eigen::Vector3d(19.5, 1, 1))};
+    held.held_boxes = {Eigen::AlignedBox3d(Eigen::Vector3d(15, 0, 0), Eigen::Vector3d(20, 1, 1))};
     EXPECT_EQ(kept_voxels(held), 8u);
     held.held_boxes = {Eigen::AlignedBox3d(Eigen::Vector3d(12, 0, 0), Eigen::Vector3d(18.5, 1, 1))}; // in the gap
     EXPECT_THROW((void)kept_voxels(held), vox::InputError);

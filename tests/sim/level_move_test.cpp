@@ -176,7 +176,7 @@ TEST(LevelMove, TheGovernorMovesCoarserAfterASecondOverBudgetAndBackOnlyWithRoom
     for (int f = 1; f <= 200 && !c; ++f) c = g.after_frame(2, 50.0);
     ASSERT_TRUE(c);
     EXPECT_EQ(c->to, 4);
-    // Levels the choice found unusable (a box catching no node there) are never tried.
+    // Levels the choice found unusable (a wet region holding no element's centre there) are never tried.
     s.unusable = {3, 4};
     LevelGovernor held(s);
     for (int f = 1; f <= 200; ++f) EXPECT_FALSE(held.after_frame(2, 50.0)) << "nothing usable is coarser";
