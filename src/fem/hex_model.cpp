@@ -57,6 +57,28 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level, const HexModel& pr
     add_mass_floor(grid);
 }
 
+HexModel::HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed)
+    : m_level(mixed.fine()), m_materials(grid.materials()), m_ties(mixed.ties())
+{
+    const Eigen::Matrix4d& t = grid.voxels().index_to_world();
+    const Eigen::Vector3d h = grid.voxels().voxel_size_m();
+    m_frame = t.topLeftCorner<3, 3>() * (h * 1e3).cwiseInverse().asDiagonal();
+    for (const Eigen::Vector3d& p : mixed.rest_positions_mm()) m_rest_world.push_back(p * 1e-3);
+    m_nodal_mass.assign(m_rest_world.size(), 0.0);
+    for (std::uint32_t n = 0; n < m_rest_world.size(); ++n) m_node_level.push_back(mixed.node_level(n));
+    // Each level's full cells share their matrices (reserved first: elements point into them).
+    const std::size_t materials = grid.materials().size();
+    m_full_stiffness.reserve(2 * materials);
+    for (int level : {mixed.fine(), mixed.coarse()})
+        for (const grid::ElasticMaterial& m : grid.materials())
+            m_full_stiffness.push_back(to_component_major(static_cast<double>(1 << level) * grid::hex8_stiffness(h, m.lame)));
+    m_partial_stiffness.reserve(mixed.elements().size());
+    m_elements.reserve(mixed.elements().size());
+    for (const grid::MixedLevels::Element& el : mixed.elements())
+        add_grid_element(grid, el.level, el.element, el.nodes, m_full_stiffness.data() + (el.level == mixed.fine() ? 0 : materials), nullptr, nullptr);
+    add_mass_floor(grid);
+}
+
 void HexModel::build_voxel_level(const grid::BranchedGrid& grid)
 {
     // Every voxel is an element; corners are shared through connected faces (the closure of face
@@ -155,6 +177,7 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     for (std::size_t i = 0; i < m_grid_node.size(); ++i) m_rest_world[i] = grid_rest[m_grid_node[i]] * 1e-3;
     m_nodal_mass.assign(m_grid_node.size(), 0.0);
 
+    m_full_stiffness.reserve(grid.materials().size());
     for (const grid::ElasticMaterial& m : grid.materials())
         m_full_stiffness.push_back(to_component_major(cell * grid::hex8_stiffness(h, m.lame)));
     m_partial_stiffness.reserve(alive);
@@ -162,71 +185,85 @@ void HexModel::build_grid_level(const grid::BranchedGrid& grid, int level, const
     for (std::uint32_t e = 0; e < lv.elements.size(); ++e) {
         const grid::Element& g = lv.elements[e];
         if (!g.alive) continue;
-        HexElement el;
-        el.grid_element = e;
-        for (int c = 0; c < 8; ++c) el.dof_node[c] = m_dense_node[g.nodes[c]];
-        const HexElement* old = previous && kept[e] != grid::no_index ? &previous->elements()[kept[e]] : nullptr;
-        if (grid.is_full(level, e)) {
-            el.stiffness = &m_full_stiffness[static_cast<std::size_t>(g.content[0].material)];
-            m_partial_stiffness.emplace_back();
-        } else if (old) {
-            m_partial_stiffness.push_back(previous->m_partial_stiffness[kept[e]]); // fictitious material included
-            el.stiffness = m_partial_stiffness.back().get();
-        } else {
-            auto k = std::make_shared<Matrix24d>(to_component_major(grid.stiffness(level, e)));
-            // The element's nodes get their material's stiffness times a small fraction from the
-            // empty part of the cell (the finite cell method's fictitious material), matching the
-            // mass floor: a corner far from the element's few voxels otherwise has almost no
-            // stiffness and almost no mass, its own fast, undamped mode, and flies off under the
-            // corotational forces (seen on the liver at level 3: 35 m/s^2 on a one-voxel element).
-            const auto dominant = static_cast<std::size_t>(std::max_element(g.content.begin(), g.content.end(),
-                [](const grid::MaterialMoments& a, const grid::MaterialMoments& b) { return a.voxels < b.voxels; })->material);
-            *k += k_fictitious_fraction * m_full_stiffness[dominant];
-            el.stiffness = k.get();
-            m_partial_stiffness.push_back(std::move(k));
-        }
-        el.mass = old ? old->mass : grid.mass(level, e);
-        for (int c = 0; c < 8; ++c) {
-            el.rest.segment<3>(3 * c) = grid::BranchedGrid::cell_corner_index(g.cell, level, c).cwiseProduct(h);
-            m_nodal_mass[el.dof_node[c]] += el.mass.row(c).sum();
-        }
-        // Centroid of the element's material (first moments over zeroth, summed over materials),
-        // in the cell's local coordinates t in [0, 1]^3.
-        double q0 = 0.0;
-        std::uint32_t voxels = 0, most = 0;
-        Eigen::Vector3d q1 = Eigen::Vector3d::Zero();
-        for (const grid::MaterialMoments& m : g.content) {
-            q0 += static_cast<double>(m.moments[0]);
-            voxels += m.voxels;
-            q1 += Eigen::Vector3d(static_cast<double>(m.moments[1]), static_cast<double>(m.moments[3]),
-                                  static_cast<double>(m.moments[9]));
-            if (m.voxels > most) {
-                most = m.voxels;
-                el.material = m.material;
-            }
-        }
-        const Eigen::Vector3d local = q1 / q0 / cell;
-        el.gradient = corner_gradients(local, cell * h);
-        el.volume_m3 = voxels * h.prod();
-        const Eigen::Vector3d centre = grid::BranchedGrid::cell_corner_index(g.cell, level, 0) + cell * local;
-        el.centroid = grid.voxels().world_mm(centre) * 1e-3;
-        m_elements.push_back(el);
+        std::array<std::uint32_t, 8> nodes{};
+        for (int c = 0; c < 8; ++c) nodes[static_cast<std::size_t>(c)] = m_dense_node[g.nodes[static_cast<std::size_t>(c)]];
+        const bool keep = previous && kept[e] != grid::no_index;
+        add_grid_element(grid, level, e, nodes, m_full_stiffness.data(), keep ? &previous->elements()[kept[e]] : nullptr,
+                         keep ? previous->m_partial_stiffness[kept[e]] : nullptr);
     }
+}
+
+void HexModel::add_grid_element(const grid::BranchedGrid& grid, int level, std::uint32_t e, const std::array<std::uint32_t, 8>& nodes,
+                                const Matrix24d* full, const HexElement* old, std::shared_ptr<const Matrix24d> old_stiffness)
+{
+    const grid::Element& g = grid.level(level).elements[e];
+    const Eigen::Vector3d h = grid.voxels().voxel_size_m(); // voxel edges, m
+    const double cell = static_cast<double>(1 << level);
+    HexElement el;
+    el.grid_element = e;
+    el.dof_node = nodes;
+    if (grid.is_full(level, e)) {
+        el.stiffness = &full[static_cast<std::size_t>(g.content[0].material)];
+        m_partial_stiffness.emplace_back();
+    } else if (old) {
+        m_partial_stiffness.push_back(std::move(old_stiffness)); // fictitious material included
+        el.stiffness = m_partial_stiffness.back().get();
+    } else {
+        auto k = std::make_shared<Matrix24d>(to_component_major(grid.stiffness(level, e)));
+        // The element's nodes get their material's stiffness times a small fraction from the
+        // empty part of the cell (the finite cell method's fictitious material), matching the
+        // mass floor: a corner far from the element's few voxels otherwise has almost no
+        // stiffness and almost no mass, its own fast, undamped mode, and flies off under the
+        // corotational forces (seen on the liver at level 3: 35 m/s^2 on a one-voxel element).
+        const auto dominant = static_cast<std::size_t>(std::max_element(g.content.begin(), g.content.end(),
+            [](const grid::MaterialMoments& a, const grid::MaterialMoments& b) { return a.voxels < b.voxels; })->material);
+        *k += k_fictitious_fraction * full[dominant];
+        el.stiffness = k.get();
+        m_partial_stiffness.push_back(std::move(k));
+    }
+    el.mass = old ? old->mass : grid.mass(level, e);
+    for (int c = 0; c < 8; ++c) {
+        el.rest.segment<3>(3 * c) = grid::BranchedGrid::cell_corner_index(g.cell, level, c).cwiseProduct(h);
+        m_nodal_mass[el.dof_node[c]] += el.mass.row(c).sum();
+    }
+    // Centroid of the element's material (first moments over zeroth, summed over materials),
+    // in the cell's local coordinates t in [0, 1]^3.
+    double q0 = 0.0;
+    std::uint32_t voxels = 0, most = 0;
+    Eigen::Vector3d q1 = Eigen::Vector3d::Zero();
+    for (const grid::MaterialMoments& m : g.content) {
+        q0 += static_cast<double>(m.moments[0]);
+        voxels += m.voxels;
+        q1 += Eigen::Vector3d(static_cast<double>(m.moments[1]), static_cast<double>(m.moments[3]),
+                              static_cast<double>(m.moments[9]));
+        if (m.voxels > most) {
+            most = m.voxels;
+            el.material = m.material;
+        }
+    }
+    const Eigen::Vector3d local = q1 / q0 / cell;
+    el.gradient = corner_gradients(local, cell * h);
+    el.volume_m3 = voxels * h.prod();
+    const Eigen::Vector3d centre = grid::BranchedGrid::cell_corner_index(g.cell, level, 0) + cell * local;
+    el.centroid = grid.voxels().world_mm(centre) * 1e-3;
+    m_elements.push_back(el);
 }
 
 void HexModel::add_mass_floor(const grid::BranchedGrid& grid)
 {
     const Eigen::Vector3d h = grid.voxels().voxel_size_m();
-    const double cell = static_cast<double>(1 << m_level);
     double density = 0.0;
     for (const grid::ElasticMaterial& m : grid.materials()) density = std::max(density, m.density_kg_m3);
-    const double floor = k_fictitious_fraction * density * (cell * cell * cell) * h.prod() / 8.0;
     m_added_mass.assign(m_nodal_mass.size(), 0.0);
-    for (std::size_t n = 0; n < m_nodal_mass.size(); ++n)
+    for (std::size_t n = 0; n < m_nodal_mass.size(); ++n) {
+        // A full cell's corner mass at the node's own level.
+        const double cell = static_cast<double>(1 << (m_node_level.empty() ? m_level : m_node_level[n]));
+        const double floor = k_fictitious_fraction * density * (cell * cell * cell) * h.prod() / 8.0;
         if (m_nodal_mass[n] < floor) {
             m_added_mass[n] = floor - m_nodal_mass[n];
             m_nodal_mass[n] = floor;
         }
+    }
 }
 
 double HexModel::total_mass() const { return std::accumulate(m_nodal_mass.begin(), m_nodal_mass.end(), 0.0); }

@@ -6,6 +6,7 @@
 
 #include "core/eigen_types.hpp"
 #include "grid/branched_grid.hpp"
+#include "grid/mixed_levels.hpp"
 
 #include <Eigen/Core>
 
@@ -39,8 +40,17 @@ public:
     /// from their moments again, the bulk of a rebuild after a cut. The nodes of `previous` still
     /// in use keep their order and come first.
     HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed);
+    /// The model of two levels joined (grid/mixed_levels.hpp): its elements of both levels, its
+    /// nodes numbered as `mixed` numbers them, and its border nodes tied to the coarse side.
+    /// level() is the fine level; grid_node() and dense_node() are empty.
+    HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed);
 
     [[nodiscard]] int level() const { return m_level; }
+    /// Border nodes of a model of two levels, each following the coarse element beside it; empty
+    /// for one level.
+    [[nodiscard]] const std::vector<grid::MixedLevels::Tie>& ties() const { return m_ties; }
+    /// Level of each node of a model of two levels; empty for one level.
+    [[nodiscard]] const std::vector<int>& node_levels() const { return m_node_level; }
     [[nodiscard]] std::size_t node_count() const { return m_rest_world.size(); }
     [[nodiscard]] const std::vector<HexElement>& elements() const { return m_elements; }
     /// Rest positions of the nodes, world frame, m.
@@ -69,6 +79,11 @@ private:
     void build_voxel_level(const grid::BranchedGrid& grid);
     void build_grid_level(const grid::BranchedGrid& grid, int level, const HexModel* previous,
                           const std::vector<unsigned char>* changed);
+    /// Appends element e of grid level `level` on dense corner nodes `nodes`: its stiffness (the
+    /// level's shared one from `full`, per material, when it fills its cell; else `old_stiffness`
+    /// when an unchanged `old` element gives it; else evaluated), mass, rest corners and centroid.
+    void add_grid_element(const grid::BranchedGrid& grid, int level, std::uint32_t e, const std::array<std::uint32_t, 8>& nodes,
+                          const Matrix24d* full, const HexElement* old, std::shared_ptr<const Matrix24d> old_stiffness);
     void add_mass_floor(const grid::BranchedGrid& grid);
 
     int m_level = 1;
@@ -84,6 +99,8 @@ private:
     std::vector<double> m_added_mass;
     Eigen::Matrix3d m_frame = Eigen::Matrix3d::Identity();
     std::vector<grid::ElasticMaterial> m_materials;
+    std::vector<grid::MixedLevels::Tie> m_ties;
+    std::vector<int> m_node_level;
 };
 
 } // namespace vox::fem

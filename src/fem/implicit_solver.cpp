@@ -544,6 +544,7 @@ Eigen::VectorXd ImplicitSolver::external_force() const
 
 void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 {
+    condense(rhs); // a tied node's load acts on the coarse nodes it follows
     // Held degrees of freedom: identity rows and columns, zero right-hand side.
     if (m_matrix_current)
         for (Eigen::Index row = 0; row < m_matrix.outerSize(); ++row)
@@ -558,6 +559,41 @@ void ImplicitSolver::apply_constraints(Eigen::VectorXd& rhs)
 }
 
 void ImplicitSolver::multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    if (m_model.ties().empty()) return multiply_full(p, out);
+    // On the free space of a model of two levels, T^T A T p: the tied nodes take the values of the
+    // coarse nodes they follow, and hand their products back to them. CG keeps tied entries zero,
+    // and they map to themselves as held ones do.
+    m_tied_p = p;
+    expand(m_tied_p);
+    multiply_full(m_tied_p, out);
+    condense(out);
+    for (const grid::MixedLevels::Tie& t : m_model.ties()) out.segment<3>(3 * static_cast<Eigen::Index>(t.node)) = p.segment<3>(3 * static_cast<Eigen::Index>(t.node));
+    for (Eigen::Index i = 0; i < out.size(); ++i)
+        if (m_fixed[static_cast<std::size_t>(i)]) out[i] = p[i];
+}
+
+void ImplicitSolver::expand(Eigen::VectorXd& v) const
+{
+    for (const grid::MixedLevels::Tie& t : m_model.ties()) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (std::size_t c = 0; c < 8; ++c)
+            if (t.weights[c] != 0.0) sum += t.weights[c] * v.segment<3>(3 * static_cast<Eigen::Index>(t.masters[c]));
+        v.segment<3>(3 * static_cast<Eigen::Index>(t.node)) = sum;
+    }
+}
+
+void ImplicitSolver::condense(Eigen::VectorXd& v) const
+{
+    for (const grid::MixedLevels::Tie& t : m_model.ties()) {
+        const Eigen::Vector3d own = v.segment<3>(3 * static_cast<Eigen::Index>(t.node));
+        for (std::size_t c = 0; c < 8; ++c)
+            if (t.weights[c] != 0.0) v.segment<3>(3 * static_cast<Eigen::Index>(t.masters[c])) += t.weights[c] * own;
+        v.segment<3>(3 * static_cast<Eigen::Index>(t.node)).setZero();
+    }
+}
+
+void ImplicitSolver::multiply_full(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
     if (!m_matrix_current) multiply_element_wise(p, out);
     else multiply_matrix(p, out);
@@ -629,9 +665,18 @@ void ImplicitSolver::update_node_rotations()
 int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system)
 {
     const Eigen::Index n = rhs.size();
+    // A tied node's diagonal counts on the nodes it follows (weights squared); its own is 1.
+    Eigen::VectorXd diagonal = m_diagonal;
+    for (const grid::MixedLevels::Tie& t : m_model.ties())
+        for (std::size_t c = 0; c < 8; ++c) {
+            const auto i = 3 * static_cast<Eigen::Index>(t.node), m = 3 * static_cast<Eigen::Index>(t.masters[c]);
+            diagonal.segment<3>(m) += t.weights[c] * t.weights[c] * m_diagonal.segment<3>(i);
+            if (c == 7) diagonal.segment<3>(i).setOnes();
+        }
+    for (const grid::MixedLevels::Tie& t : m_model.ties()) x.segment<3>(3 * static_cast<Eigen::Index>(t.node)).setZero();
     Eigen::VectorXd inv_d(n), inv_sqrt_d(n);
     for (Eigen::Index i = 0; i < n; ++i) {
-        const double d = m_diagonal[i];
+        const double d = diagonal[i];
         inv_d[i] = d > 0.0 ? 1.0 / d : 1.0;
         inv_sqrt_d[i] = std::sqrt(inv_d[i]);
     }
@@ -654,10 +699,13 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
             m_preconditioner->apply(res, out);
         else
             out = res.cwiseProduct(inv_d);
+        // On the free space: a principal part of an SPD preconditioner is SPD.
+        for (const grid::MixedLevels::Tie& t : m_model.ties()) out.segment<3>(3 * static_cast<Eigen::Index>(t.node)).setZero();
     };
     const CgResult cg = conjugate_gradient([this](const Eigen::VectorXd& p, Eigen::VectorXd& out) { multiply(p, out); }, precondition, rhs,
                                            inv_sqrt_d, m_options.cg_tolerance, m_options.cg_max_iterations, x);
     residual = cg.residual;
+    expand(x);
     if (m_preconditioner && !same_system) m_preconditioner->report_iterations(cg.iterations);
     return cg.iterations;
 }

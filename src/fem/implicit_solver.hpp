@@ -233,7 +233,14 @@ private:
     void pairs_into_matrix(double sign, const std::vector<std::size_t>* which = nullptr);
     Eigen::VectorXd external_force() const;
     void apply_constraints(Eigen::VectorXd& rhs);
+    /// The system's product on the free space (ties applied: T^T A T p).
     void multiply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    /// The whole system's product, every node its own.
+    void multiply_full(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    /// Tied nodes take the values of the coarse nodes they follow (T v on the free entries).
+    void expand(Eigen::VectorXd& v) const;
+    /// Tied nodes' entries handed to the nodes they follow (T^T v), theirs set to zero.
+    void condense(Eigen::VectorXd& v) const;
     void multiply_matrix(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void multiply_element_wise(const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
     void update_node_rotations();
@@ -287,6 +294,7 @@ private:
     /// its nodes, the runs of one group in parallel.
     std::vector<std::vector<std::uint32_t>> m_run_groups;
     mutable Eigen::VectorXd m_stiffness_product; ///< sum over elements of R K R^T p, per dof (matrix-free product)
+    mutable Eigen::VectorXd m_tied_p;            ///< the product's input with tied nodes filled in
     bool m_matrix_current = false;                    ///< m_matrix holds the system being solved
     Eigen::VectorXd m_diagonal;                       ///< of the system matrix (held dofs: 1)
     double m_m_scale = 0.0, m_k_scale = 0.0;          ///< system matrix = m_scale M + k_scale K
