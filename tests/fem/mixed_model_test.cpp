@@ -7,6 +7,7 @@
 
 #include "fem/hex_model.hpp"
 #include "fem/implicit_solver.hpp"
+#include "fem/rest_cholesky.hpp"
 #include "grid/mixed_levels.hpp"
 
 #include "block_grid.hpp"
@@ -14,6 +15,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
+#include <memory>
 #include <numeric>
 
 namespace vox::fem {
@@ -21,15 +24,16 @@ namespace {
 
 /// A 32 x 32 x 16 mm block on a table (bottom held), a 5 x 5 mm square of its top bonded to an
 /// indenter pushed 0.5 mm down: the elastic energy at static equilibrium, J.
-double press_energy(const HexModel& model, int* iterations = nullptr)
+double press_energy(const HexModel& model, int* iterations = nullptr, bool factor = false)
 {
     SolverOptions o;
     o.quasi_static = true;
     o.cg_tolerance = 1e-9;
     o.cg_max_iterations = 5000;
     o.newton_max_iterations = 20;
-    o.matrix_free = true;
+    o.matrix_free = !factor;
     ImplicitSolver solver(model, o);
+    if (factor) solver.set_preconditioner(std::make_unique<RestCholesky>(model.frame(), 25, std::numeric_limits<double>::infinity()));
     solver.set_gravity(Eigen::Vector3d::Zero());
     const double depth = 0.5e-3;
     for (std::uint32_t n = 0; n < model.node_count(); ++n) {
@@ -75,6 +79,10 @@ TEST(MixedModel, PressingFineAroundTheIndenterAndCoarseElsewhereGivesTheFineBloc
                 e_fine, e_coarse, e_both, 100.0 * (e_both / e_fine - 1.0), 100.0 * (e_coarse / e_fine - 1.0), iterations_fine,
                 iterations_both, fine.node_count(), both.node_count());
     EXPECT_NEAR(e_both / e_fine, 1.0, 0.05);
+    // The warped Cholesky factor of the whole matrix, restricted to the free nodes, preconditions
+    // the same solve on the free space to the same answer (though no faster than Jacobi: 193
+    // against 182 iterations; the factor to take is that of T^T A T).
+    EXPECT_NEAR(press_energy(both, nullptr, true) / e_both, 1.0, 1e-6);
     EXPECT_GT(std::abs(e_coarse / e_fine - 1.0), 0.1) << "the coarse block should be visibly off: the test would show nothing";
 }
 
