@@ -13,7 +13,34 @@ ModelSurface::ModelSurface(const grid::BranchedGrid& grid, const fem::HexModel& 
     const int level = model.level();
     // Model element of each voxel slot (level 0) or grid element (coarser levels).
     m_model_element.assign(level == 0 ? grid.voxels().slots() : grid.level(level).elements.size(), grid::no_index);
-    for (std::uint32_t e = 0; e < model.elements().size(); ++e) m_model_element[model.elements()[e].grid_element] = e;
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+        if (model.elements()[e].level == level) m_model_element[model.elements()[e].grid_element] = e;
+    if (!model.mixed()) return;
+    // A model of two levels: the surface lies in the fine level's elements; one outside the region
+    // maps to the coarse element holding it, its coordinates scaled into the coarse cell.
+    const int coarse = model.coarse_level();
+    const double ratio = static_cast<double>(1 << (coarse - level));
+    std::vector<std::uint32_t> coarse_model(grid.level(coarse).elements.size(), grid::no_index);
+    for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+        if (model.elements()[e].level == coarse) coarse_model[model.elements()[e].grid_element] = e;
+    m_offset.assign(m_model_element.size(), Eigen::Vector3d::Zero());
+    m_scale.assign(m_model_element.size(), 1.0);
+    m_fine_elements.assign(model.elements().size(), {});
+    const grid::Level& fine = grid.level(level);
+    for (std::uint32_t f = 0; f < fine.elements.size(); ++f) {
+        if (!fine.elements[f].alive) continue;
+        if (m_model_element[f] != grid::no_index) {
+            m_fine_elements[m_model_element[f]].push_back(f);
+            continue;
+        }
+        const std::uint32_t a = grid::ancestor(grid, level, f, coarse);
+        const std::uint32_t e = coarse_model[a];
+        if (e == grid::no_index) continue;
+        m_model_element[f] = e;
+        m_offset[f] = (fine.elements[f].cell.cast<double>() - grid.level(coarse).elements[a].cell.cast<double>() * ratio) / ratio;
+        m_scale[f] = 1.0 / ratio;
+        m_fine_elements[e].push_back(f);
+    }
 }
 
 std::uint32_t ModelSurface::vertex_element(std::uint32_t v) const
@@ -26,6 +53,7 @@ std::uint32_t ModelSurface::vertex_element(std::uint32_t v) const
 Eigen::Vector3d ModelSurface::vertex_local(std::uint32_t v) const
 {
     const surface::SurfaceVertex& vertex = m_surface.vertices()[v];
+    if (m_model.mixed()) return m_offset[vertex.element] + m_scale[vertex.element] * vertex.local;
     if (m_model.level() > 0) return vertex.local;
     return vertex.rest - grid::BranchedGrid::cell_corner_index(m_grid.voxels().coord(vertex.voxel), 0, 0);
 }
@@ -57,6 +85,7 @@ std::uint32_t ModelSurface::voxel_element(std::uint32_t v, Eigen::Vector3d& loca
     const std::uint32_t ge = m_grid.element_of(v, level);
     local = (centre - grid::BranchedGrid::cell_corner_index(m_grid.level(level).elements[ge].cell, level, 0)) /
             static_cast<double>(1 << level);
+    if (m_model.mixed()) local = m_offset[ge] + m_scale[ge] * local;
     return m_model_element[ge];
 }
 

@@ -16,7 +16,8 @@ namespace vox::cut {
 
 class ModelSurface {
 public:
-    /// `surface` must be embedded at max(model.level(), 1) in `grid`. Keeps references to all three.
+    /// `surface` must be embedded at max(model.level(), 1) in `grid` (a model of two levels: at its
+    /// fine level). Keeps references to all three.
     ModelSurface(const grid::BranchedGrid& grid, const fem::HexModel& model, const surface::EmbeddedSurface& surface);
 
     [[nodiscard]] const grid::BranchedGrid& grid() const { return m_grid; }
@@ -42,7 +43,10 @@ public:
     template <class F> void for_each_element_vertex(std::uint32_t e, F&& f) const
     {
         const std::uint32_t ge = m_model.elements()[e].grid_element;
-        if (m_model.level() == 0) m_surface.for_each_voxel_vertex(ge, f); // the element is one voxel
+        if (m_model.mixed())
+            for (std::uint32_t fine : m_fine_elements[e])
+                for (std::uint32_t v : m_surface.element_vertices(fine)) f(v);
+        else if (m_model.level() == 0) m_surface.for_each_voxel_vertex(ge, f); // the element is one voxel
         else
             for (std::uint32_t v : m_surface.element_vertices(ge)) f(v);
     }
@@ -51,6 +55,11 @@ public:
     [[nodiscard]] bool element_has_vertex(std::uint32_t e) const
     {
         const std::uint32_t ge = m_model.elements()[e].grid_element;
+        if (m_model.mixed()) {
+            for (std::uint32_t fine : m_fine_elements[e])
+                if (!m_surface.element_vertices(fine).empty()) return true;
+            return false;
+        }
         if (m_model.level() != 0) return !m_surface.element_vertices(ge).empty();
         bool any = false;
         m_surface.for_each_voxel_vertex(ge, [&](std::uint32_t) { any = true; });
@@ -79,6 +88,12 @@ private:
     /// surface's own (its vertices' elements and coordinates, its lists by element and vertex),
     /// so a model rebuilt after a cut maps the surface without going over it.
     std::vector<std::uint32_t> m_model_element;
+    /// A model of two levels (the surface embedded at the fine one): per fine grid element, where
+    /// its cell lies in its model element's (coordinates there = offset + scale * its own), and
+    /// per model element, the fine grid elements it holds.
+    std::vector<Eigen::Vector3d> m_offset;
+    std::vector<double> m_scale;
+    std::vector<std::vector<std::uint32_t>> m_fine_elements;
 };
 
 } // namespace vox::cut

@@ -11,6 +11,10 @@ std::vector<std::uint32_t> element_pieces(const fem::HexModel& model)
     UnionFind nodes(model.node_count()); // the corners of every element joined
     for (const fem::HexElement& el : model.elements())
         for (int c = 1; c < 8; ++c) nodes.unite(el.dof_node[c], el.dof_node[0]);
+    // Two levels: a border node moves with the coarse nodes it is tied to.
+    for (const grid::MixedLevels::Tie& t : model.ties())
+        for (std::size_t c = 0; c < 8; ++c)
+            if (t.weights[c] != 0.0) nodes.unite(t.node, t.masters[c]);
     std::vector<std::uint32_t> number(model.node_count(), ~0u), out;
     std::uint32_t next = 0;
     for (const fem::HexElement& el : model.elements()) {

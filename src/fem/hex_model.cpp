@@ -32,7 +32,7 @@ Eigen::Matrix<double, 8, 3> corner_gradients(const Eigen::Vector3d& t, const Eig
 
 } // namespace
 
-HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level), m_materials(grid.materials())
+HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level), m_coarse_level(level), m_materials(grid.materials())
 {
     if (level < 0 || level > grid.max_level())
         throw InputError("the simulated level must be 0 .. " + std::to_string(grid.max_level()) + ", got " +
@@ -47,7 +47,7 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level) : m_level(level), 
 }
 
 HexModel::HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed)
-    : m_level(level), m_materials(grid.materials())
+    : m_level(level), m_coarse_level(level), m_materials(grid.materials())
 {
     if (level < 1 || level > grid.max_level() || previous.level() != level)
         throw InputError("a model rebuilt from a previous one needs the same level, 1 .. " + std::to_string(grid.max_level()));
@@ -58,7 +58,7 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level, const HexModel& pr
 }
 
 HexModel::HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed)
-    : m_level(mixed.fine()), m_materials(grid.materials()), m_ties(mixed.ties())
+    : m_level(mixed.fine()), m_coarse_level(mixed.coarse()), m_materials(grid.materials()), m_ties(mixed.ties())
 {
     const Eigen::Matrix4d& t = grid.voxels().index_to_world();
     const Eigen::Vector3d h = grid.voxels().voxel_size_m();
@@ -201,6 +201,7 @@ void HexModel::add_grid_element(const grid::BranchedGrid& grid, int level, std::
     const double cell = static_cast<double>(1 << level);
     HexElement el;
     el.grid_element = e;
+    el.level = level;
     el.dof_node = nodes;
     if (grid.is_full(level, e)) {
         el.stiffness = &full[static_cast<std::size_t>(g.content[0].material)];

@@ -25,6 +25,7 @@ struct HexElement {
     Eigen::Matrix<double, 8, 3> gradient;      ///< dN_c/dX at the material centroid, 1/m, index-aligned frame
     Vector24d rest;                            ///< corner rest positions, m, index-aligned frame
     std::uint32_t grid_element = 0;            ///< the branched-grid element it models (level 0: voxel slot)
+    int level = 0;                             ///< the grid level of grid_element (a model of two levels has both)
     std::int32_t material = 0;                 ///< the material holding most of its volume
     double volume_m3 = 0.0;                    ///< of its material
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero(); ///< of its material at rest, world frame, m
@@ -46,6 +47,9 @@ public:
     HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed);
 
     [[nodiscard]] int level() const { return m_level; }
+    /// The coarse level of a model of two levels; level() for one level.
+    [[nodiscard]] int coarse_level() const { return m_coarse_level; }
+    [[nodiscard]] bool mixed() const { return m_coarse_level != m_level; }
     /// Border nodes of a model of two levels, each following the coarse element beside it; empty
     /// for one level.
     [[nodiscard]] const std::vector<grid::MixedLevels::Tie>& ties() const { return m_ties; }
@@ -87,6 +91,7 @@ private:
     void add_mass_floor(const grid::BranchedGrid& grid);
 
     int m_level = 1;
+    int m_coarse_level = 1;
     std::vector<HexElement> m_elements;
     /// Per element: the stiffness a partial element owns (null for a full one), shared with the
     /// models rebuilt after later cuts while the element stays unchanged (copying them took

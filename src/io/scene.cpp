@@ -359,8 +359,17 @@ SceneObject read_object(JsonReader r)
     }
     if (const std::optional<JsonNode> levels = r.optional_node("levels")) {
         if (levels->value().is_string()) {
-            if (as<std::string>(*levels) != "auto") levels->fail("expected an integer 0 to 6 or \"auto\"");
+            if (as<std::string>(*levels) != "auto") levels->fail("expected an integer 0 to 6, \"auto\" or {\"fine\", \"coarse\", \"fine_radius_mm\"}");
             o.auto_levels = true;
+        } else if (levels->value().is_object()) {
+            JsonReader l(*levels);
+            MixedLevelsSpec m;
+            m.fine = l.required<int>("fine", closed_range(1, 5));
+            m.coarse = l.required<int>("coarse", closed_range(2, 6));
+            m.fine_radius_mm = l.required<double>("fine_radius_mm", positive);
+            if (m.fine >= m.coarse) l.required_node("coarse").fail("must be coarser than \"fine\" (" + std::to_string(m.fine) + "), got " + std::to_string(m.coarse));
+            o.levels = m.coarse; // the grid is built up to it
+            o.mixed_levels = m;
         } else {
             o.levels = as<int>(*levels, closed_range(0, 6));
         }
@@ -721,6 +730,19 @@ InputError Scene::error(std::string_view key_path, std::string_view problem) con
     return located_error(source, std::string(key_path), problem);
 }
 
+/// What two levels in one model ("levels" as an object) do not run with yet.
+static void check_mixed_levels(const Scene& scene)
+{
+    if (scene.object.auto_levels) throw scene.error("object.levels", "is either \"auto\" or two levels, not both");
+    if (scene.solver.type != SolverType::dbg)
+        throw scene.error("object.levels", "two levels run on the branched grid only (\"solver\": {\"type\": \"dbg\"})");
+    if (scene.solver.preconditioner == PreconditionerChoice::cholesky || scene.solver.preconditioner == PreconditionerChoice::multigrid)
+        throw scene.error("solver.preconditioner", "two levels solve with Jacobi (\"auto\" or \"jacobi\")");
+    for (std::size_t i = 0; i < scene.tools.size(); ++i)
+        if (scene.tools[i].action == ToolAction::cut || scene.tools[i].action == ToolAction::drill)
+            throw scene.error("tools[" + std::to_string(i) + "].action", "cutting and drilling on two levels are not built yet; push, or simulate one level");
+}
+
 Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& folder,
                   const std::string& name_for_messages)
 {
@@ -798,6 +820,7 @@ Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& f
             scene.script.push_back(std::move(entry));
         }
     }
+    if (scene.object.mixed_levels) check_mixed_levels(scene);
     scene.output.dir = (context.folder / "out").lexically_normal();
     if (output) {
         scene.output = read_output(JsonReader(*output), scene.output);

@@ -42,6 +42,13 @@ enum class UnheldPieces {
 };
 
 /// The object to simulate: its source, and the coarsening level it is simulated at.
+/// Two levels in one model (key "levels" as an object).
+struct MixedLevelsSpec {
+    int fine = 1;                ///< 1 .. 5
+    int coarse = 3;              ///< fine + 1 .. 6
+    double fine_radius_mm = 20.0; ///< > 0
+};
+
 struct SceneObject {
     ObjectKind kind = ObjectKind::phantom;
     /// volume, mesh: the file, absolute (resolved against the scene's folder); it existed when
@@ -70,6 +77,10 @@ struct SceneObject {
     /// whose measured step fits) or max_error (the coarsest level whose deflection differs from
     /// the next finer level's by at most this fraction); exactly one of the two is given.
     bool auto_levels = false;
+    /// "levels": {"fine": F, "coarse": C, "fine_radius_mm": R}: the branched grid simulates level F
+    /// within R mm of each tool's outer shape where the run starts and level C elsewhere
+    /// (grid/mixed_levels.hpp); `levels` is then C. Unset: one level.
+    std::optional<MixedLevelsSpec> mixed_levels;
     /// Key "unheld_pieces"; unset: hold, or fall when the scene has obstacles (they catch it).
     UnheldPieces unheld = UnheldPieces::hold;
     bool unheld_given = false; ///< the file set "unheld_pieces"

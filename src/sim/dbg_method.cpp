@@ -468,7 +468,7 @@ std::unique_ptr<Method> DbgMethod::at_level(int level) const
 bool DbgMethod::move_to_level(int level, io::PreconditionerChoice preconditioner)
 {
     if (level == m_level && preconditioner == m_scene.solver.preconditioner) return true;
-    if (level < 1 || m_level < 1 || level > m_grid->max_level()) return false;
+    if (level < 1 || m_level < 1 || level > m_grid->max_level() || m_scene.object.mixed_levels) return false; // two levels: not yet
     auto moved = std::make_unique<DbgSimulation>(*m_sim, level, preconditioner); // throws with m_sim untouched
     m_sim = std::move(moved);
     m_level = level;

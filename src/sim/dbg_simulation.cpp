@@ -93,10 +93,12 @@ void smooth_scene_surface(const io::Scene& scene, const grid::BranchedGrid& grid
 }
 
 DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& grid, int level)
-    : m_scene(scene), m_grid(&grid), m_rigid_material(rigid_materials(scene)), m_level(level)
+    : m_scene(scene), m_grid(&grid), m_rigid_material(rigid_materials(scene)),
+      m_level(scene.object.mixed_levels ? scene.object.mixed_levels->fine : level)
 {
+    if (scene.object.mixed_levels) m_mixed = mixed_region(scene, grid);
     build(Build::first);
-    m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(level, 1));
+    m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(m_level, 1)); // two levels: the fine one
     smooth_scene_surface(scene, grid, *m_surface);
     m_model_surface = std::make_unique<cut::ModelSurface>(grid, *m_model, *m_surface);
 }
@@ -316,7 +318,9 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     const grid::BranchedGrid& grid = *m_grid;
     const int level = m_level;
     std::vector<unsigned char> changed; // per grid element of the level: touched by the cut
-    if (previous && level >= 1) {
+    if (m_mixed) {
+        m_model = std::make_unique<fem::HexModel>(grid, *m_mixed);
+    } else if (previous && level >= 1) {
         // The elements the change touched; all others keep their matrices.
         changed = changed_elements(grid, level, *report);
         m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);
@@ -328,13 +332,16 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     // Which axes of which nodes are held, before the solver exists: the preconditioner is chosen
     // by the degrees of freedom left free (a rigid skull leaves none).
     // The material each box holds: measured afresh, or after a cut in the elements it changed.
-    const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty();
+    const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty() && !m_mixed;
     if (!after_cut) {
         m_boxes.clear();
         for (const io::Constraint& c : scene.constraints) m_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
         for (const io::Load& l : scene.loads) m_boxes.emplace_back(l.box_min_mm, l.box_max_mm);
     }
-    for (BoxMaterial& b : m_boxes) b.update(grid, level, after_cut ? &changed : nullptr);
+    for (BoxMaterial& b : m_boxes) {
+        b.update(grid, level, after_cut ? &changed : nullptr);
+        if (m_mixed) b.update(grid, m_mixed->coarse(), nullptr);
+    }
     std::vector<unsigned> held_axes(model.node_count(), 0u);
     std::vector<unsigned char> constrained(model.node_count(), 0);
     for (std::size_t k = 0; k < scene.constraints.size(); ++k) {
@@ -372,7 +379,9 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
         free_dofs += 3 - static_cast<std::size_t>(std::popcount(held_axes[n]));
     }
 
-    const io::PreconditionerChoice choice = m_choice = free_dofs == 0 ? io::PreconditionerChoice::jacobi
+    // Two levels: Jacobi on the free space (a factor of the whole matrix restricted to it does no
+    // better, docs/branched-grid.md).
+    const io::PreconditionerChoice choice = m_choice = free_dofs == 0 || m_mixed ? io::PreconditionerChoice::jacobi
                                                            : resolve(scene.solver.preconditioner, free_dofs, level < grid.max_level());
     if (choice == io::PreconditionerChoice::multigrid && level >= grid.max_level())
         throw scene.error("solver.preconditioner", "multigrid needs a level coarser than the simulated one");
@@ -446,8 +455,8 @@ void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned ch
     const grid::BranchedGrid& grid = *m_grid;
     // The fine voxels of model element e (level 0: the element is one voxel).
     const auto first_voxel = [&](std::uint32_t e) {
-        const std::uint32_t ge = model.elements()[e].grid_element;
-        return m_level == 0 ? ge : grid.level(m_level).elements[ge].voxels.front();
+        const fem::HexElement& el = model.elements()[e];
+        return el.level == 0 ? el.grid_element : grid.level(el.level).elements[el.grid_element].voxels.front();
     };
     if (first) {
         // The pieces as the run starts; their voxels stay held through later cuts and rebuilds,
@@ -456,11 +465,11 @@ void DbgSimulation::hold_unheld_pieces(bool first, const std::vector<unsigned ch
         m_held_voxels.assign(grid.voxels().slots(), 0);
         for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
             if (!unheld[e]) continue;
-            const std::uint32_t ge = model.elements()[e].grid_element;
-            if (m_level == 0) {
-                m_held_voxels[ge] = 1;
+            const fem::HexElement& el = model.elements()[e];
+            if (el.level == 0) {
+                m_held_voxels[el.grid_element] = 1;
             } else {
-                for (std::uint32_t v : grid.level(m_level).elements[ge].voxels) m_held_voxels[v] = 1;
+                for (std::uint32_t v : grid.level(el.level).elements[el.grid_element].voxels) m_held_voxels[v] = 1;
             }
         }
     }

@@ -10,6 +10,7 @@
 #include "fem/rigid_body.hpp"
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
+#include "sim/mixed_region.hpp"
 #include "sim/supports.hpp"
 
 #include <memory>
@@ -115,6 +116,8 @@ private:
     std::vector<unsigned char> m_held_voxels; ///< per fine voxel slot: held by "unheld_pieces": "hold"
     std::size_t m_held_pieces = 0;
     std::vector<BoxMaterial> m_boxes; ///< what each constraint box, then each load box, holds at m_level
+    /// "levels" as an object: the two-level selection (m_level is its fine level); null for one level.
+    std::unique_ptr<grid::MixedLevels> m_mixed;
     int m_level;
     std::unique_ptr<fem::HexModel> m_model;
     std::unique_ptr<fem::ImplicitSolver> m_solver;

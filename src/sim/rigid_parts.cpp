@@ -20,10 +20,10 @@ std::vector<RigidContent> rigid_content(const grid::BranchedGrid& grid, const fe
     if (std::find(rigid_material.begin(), rigid_material.end(), 1) == rigid_material.end()) return out;
     const grid::FineVoxels& voxels = grid.voxels();
     const auto rigid_voxel = [&](std::uint32_t v) { return rigid_material[static_cast<std::size_t>(voxels.material(v))] != 0; };
-    const int level = model.level();
-    const double half = 0.5 * static_cast<double>(1 << level); // voxels
     for (std::uint32_t e = 0; e < model.elements().size(); ++e) {
         const std::uint32_t ge = model.elements()[e].grid_element;
+        const int level = model.elements()[e].level; // a model of two levels has both
+        const double half = 0.5 * static_cast<double>(1 << level); // voxels
         RigidContent& r = out[e];
         if (level == 0) { // the element is the voxel
             r.corners = rigid_voxel(ge) ? 0xFF : 0;

@@ -51,32 +51,39 @@ void BoxMaterial::update(const grid::BranchedGrid& grid, int level, const std::v
 {
     const std::size_t count = level == 0 ? grid.voxels().slots() : grid.level(level).elements.size();
     if (level == 0) changed = nullptr; // level-0 models are built afresh after every change
-    m_by_element.resize(count);
+    std::vector<Held>& by_element = m_by_level.at(static_cast<std::size_t>(level));
+    by_element.resize(count);
     for (std::uint32_t e = 0; e < count; ++e) {
         if (changed && !(e < changed->size() && (*changed)[e])) continue;
         const bool alive = level == 0 || grid.level(level).elements[e].alive;
-        m_by_element[e] = alive ? measure(grid, level, e) : Held{};
+        by_element[e] = alive ? measure(grid, level, e) : Held{};
     }
 }
 
 std::size_t BoxMaterial::voxel_count(const fem::HexModel& model) const
 {
     std::size_t n = 0;
-    for (const fem::HexElement& el : model.elements()) n += m_by_element[el.grid_element].voxels;
+    for (const fem::HexElement& el : model.elements()) n += held(el).voxels;
     return n;
 }
 
 std::vector<std::uint32_t> BoxMaterial::supported_nodes(const fem::HexModel& model) const
 {
-    std::vector<unsigned char> held(model.node_count(), 0);
+    std::vector<unsigned char> holds(model.node_count(), 0);
     for (const fem::HexElement& el : model.elements()) {
-        const std::uint8_t corners = m_by_element[el.grid_element].corners;
+        const std::uint8_t corners = held(el).corners;
         for (std::size_t c = 0; c < 8; ++c)
-            if (corners & (1u << c)) held[el.dof_node[c]] = 1;
+            if (corners & (1u << c)) holds[el.dof_node[c]] = 1;
+    }
+    for (const grid::MixedLevels::Tie& t : model.ties()) {
+        if (!holds[t.node]) continue;
+        holds[t.node] = 0;
+        for (std::size_t c = 0; c < 8; ++c)
+            if (t.weights[c] != 0.0) holds[t.masters[c]] = 1;
     }
     std::vector<std::uint32_t> out;
-    for (std::uint32_t n = 0; n < held.size(); ++n)
-        if (held[n]) out.push_back(n);
+    for (std::uint32_t n = 0; n < holds.size(); ++n)
+        if (holds[n]) out.push_back(n);
     return out;
 }
 
@@ -85,7 +92,7 @@ std::vector<std::pair<std::uint32_t, double>> BoxMaterial::load_shares(const fem
     const std::size_t voxels = voxel_count(model);
     std::vector<double> share(model.node_count(), 0.0);
     for (const fem::HexElement& el : model.elements()) {
-        const Held& h = m_by_element[el.grid_element];
+        const Held& h = held(el);
         if (h.voxels == 0) continue;
         for (std::size_t c = 0; c < 8; ++c) share[el.dof_node[c]] += h.weight[c] / static_cast<double>(voxels);
     }

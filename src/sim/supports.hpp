@@ -33,12 +33,15 @@ public:
     BoxMaterial(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) : m_lo(lo), m_hi(hi) {}
 
     /// Measures the alive elements of `level` flagged in `changed` (per grid element id of the
-    /// level, as HexModel takes it), or all of them when `changed` is null.
+    /// level, as HexModel takes it), or all of them when `changed` is null. A model of two levels
+    /// needs both measured.
     void update(const grid::BranchedGrid& grid, int level, const std::vector<unsigned char>* changed);
 
     /// Voxels of alive elements in the box, as last measured.
     [[nodiscard]] std::size_t voxel_count(const fem::HexModel& model) const;
     /// The nodes the box holds as a support (each once, ascending); empty when it holds no material.
+    /// A border node of a model of two levels moves with the coarse nodes it is tied to: those are
+    /// held in its place.
     [[nodiscard]] std::vector<std::uint32_t> supported_nodes(const fem::HexModel& model) const;
     /// Each node's share of a load on the box's material (shares sum to 1; each node once, ascending).
     [[nodiscard]] std::vector<std::pair<std::uint32_t, double>> load_shares(const fem::HexModel& model) const;
@@ -52,9 +55,14 @@ private:
         std::array<double, 8> weight{};
     };
     [[nodiscard]] Held measure(const grid::BranchedGrid& grid, int level, std::uint32_t element) const;
+    [[nodiscard]] const Held& held(const fem::HexElement& el) const
+    {
+        return m_by_level[static_cast<std::size_t>(el.level)][el.grid_element];
+    }
 
     Eigen::Vector3d m_lo, m_hi;
-    std::vector<Held> m_by_element; ///< per grid element id of the level (level 0: voxel slot)
+    /// Per level, per grid element id (level 0: voxel slot).
+    std::array<std::vector<Held>, 7> m_by_level;
 };
 
 /// Whether p lies in [lo, hi] (world mm), boundary included up to rounding.

@@ -902,7 +902,7 @@ const BadScene bad_scenes[] = {
     BadScene{"gravity_type", "gravity_m_s2", "expected an array of 3 numbers, got \"down\""},
     BadScene{"mesh_every_zero", "output.mesh_every_n_frames", "must be >= 1, got 0"},
     BadScene{"output_dir_empty", "output.dir", "expected a path, got an empty string"},
-    BadScene{"levels_word", "object.levels", "expected an integer 0 to 6 or \"auto\""},
+    BadScene{"levels_word", "object.levels", "expected an integer 0 to 6, \"auto\" or {\"fine\", \"coarse\", \"fine_radius_mm\"}"},
     BadScene{"auto_without_target", "object.levels", "needs exactly one of step_budget_ms and max_error"},
     BadScene{"budget_without_auto", "object.step_budget_ms", "only meaningful with \"levels\": \"auto\""},
     BadScene{"plastic_yield", "materials.default.plasticity.yield_strain", "must be > 0, got -0.1"},

@@ -66,7 +66,7 @@ TEST(Supports, ABoxHoldsTheSameMaterialAtEveryLevelAndEachLevelHoldsItWithinHalf
             box.update(grid, level, nullptr);
             const std::vector<Found> voxels = voxels_in_box(grid, model, level, lo, hi);
             EXPECT_EQ(box.voxel_count(model), voxels.size()) << "level " << level;
-            EXPECT_EQ(voxels.size(), std::size_t{(hi.x() > 5 ? 1 : 5) * 8 * 8}) << "level " << level;
+            EXPECT_EQ(voxels.size(), static_cast<std::size_t>((hi.x() > 5 ? 1 : 5) * 8 * 8)) << "level " << level;
 
             const std::vector<std::uint32_t> held = box.supported_nodes(model);
             ASSERT_FALSE(held.empty()) << "level " << level;
