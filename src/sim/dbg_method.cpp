@@ -61,9 +61,24 @@ std::string DbgMethod::linear_solver() const
     return m_sim->solver().fallback_note().empty() ? m_sim->linear_solver() : m_sim->solver().fallback_note();
 }
 
+std::map<int, std::size_t> DbgMethod::elements_per_level() const
+{
+    std::map<int, std::size_t> out;
+    for (const fem::HexElement& el : m_sim->model().elements()) ++out[el.level];
+    return out;
+}
+
 std::string DbgMethod::description() const
 {
     char text[256];
+    const fem::HexModel& model = m_sim->model();
+    if (model.mixed()) {
+        std::size_t fine = 0;
+        for (const fem::HexElement& el : model.elements()) fine += el.level == model.level() ? 1 : 0;
+        std::snprintf(text, sizeof text, "branched grid, level %d within %g mm of the tools (%zu elements) and %d elsewhere (%zu), %zu degrees of freedom",
+                      model.level(), m_scene.object.mixed_levels->fine_radius_mm, fine, model.coarse_level(), element_count() - fine, dof_count());
+        return text;
+    }
     std::snprintf(text, sizeof text, "branched grid%s, level %d, %zu elements, %zu degrees of freedom",
                   m_scene.solver.type == io::SolverType::shape_matching ? " moved by shape matching" : "", m_level, element_count(), dof_count());
     return text;

@@ -39,6 +39,7 @@ public:
     [[nodiscard]] const char* name() const override { return io::solver_type_name(m_scene.solver.type).data(); }
     [[nodiscard]] int level() const override { return m_level; }
     [[nodiscard]] std::size_t element_count() const override { return m_sim->model().elements().size(); }
+    [[nodiscard]] std::map<int, std::size_t> elements_per_level() const override;
     [[nodiscard]] std::size_t dof_count() const override { return m_sim->solver().dof_count(); }
     [[nodiscard]] std::string linear_solver() const override;
     [[nodiscard]] std::string description() const override;

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -94,6 +95,8 @@ public:
     /// Elements (hexahedra, tetrahedra) and degrees of freedom now.
     [[nodiscard]] virtual std::size_t element_count() const = 0;
     [[nodiscard]] virtual std::size_t dof_count() const = 0;
+    /// Elements by grid level: one entry, unless the model holds two levels ("levels" as an object).
+    [[nodiscard]] virtual std::map<int, std::size_t> elements_per_level() const { return {{level(), element_count()}}; }
     /// "CG, warped Cholesky preconditioner", ...; after a fallback, what took over and why.
     [[nodiscard]] virtual std::string linear_solver() const = 0;
     /// A line for the log: the model, its size and solver.

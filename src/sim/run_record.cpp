@@ -32,12 +32,21 @@ nlohmann::json tool_frames_json(const std::vector<ToolFrame>& tools)
     return out;
 }
 
+/// {"LEVEL": elements, ...}: one entry, two for a model of two levels.
+static nlohmann::json per_level(const Method& method)
+{
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [level, count] : method.elements_per_level()) out[std::to_string(level)] = count;
+    return out;
+}
+
 RunRecord::RunRecord(const std::string& scene_path, const Method& method, double dt_s)
 {
     m_document = {{"scene", scene_path},
                   {"method", method.name()},
                   {"level", method.level()},
                   {"elements", method.element_count()},
+                  {"elements_per_level", per_level(method)},
                   {"dofs", method.dof_count()},
                   {"dt_s", dt_s},
                   {"linear_solver", method.linear_solver()},
