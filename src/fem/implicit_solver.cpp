@@ -665,15 +665,20 @@ void ImplicitSolver::update_node_rotations()
 int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system)
 {
     const Eigen::Index n = rhs.size();
-    // A tied node's diagonal counts on the nodes it follows (weights squared); its own is 1.
-    Eigen::VectorXd diagonal = m_diagonal;
-    for (const grid::MixedLevels::Tie& t : m_model.ties())
-        for (std::size_t c = 0; c < 8; ++c) {
-            const auto i = 3 * static_cast<Eigen::Index>(t.node), m = 3 * static_cast<Eigen::Index>(t.masters[c]);
-            diagonal.segment<3>(m) += t.weights[c] * t.weights[c] * m_diagonal.segment<3>(i);
-            if (c == 7) diagonal.segment<3>(i).setOnes();
+    // Two levels: a tied node's diagonal counts on the nodes it follows (weights squared), its own
+    // is 1, and CG starts it at zero (it keeps it there).
+    Eigen::VectorXd tied_diagonal;
+    if (!m_model.ties().empty()) {
+        tied_diagonal = m_diagonal;
+        for (const grid::MixedLevels::Tie& t : m_model.ties()) {
+            const auto i = 3 * static_cast<Eigen::Index>(t.node);
+            for (std::size_t c = 0; c < 8; ++c)
+                tied_diagonal.segment<3>(3 * static_cast<Eigen::Index>(t.masters[c])) += t.weights[c] * t.weights[c] * m_diagonal.segment<3>(i);
+            tied_diagonal.segment<3>(i).setOnes();
+            x.segment<3>(i).setZero();
         }
-    for (const grid::MixedLevels::Tie& t : m_model.ties()) x.segment<3>(3 * static_cast<Eigen::Index>(t.node)).setZero();
+    }
+    const Eigen::VectorXd& diagonal = m_model.ties().empty() ? m_diagonal : tied_diagonal;
     Eigen::VectorXd inv_d(n), inv_sqrt_d(n);
     for (Eigen::Index i = 0; i < n; ++i) {
         const double d = diagonal[i];
