@@ -1,5 +1,7 @@
 #include "io/piece_selection.hpp"
 
+#include "io/box.hpp"
+
 #include "core/error.hpp"
 
 #include <algorithm>
@@ -53,13 +55,11 @@ std::vector<bool> pieces_in_boxes(const grid::LabelGrid& labels, const grid::Vox
     for (std::size_t v = 0; v < coords.size(); ++v) {
         if (in[which[v]]) continue;
         const Eigen::Vector3d c = labels.index_to_world(coords[v].cast<double>());
-        for (const Eigen::AlignedBox3d& b : boxes) {
-            const double tol = 1e-9 * (1.0 + b.min().cwiseAbs().maxCoeff() + b.max().cwiseAbs().maxCoeff());
-            if ((c.array() >= b.min().array() - tol).all() && (c.array() <= b.max().array() + tol).all()) {
+        for (const Eigen::AlignedBox3d& b : boxes)
+            if (in_box(c, b.min(), b.max())) {
                 in[which[v]] = true;
                 break;
             }
-        }
     }
     return in;
 }

@@ -1,6 +1,7 @@
 #include "io/scene_object.hpp"
 
 #include "core/error.hpp"
+#include "io/box.hpp"
 #include "grid/coarse_cells.hpp"
 #include "grid/phantom.hpp"
 #include "io/object_import.hpp"
@@ -84,11 +85,8 @@ void check_constraints(const Scene& scene, const grid::LabelGrid& labels)
     labels.for_each_active([&](const grid::Coord& ijk, std::int32_t) {
         const Eigen::Vector3d p = labels.index_to_world(ijk.cast<double>());
         span.extend(p);
-        for (std::size_t c = 0; c < n; ++c) {
-            const Constraint& con = scene.constraints[c];
-            const double tol = 1e-9 * (1.0 + con.box_max_mm.cwiseAbs().maxCoeff() + con.box_min_mm.cwiseAbs().maxCoeff());
-            holds[c] = holds[c] || ((p.array() >= con.box_min_mm.array() - tol).all() && (p.array() <= con.box_max_mm.array() + tol).all());
-        }
+        for (std::size_t c = 0; c < n; ++c)
+            holds[c] = holds[c] || in_box(p, scene.constraints[c].box_min_mm, scene.constraints[c].box_max_mm);
     });
     for (std::size_t c = 0; c < n; ++c) {
         if (holds[c]) continue;

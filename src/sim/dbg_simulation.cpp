@@ -4,6 +4,7 @@
 
 #include "cut/pieces.hpp"
 #include "cut/state_transfer.hpp"
+#include "io/box.hpp"
 #include "sim/rigid_parts.hpp"
 #include "fem/multigrid.hpp"
 #include "fem/rest_cholesky.hpp"
@@ -428,7 +429,7 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
         const io::WetRegion& w = scene.wet_regions[k];
         bool caught = false;
         for (std::uint32_t e = 0; e < model.elements().size(); ++e)
-            if (in_box(model.elements()[e].centroid * 1e3, w.box_min_mm, w.box_max_mm)) {
+            if (io::in_box(model.elements()[e].centroid * 1e3, w.box_min_mm, w.box_max_mm)) {
                 solver.set_water(e, w.water);
                 caught = true;
             }

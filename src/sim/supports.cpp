@@ -1,23 +1,18 @@
 #include "sim/supports.hpp"
 
 #include "grid/hex8.hpp"
+#include "io/box.hpp"
 
 #include <Eigen/Geometry>
 
 namespace vox::sim {
-
-bool in_box(const Eigen::Vector3d& p_mm, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi)
-{
-    const double tol = 1e-9 * (1.0 + lo.cwiseAbs().maxCoeff() + hi.cwiseAbs().maxCoeff());
-    return (p_mm.array() >= lo.array() - tol).all() && (p_mm.array() <= hi.array() + tol).all();
-}
 
 BoxMaterial::Held BoxMaterial::measure(const grid::BranchedGrid& grid, int level, std::uint32_t element) const
 {
     const grid::FineVoxels& fine = grid.voxels();
     Held out;
     if (level == 0) { // the voxel is the element: all eight corners, an eighth of it each
-        if (fine.alive(element) && in_box(fine.world_mm(fine.coord(element).cast<double>()), m_lo, m_hi)) {
+        if (fine.alive(element) && io::in_box(fine.world_mm(fine.coord(element).cast<double>()), m_lo, m_hi)) {
             out.voxels = 1;
             out.corners = 0xff;
             out.weight.fill(0.125);
@@ -36,7 +31,7 @@ BoxMaterial::Held BoxMaterial::measure(const grid::BranchedGrid& grid, int level
     for (std::uint32_t v : g.voxels) {
         if (!fine.alive(v)) continue;
         const Eigen::Vector3d centre = fine.coord(v).cast<double>();
-        if (!in_box(fine.world_mm(centre), m_lo, m_hi)) continue;
+        if (!io::in_box(fine.world_mm(centre), m_lo, m_hi)) continue;
         const Eigen::Vector3d t = (centre - corner0) / size; // in (0, 1) per axis
         ++out.voxels;
         // A voxel centre never lies on a cell's mid-plane above level 0 (centres sit half a voxel

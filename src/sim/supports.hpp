@@ -65,7 +65,4 @@ private:
     std::array<std::vector<Held>, 7> m_by_level;
 };
 
-/// Whether p lies in [lo, hi] (world mm), boundary included up to rounding.
-[[nodiscard]] bool in_box(const Eigen::Vector3d& p_mm, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
-
 } // namespace vox::sim

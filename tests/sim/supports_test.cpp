@@ -12,6 +12,7 @@
 #include "io/scene_object.hpp"
 #include "core/error.hpp"
 #include "sim/dbg_simulation.hpp"
+#include "io/box.hpp"
 #include "sim/supports.hpp"
 
 #include <gtest/gtest.h>
@@ -48,7 +49,7 @@ std::vector<Found> voxels_in_box(const grid::BranchedGrid& grid, const fem::HexM
     for (std::uint32_t v = 0; v < grid.voxels().slots(); ++v) {
         if (!grid.voxels().alive(v)) continue;
         const Eigen::Vector3d c = grid.voxels().world_mm(grid.voxels().coord(v).cast<double>());
-        if (in_box(c, lo, hi)) out.push_back({c, model_element[level == 0 ? v : grid.element_of(v, level)]});
+        if (io::in_box(c, lo, hi)) out.push_back({c, model_element[level == 0 ? v : grid.element_of(v, level)]});
     }
     return out;
 }
