@@ -6,19 +6,44 @@
 #include <unordered_map>
 
 namespace vox::cut {
+namespace {
+
+std::uint64_t key(int level, std::uint32_t grid_element) { return (std::uint64_t{static_cast<std::uint32_t>(level)} << 32) | grid_element; }
+std::uint64_t key(const fem::HexElement& el) { return key(el.level, el.grid_element); }
+
+/// A model of two levels: its tied nodes placed and moving on the field of the coarse nodes they
+/// follow (the transfer gave them the old field, which a fine region may have bent past it).
+void follow_ties(const fem::HexModel& model, fem::ImplicitSolver& solver)
+{
+    std::vector<Eigen::Vector3d>& x = solver.positions();
+    std::vector<Eigen::Vector3d>& v = solver.velocities();
+    const auto& rest = model.rest_positions();
+    for (const grid::MixedLevels::Tie& t : model.ties()) {
+        Eigen::Vector3d u = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
+        for (std::size_t c = 0; c < 8; ++c) {
+            u += t.weights[c] * (x[t.masters[c]] - rest[t.masters[c]]);
+            w += t.weights[c] * v[t.masters[c]];
+        }
+        x[t.node] = rest[t.node] + u;
+        v[t.node] = w;
+    }
+}
+
+} // namespace
 
 void transfer_state(const grid::UpdateReport& report, const fem::HexModel& old_model, const fem::ImplicitSolver& old_solver,
                     const fem::HexModel& new_model, fem::ImplicitSolver& new_solver)
 {
-    const int level = new_model.level();
-    // Old model element by grid element (level 0: by voxel slot, which cuts never renumber).
-    std::unordered_map<std::uint32_t, std::uint32_t> old_element;
-    for (std::uint32_t e = 0; e < old_model.elements().size(); ++e) old_element.emplace(old_model.elements()[e].grid_element, e);
+    // Old model element by level and grid element (level 0: by voxel slot, which cuts never
+    // renumber); a model of two levels has elements of both.
+    std::unordered_map<std::uint64_t, std::uint32_t> old_element;
+    for (std::uint32_t e = 0; e < old_model.elements().size(); ++e) old_element.emplace(key(old_model.elements()[e]), e);
     // Where each new grid element came from: itself unless the update created it.
-    std::unordered_map<std::uint32_t, std::uint32_t> source;
-    if (level > 0 && static_cast<std::size_t>(level) < report.levels.size())
-        for (const auto& [created, from] : report.levels[static_cast<std::size_t>(level)].created)
-            source[created] = from.empty() ? grid::no_index : from.front();
+    std::unordered_map<std::uint64_t, std::uint32_t> source;
+    for (const int level : {new_model.level(), new_model.coarse_level()})
+        if (level > 0 && static_cast<std::size_t>(level) < report.levels.size())
+            for (const auto& [created, from] : report.levels[static_cast<std::size_t>(level)].created)
+                source[key(level, created)] = from.empty() ? grid::no_index : from.front();
 
     std::vector<Eigen::Vector3d>& x = new_solver.positions();
     std::vector<Eigen::Vector3d>& v = new_solver.velocities();
@@ -26,8 +51,8 @@ void transfer_state(const grid::UpdateReport& report, const fem::HexModel& old_m
     for (std::uint32_t e = 0; e < new_model.elements().size(); ++e) {
         const fem::HexElement& el = new_model.elements()[e];
         std::uint32_t from = el.grid_element;
-        if (const auto s = source.find(from); s != source.end()) from = s->second;
-        const auto old = old_element.find(from);
+        if (const auto s = source.find(key(el)); s != source.end()) from = s->second;
+        const auto old = old_element.find(key(el.level, from));
         if (old == old_element.end()) continue; // nothing to inherit: the node stays at rest
         const fem::HexElement& old_el = old_model.elements()[old->second];
         for (int c = 0; c < 8; ++c) {
@@ -40,25 +65,37 @@ void transfer_state(const grid::UpdateReport& report, const fem::HexModel& old_m
         if (const double w = old_solver.water(old->second); w > 0.0) new_solver.set_water(e, w);
         if (old_solver.has_plasticity()) new_solver.set_plastic_strain(e, old_solver.plastic_strain(old->second));
     }
+    follow_ties(new_model, new_solver);
 }
 
 void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel& old_model, const fem::ImplicitSolver& old_solver,
                              const fem::HexModel& new_model, fem::ImplicitSolver& new_solver)
 {
-    const int from = old_model.level(), to = new_model.level();
-    if (from < 1 || to < 1) throw std::invalid_argument("transfer_between_levels: levels start at 1");
-    const grid::Level& old_level = grid.level(from);
-    const grid::Level& new_level = grid.level(to);
-    std::vector<std::uint32_t> old_element(old_level.elements.size(), grid::no_index); // grid element -> model element
-    for (std::uint32_t e = 0; e < old_model.elements().size(); ++e) old_element[old_model.elements()[e].grid_element] = e;
+    if (old_model.level() < 1 || new_model.level() < 1) throw std::invalid_argument("transfer_between_levels: levels start at 1");
+    // The old model element holding a voxel: per level the old model has (one, or a model of
+    // two: fine first), grid element -> model element.
+    std::vector<std::pair<int, std::vector<std::uint32_t>>> old_element;
+    for (const int level : {old_model.level(), old_model.coarse_level()}) {
+        if (!old_element.empty() && old_element.back().first == level) continue;
+        old_element.emplace_back(level, std::vector<std::uint32_t>(grid.level(level).elements.size(), grid::no_index));
+    }
+    for (std::uint32_t e = 0; e < old_model.elements().size(); ++e) {
+        const fem::HexElement& el = old_model.elements()[e];
+        for (auto& [level, ids] : old_element)
+            if (level == el.level) ids[el.grid_element] = e;
+    }
+    const auto holding = [&](std::uint32_t voxel) {
+        for (const auto& [level, ids] : old_element)
+            if (const std::uint32_t e = ids[grid.element_of(voxel, level)]; e != grid::no_index) return e;
+        throw std::logic_error("transfer_between_levels: a voxel in no element of the old model");
+    };
     const auto& old_x = old_solver.positions();
     const auto& old_v = old_solver.velocities();
     const auto& old_rest = old_model.rest_positions();
-    // The old level's displacement and velocity at index-space point p, in old grid element ge.
-    const auto field_at = [&](std::uint32_t ge, const Eigen::Vector3d& p, Eigen::Vector3d& u, Eigen::Vector3d& v) {
-        const grid::Element& el = old_level.elements[ge];
-        const fem::HexElement& me = old_model.elements()[old_element[ge]];
-        const Eigen::Vector3d t = (p - grid::BranchedGrid::cell_corner_index(el.cell, from, 0)) / static_cast<double>(1 << from);
+    // The old model's displacement and velocity at index-space point p, in its element me.
+    const auto field_at = [&](const fem::HexElement& me, const Eigen::Vector3d& p, Eigen::Vector3d& u, Eigen::Vector3d& v) {
+        const grid::Element& el = grid.level(me.level).elements[me.grid_element];
+        const Eigen::Vector3d t = (p - grid::BranchedGrid::cell_corner_index(el.cell, me.level, 0)) / static_cast<double>(1 << me.level);
         const Eigen::Vector3d s = Eigen::Vector3d::Ones() - t;
         u.setZero();
         v.setZero();
@@ -80,12 +117,12 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
     }();
     for (std::uint32_t e = 0; e < new_model.elements().size(); ++e) {
         const fem::HexElement& me = new_model.elements()[e];
-        const grid::Element& ge = new_level.elements[me.grid_element];
+        const grid::Element& ge = grid.level(me.level).elements[me.grid_element];
         // Per corner, the element's voxel nearest it (its material is what the node follows).
         std::array<Eigen::Vector3d, 8> corner;
         std::array<double, 8> best;
         std::array<std::uint32_t, 8> nearest{};
-        for (int c = 0; c < 8; ++c) corner[c] = grid::BranchedGrid::cell_corner_index(ge.cell, to, c);
+        for (int c = 0; c < 8; ++c) corner[c] = grid::BranchedGrid::cell_corner_index(ge.cell, me.level, c);
         best.fill(std::numeric_limits<double>::infinity());
         double water = 0.0;
         Eigen::Matrix3d plastic = Eigen::Matrix3d::Zero();
@@ -97,7 +134,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
                     nearest[c] = voxel;
                 }
             if (wet || old_solver.has_plasticity()) {
-                const std::uint32_t source = old_element[grid.element_of(voxel, from)];
+                const std::uint32_t source = holding(voxel);
                 water += old_solver.water(source);
                 if (old_solver.has_plasticity()) plastic += old_solver.plastic_strain(source);
             }
@@ -111,11 +148,12 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
             if (done[n]) continue;
             done[n] = 1;
             Eigen::Vector3d u, velocity;
-            field_at(grid.element_of(nearest[c], from), corner[c], u, velocity);
+            field_at(old_model.elements()[holding(nearest[c])], corner[c], u, velocity);
             x[n] = new_rest[n] + u;
             v[n] = velocity;
         }
     }
+    follow_ties(new_model, new_solver);
 }
 
 } // namespace vox::cut

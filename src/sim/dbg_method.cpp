@@ -29,6 +29,7 @@ struct DbgCheckpoint final : Checkpoint {
     std::vector<double> water;
     std::vector<Eigen::Matrix3d> plastic;
     std::unordered_set<std::uint32_t> separated;
+    RegionCells region; ///< two levels: the fine region the state is on
 };
 
 } // namespace
@@ -92,6 +93,7 @@ void DbgMethod::begin_tools(std::size_t tool_count)
     m_previous_section.resize(tool_count);
     m_marked_from.resize(tool_count);
     m_tool_reach.clear();
+    m_region_reach.clear();
 }
 
 const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolSpec& spec, const contact::PlacedShape& at,
@@ -100,6 +102,7 @@ const contact::ContactResult& DbgMethod::touch(std::size_t tool, const io::ToolS
     const contact::ContactParameters parameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm};
     m_touch[tool] = cut::touch_surface(m_sim->surface(), m_sim->solver().positions(), at, parameters, from);
     m_tool_reach.push_back(at.world_bounds(k_sleep_tool_mm)); // wakes what sleeps near it
+    if (m_scene.object.mixed_levels) m_region_reach.push_back(at.world_bounds(m_scene.object.mixed_levels->fine_radius_mm));
     m_touched[tool] = true;
     m_fresh[tool] = true;
     return m_touch[tool].contact;
@@ -315,6 +318,9 @@ void DbgMethod::wet(std::size_t tool, double water)
 
 void DbgMethod::end_tools()
 {
+    // Two levels: the fine region follows the tools before the forces go onto the model's nodes.
+    if (m_sim->follow_tools(m_region_reach)) std::fill(m_fresh.begin(), m_fresh.end(), false);
+    m_region_reach.clear();
     // The forces for the next step, on the model as it now is.
     std::vector<fem::NodeContact> nodes;
     for (std::size_t k = 0; k < m_touch.size(); ++k) {
@@ -566,15 +572,32 @@ std::vector<double> DbgMethod::motion() const
         const Eigen::Matrix3d p = s.plastic_strain(e);
         out.insert(out.end(), p.data(), p.data() + 9);
     }
+    // Two levels: the fine region the state is on, its cells then their count, last.
+    if (m_scene.object.mixed_levels) {
+        for (const grid::Coord& c : m_sim->region()) out.insert(out.end(), {double(c.x()), double(c.y()), double(c.z())});
+        out.push_back(static_cast<double>(m_sim->region().size()));
+    }
     return out;
 }
 
 void DbgMethod::set_motion(const std::vector<double>& numbers)
 {
+    std::size_t region_numbers = 0;
+    if (m_scene.object.mixed_levels) {
+        const double count = numbers.empty() ? -1.0 : numbers.back();
+        if (!(count >= 0.0 && count == std::floor(count) && 3.0 * count + 1.0 <= static_cast<double>(numbers.size())))
+            throw InputError("the state does not end with the fine region of a run on two levels");
+        const auto cells = static_cast<std::size_t>(count);
+        region_numbers = 3 * cells + 1;
+        const double* at = numbers.data() + numbers.size() - region_numbers;
+        RegionCells region;
+        for (std::size_t c = 0; c < cells; ++c, at += 3) region.emplace_back(static_cast<int>(at[0]), static_cast<int>(at[1]), static_cast<int>(at[2]));
+        m_sim->set_region(std::move(region));
+    }
     fem::ImplicitSolver& s = m_sim->solver();
     const std::size_t nodes = s.positions().size();
     const auto elements = static_cast<std::uint32_t>(m_sim->model().elements().size());
-    check_motion(numbers, 6 * nodes + 10 * std::size_t{elements});
+    check_motion(numbers, 6 * nodes + 10 * std::size_t{elements} + region_numbers);
     const double* at = numbers.data();
     for (auto* field : {&s.positions(), &s.velocities()})
         for (Eigen::Vector3d& p : *field) {
@@ -602,6 +625,7 @@ std::unique_ptr<Checkpoint> DbgMethod::checkpoint() const
         c->plastic.push_back(s.plastic_strain(e));
     }
     c->separated = m_separated;
+    c->region = m_sim->region();
     return c;
 }
 
@@ -617,6 +641,7 @@ void DbgMethod::restore(const Checkpoint& checkpoint)
     m_sim = std::make_unique<DbgSimulation>(m_scene, *m_grid, m_level);
     m_cuts.resize(std::min(m_cuts.size(), c.cuts));
     for (const CutRecord& r : m_cuts) m_sim->apply_cut(*m_grid, r.removed, r.faces);
+    m_sim->set_region(c.region);
     fem::ImplicitSolver& s = m_sim->solver();
     if (s.positions().size() == c.positions.size()) {
         s.positions() = c.positions;

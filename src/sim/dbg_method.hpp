@@ -121,6 +121,7 @@ private:
     // Per tool, this frame and across frames.
     std::vector<cut::SurfaceContact> m_touch;
     std::vector<Eigen::AlignedBox3d> m_tool_reach; ///< this frame's tools, grown by k_sleep_tool_mm (DbgSimulation::set_tool_reach)
+    std::vector<Eigen::AlignedBox3d> m_region_reach; ///< two levels: this frame's tools, grown by fine_radius_mm (DbgSimulation::follow_tools)
     std::vector<bool> m_touched;  ///< placed (and touched) this frame
     std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
     std::vector<double> m_drill_budget; ///< per tool: volume a drill may still remove, below one voxel's, mm^3

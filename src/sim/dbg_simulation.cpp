@@ -97,7 +97,10 @@ DbgSimulation::DbgSimulation(const io::Scene& scene, const grid::BranchedGrid& g
     : m_scene(scene), m_grid(&grid), m_rigid_material(rigid_materials(scene)),
       m_level(scene.object.mixed_levels ? scene.object.mixed_levels->fine : level)
 {
-    if (scene.object.mixed_levels) m_mixed = mixed_region(scene, grid);
+    if (scene.object.mixed_levels) {
+        m_region = starting_region(scene, grid);
+        m_mixed = mixed_levels(grid, *scene.object.mixed_levels, m_region);
+    }
     build(Build::first);
     m_surface = std::make_unique<surface::EmbeddedSurface>(grid, std::max(m_level, 1)); // two levels: the fine one
     smooth_scene_surface(scene, grid, *m_surface);
@@ -112,9 +115,14 @@ DbgSimulation::DbgSimulation(DbgSimulation& from, int level, io::PreconditionerC
     m_scene.solver.preconditioner = preconditioner;
     build(Build::level_change);
     cut::transfer_between_levels(*m_grid, *from.m_model, *from.m_solver, *m_model, *m_solver);
-    // What is held stays at rest (constraints, rigid anchoring, held pieces: the interpolation
-    // would move a held node by the old level's field beside it); a rigid body's nodes are where
-    // its body put them.
+    rest_held_nodes();
+    m_surface = std::move(from.m_surface);
+    m_surface->reembed(*m_grid, level);
+    m_model_surface = std::make_unique<cut::ModelSurface>(*m_grid, *m_model, *m_surface);
+}
+
+void DbgSimulation::rest_held_nodes()
+{
     fem::ImplicitSolver& solver = *m_solver;
     for (std::uint32_t n = 0; n < m_model->node_count(); ++n) {
         if (m_body_of_node[n] >= 0) continue;
@@ -124,8 +132,28 @@ DbgSimulation::DbgSimulation(DbgSimulation& from, int level, io::PreconditionerC
                 solver.velocities()[n][a] = 0.0;
             }
     }
-    m_surface = std::move(from.m_surface);
-    m_surface->reembed(*m_grid, level);
+}
+
+bool DbgSimulation::follow_tools(std::span<const Eigen::AlignedBox3d> reach_mm)
+{
+    if (!m_mixed || reach_mm.empty()) return false;
+    RegionCells cells = followed_region(*m_grid, *m_model, m_solver->positions(), reach_mm, m_region);
+    if (cells == m_region) return false;
+    set_region(std::move(cells));
+    return true;
+}
+
+void DbgSimulation::set_region(RegionCells cells)
+{
+    if (!m_mixed || cells == m_region) return;
+    m_region = std::move(cells);
+    m_mixed = mixed_levels(*m_grid, *m_scene.object.mixed_levels, m_region);
+    std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
+    std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
+    m_model_surface.reset(); // it refers to the old model
+    build(Build::region);
+    cut::transfer_between_levels(*m_grid, *old_model, *old_solver, *m_model, *m_solver);
+    rest_held_nodes();
     m_model_surface = std::make_unique<cut::ModelSurface>(*m_grid, *m_model, *m_surface);
 }
 
@@ -142,6 +170,7 @@ CutTimings DbgSimulation::apply_cut(grid::BranchedGrid& grid, std::span<const gr
     std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
+    if (m_mixed) m_mixed = mixed_levels(grid, *m_scene.object.mixed_levels, m_region); // on the grid's new elements
     const io::PreconditionerChoice old_choice = m_choice;
     build(Build::cut, old_model.get(), &report, old_solver.get());
     cut::transfer_state(report, *old_model, *old_solver, *m_model, *m_solver);
@@ -318,12 +347,15 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     const io::Scene& scene = m_scene;
     const grid::BranchedGrid& grid = *m_grid;
     const int level = m_level;
-    std::vector<unsigned char> changed; // per grid element of the level: touched by the cut
+    std::vector<unsigned char> changed, changed_coarse; // per grid element of the level (and the coarse one): touched by the cut
+    if (previous && level >= 1) {
+        changed = changed_elements(grid, level, *report);
+        if (m_mixed) changed_coarse = changed_elements(grid, m_mixed->coarse(), *report);
+    }
     if (m_mixed) {
         m_model = std::make_unique<fem::HexModel>(grid, *m_mixed);
     } else if (previous && level >= 1) {
         // The elements the change touched; all others keep their matrices.
-        changed = changed_elements(grid, level, *report);
         m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);
     } else {
         m_model = std::make_unique<fem::HexModel>(grid, level);
@@ -333,15 +365,17 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     // Which axes of which nodes are held, before the solver exists: the preconditioner is chosen
     // by the degrees of freedom left free (a rigid skull leaves none).
     // The material each box holds: measured afresh, or after a cut in the elements it changed.
-    const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty() && !m_mixed;
-    if (!after_cut) {
+    // A move of the fine region keeps the grid, and so what the boxes hold.
+    const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty();
+    if (!after_cut && kind != Build::region) {
         m_boxes.clear();
         for (const io::Constraint& c : scene.constraints) m_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
         for (const io::Load& l : scene.loads) m_boxes.emplace_back(l.box_min_mm, l.box_max_mm);
     }
     for (BoxMaterial& b : m_boxes) {
+        if (kind == Build::region) break;
         b.update(grid, level, after_cut ? &changed : nullptr);
-        if (m_mixed) b.update(grid, m_mixed->coarse(), nullptr);
+        if (m_mixed) b.update(grid, m_mixed->coarse(), after_cut ? &changed_coarse : nullptr);
     }
     std::vector<unsigned> held_axes(model.node_count(), 0u);
     std::vector<unsigned char> constrained(model.node_count(), 0);
@@ -353,7 +387,7 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
             held_axes[n] |= axes;
             constrained[n] = 1;
         }
-        if (nodes.empty() && kind != Build::cut)
+        if (nodes.empty() && (kind == Build::first || kind == Build::level_change))
             throw scene.error("constraints[" + std::to_string(k) + "].box_mm", "holds no voxel centre of the object");
     }
     // Rigid material holds the soft material of its piece, so "hold" leaves such pieces to it.
@@ -443,7 +477,7 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
         const io::Load& load = scene.loads[k];
         const BoxMaterial& box = m_boxes[scene.constraints.size() + k];
         const bool empty = box.voxel_count(model) == 0;
-        if (empty && kind == Build::cut) continue; // the cut took the loaded material
+        if (empty && (kind == Build::cut || kind == Build::region)) continue; // the cut took the loaded material
         if (empty) throw scene.error("loads[" + std::to_string(k) + "].box_mm", "holds no voxel centre of the object");
         for (const auto& [n, share] : box.load_shares(model)) solver.external_forces()[n] += share * load.force_n;
     }

@@ -94,11 +94,23 @@ public:
     CutTimings apply_cut(grid::BranchedGrid& grid, std::span<const grid::Coord> removed,
                          std::span<const std::pair<grid::Coord, int>> faces);
 
+    /// Two levels: the fine region (sim/mixed_region.hpp), and moving it after the tools, whose
+    /// reach this frame is `reach_mm` (world boxes of their outer shapes grown by fine_radius_mm;
+    /// none placed: the region stays). Returns whether the region moved: the model was rebuilt
+    /// on the new region, carrying positions, velocities, water and plastic strain
+    /// (cut/state_transfer.hpp), and node numbers changed. One level: false, always.
+    [[nodiscard]] const RegionCells& region() const { return m_region; }
+    bool follow_tools(std::span<const Eigen::AlignedBox3d> reach_mm);
+    /// Two levels: the model rebuilt on the fine region `cells`, carrying the state over (a restored
+    /// checkpoint's region). Does nothing when the region is already that.
+    void set_region(RegionCells cells);
+
 private:
     /// What a build starts from: the scene (the wet regions are applied and the pieces to hold
     /// found), another level's simulation, or the same level before a cut. Boxes that hold no material
     /// are errors except after a cut (it may have taken their material).
-    enum class Build { first, level_change, cut };
+    /// A move of the fine region keeps the grid: what the boxes hold stays measured.
+    enum class Build { first, level_change, cut, region };
     /// Model, solver, preconditioner, materials, constraints and loads at m_level. After a cut,
     /// `previous` and `report` let unchanged elements keep their matrices, and `previous_solver`
     /// lends its matrix pattern when the elements sit on the same nodes.
@@ -109,6 +121,10 @@ private:
     /// `first`; after cuts, the elements holding their voxels). `constrained` flags the nodes the
     /// scene's constraint boxes hold; the held nodes get all three axes in `held_axes`.
     void hold_unheld_pieces(bool first, const std::vector<unsigned char>& constrained, std::vector<unsigned>& held_axes);
+    /// After a state carried from another model: what is held back at rest (constraints, rigid
+    /// anchoring, held pieces: the interpolation would move a held node by the field beside it); a
+    /// rigid body's nodes are where its body put them.
+    void rest_held_nodes();
 
     io::Scene m_scene;
     const grid::BranchedGrid* m_grid;
@@ -116,8 +132,10 @@ private:
     std::vector<unsigned char> m_held_voxels; ///< per fine voxel slot: held by "unheld_pieces": "hold"
     std::size_t m_held_pieces = 0;
     std::vector<BoxMaterial> m_boxes; ///< what each constraint box, then each load box, holds at m_level
-    /// "levels" as an object: the two-level selection (m_level is its fine level); null for one level.
+    /// "levels" as an object: the two-level selection (m_level is its fine level) refining
+    /// m_region; null for one level.
     std::unique_ptr<grid::MixedLevels> m_mixed;
+    RegionCells m_region;
     int m_level;
     std::unique_ptr<fem::HexModel> m_model;
     std::unique_ptr<fem::ImplicitSolver> m_solver;

@@ -112,3 +112,77 @@ TEST_P(StateTransfer, AModelRebuiltFromTheOldOneEqualsAFreshOne)
 }
 
 INSTANTIATE_TEST_SUITE_P(Levels, StateTransfer, ::testing::Values(1, 2));
+
+namespace {
+
+/// The two-level selection of a 16 x 8 x 8 block (level-3 cells 8 voxels wide: two of them along
+/// x) refining the coarse cell at x index `cell`.
+grid::MixedLevels refining(const grid::BranchedGrid& grid, int cell)
+{
+    return grid::MixedLevels(grid, 1, 3, [&](std::uint32_t e) { return grid.level(3).elements[e].cell.x() == cell; });
+}
+
+void set_fields(const fem::HexModel& model, fem::ImplicitSolver& solver)
+{
+    for (std::uint32_t n = 0; n < model.node_count(); ++n) {
+        solver.positions()[n] = position_field(model.rest_positions()[n]);
+        solver.velocities()[n] = velocity_field(model.rest_positions()[n]);
+    }
+}
+
+void expect_fields(const fem::HexModel& model, const fem::ImplicitSolver& solver)
+{
+    for (std::uint32_t n = 0; n < model.node_count(); ++n) {
+        const Eigen::Vector3d X = model.rest_positions()[n];
+        EXPECT_LT((solver.positions()[n] - position_field(X)).norm(), 1e-15) << n;
+        EXPECT_LT((solver.velocities()[n] - velocity_field(X)).norm(), 1e-12) << n;
+    }
+}
+
+} // namespace
+
+TEST(StateTransferTwoLevels, AnAffineStateCarriesOverExactlyAsTheFineRegionMoves)
+{
+    // The fine region moves from one coarse cell to the other, then the model goes to one level:
+    // the state is affine, so every node, fine, coarse or tied, must land on it exactly, and an
+    // element's water is the mean over its voxels of the old elements' water.
+    const grid::BranchedGrid grid = test::block_grid({16, 8, 8}, 3);
+    const grid::MixedLevels left = refining(grid, 0), right = refining(grid, 1);
+    const fem::HexModel a(grid, left), b(grid, right), one(grid, 2);
+    ASSERT_FALSE(a.ties().empty());
+    fem::SolverOptions o;
+    fem::ImplicitSolver sa(a, o), sb(b, o), s_one(one, o);
+    set_fields(a, sa);
+    for (std::uint32_t e = 0; e < a.elements().size(); ++e) sa.set_water(e, a.elements()[e].level == 1 ? 0.2 : 0.6);
+    cut::transfer_between_levels(grid, a, sa, b, sb);
+    expect_fields(b, sb);
+    for (std::uint32_t e = 0; e < b.elements().size(); ++e) {
+        const fem::HexElement& el = b.elements()[e];
+        const double x_mm = 1e3 * el.centroid.x(); // the left cell (x < 7.5 mm) was fine, the right one coarse
+        EXPECT_NEAR(sb.water(e), x_mm < 7.5 ? 0.2 : 0.6, 1e-12) << e;
+    }
+    cut::transfer_between_levels(grid, b, sb, one, s_one);
+    expect_fields(one, s_one);
+}
+
+TEST(StateTransferTwoLevels, ACutOnTwoLevelsCarriesTheStateOver)
+{
+    // Faces opened across both cells (inside the fine region and inside the coarse one); the
+    // model rebuilt on the same region takes the old state corner by corner.
+    grid::BranchedGrid grid = test::block_grid({16, 8, 8}, 3);
+    const grid::MixedLevels before = refining(grid, 0);
+    const fem::HexModel old_model(grid, before);
+    fem::SolverOptions o;
+    fem::ImplicitSolver old_solver(old_model, o);
+    set_fields(old_model, old_solver);
+    std::vector<std::pair<grid::Coord, int>> faces;
+    for (int x = 0; x < 16; ++x)
+        for (int y = 0; y < 5; ++y) faces.emplace_back(grid::Coord(x, y, 4), 2);
+    const grid::UpdateReport report = grid.update({}, faces);
+    const grid::MixedLevels after = refining(grid, 0);
+    const fem::HexModel new_model(grid, after);
+    ASSERT_GT(new_model.node_count(), old_model.node_count()); // split nodes on both levels
+    fem::ImplicitSolver new_solver(new_model, o);
+    cut::transfer_state(report, old_model, old_solver, new_model, new_solver);
+    expect_fields(new_model, new_solver);
+}
