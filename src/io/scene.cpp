@@ -738,9 +738,6 @@ static void check_mixed_levels(const Scene& scene)
         throw scene.error("object.levels", "two levels run on the branched grid only (\"solver\": {\"type\": \"dbg\"})");
     if (scene.solver.preconditioner == PreconditionerChoice::cholesky || scene.solver.preconditioner == PreconditionerChoice::multigrid)
         throw scene.error("solver.preconditioner", "two levels solve with Jacobi (\"auto\" or \"jacobi\")");
-    for (std::size_t i = 0; i < scene.tools.size(); ++i)
-        if (scene.tools[i].action == ToolAction::cut || scene.tools[i].action == ToolAction::drill)
-            throw scene.error("tools[" + std::to_string(i) + "].action", "cutting and drilling on two levels are not built yet; push, or simulate one level");
 }
 
 Scene parse_scene(const nlohmann::json& document, const std::filesystem::path& folder,

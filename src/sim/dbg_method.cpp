@@ -319,7 +319,13 @@ void DbgMethod::wet(std::size_t tool, double water)
 void DbgMethod::end_tools()
 {
     // Two levels: the fine region follows the tools before the forces go onto the model's nodes.
-    if (m_sim->follow_tools(m_region_reach)) std::fill(m_fresh.begin(), m_fresh.end(), false);
+    Stopwatch region_clock;
+    m_region_move_ms = 0.0;
+    if (m_sim->follow_tools(m_region_reach)) {
+        std::fill(m_fresh.begin(), m_fresh.end(), false);
+        m_region_move_ms = region_clock.lap();
+        ++m_region_moves;
+    }
     m_region_reach.clear();
     // The forces for the next step, on the model as it now is.
     std::vector<fem::NodeContact> nodes;
@@ -465,8 +471,14 @@ void DbgMethod::sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpe
 
 std::size_t DbgMethod::piece_count() const { return cut::piece_count(m_sim->model()); }
 
+void DbgMethod::add_frame_figures(nlohmann::json& frame) const
+{
+    if (m_scene.object.mixed_levels) frame["fine_region"] = {{"cells", m_sim->region().size()}, {"move_ms", m_region_move_ms}};
+}
+
 void DbgMethod::add_summary_figures(nlohmann::json& summary) const
 {
+    if (m_scene.object.mixed_levels) summary["fine_region_moves"] = m_region_moves;
     std::size_t wet = 0;
     for (std::uint32_t e = 0; e < m_sim->model().elements().size(); ++e) wet += m_sim->solver().water(e) > 0.0;
     summary.update({{"voxels", m_grid->voxels().alive_count()},

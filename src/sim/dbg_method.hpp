@@ -70,6 +70,7 @@ public:
     [[nodiscard]] const std::vector<contact::Obstacle>& obstacles() const override { return m_obstacles; }
     [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
     [[nodiscard]] PieceContactFigures piece_contact() const override { return m_piece_contact; }
+    void add_frame_figures(nlohmann::json& frame) const override;
     void add_summary_figures(nlohmann::json& summary) const override;
 
     [[nodiscard]] std::unique_ptr<Method> at_level(int level) const override;
@@ -122,6 +123,8 @@ private:
     std::vector<cut::SurfaceContact> m_touch;
     std::vector<Eigen::AlignedBox3d> m_tool_reach; ///< this frame's tools, grown by k_sleep_tool_mm (DbgSimulation::set_tool_reach)
     std::vector<Eigen::AlignedBox3d> m_region_reach; ///< two levels: this frame's tools, grown by fine_radius_mm (DbgSimulation::follow_tools)
+    double m_region_move_ms = 0.0; ///< two levels: this frame's move of the fine region (0: it stayed)
+    std::size_t m_region_moves = 0;
     std::vector<bool> m_touched;  ///< placed (and touched) this frame
     std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
     std::vector<double> m_drill_budget; ///< per tool: volume a drill may still remove, below one voxel's, mm^3
