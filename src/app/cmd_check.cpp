@@ -7,6 +7,8 @@
 #include "io/scene.hpp"
 #include "io/piece_selection.hpp"
 #include "io/scene_object.hpp"
+#include "sim/dbg_simulation.hpp"
+#include "sim/mixed_region.hpp"
 #include "sim/obstacles.hpp"
 
 #include <CLI/CLI.hpp>
@@ -100,6 +102,15 @@ void add_check_command(CLI::App& app)
                 std::printf("level: auto, the finest whose whole frames (tools, cuts, step) fit %g ms\n", *scene.object.step_budget_ms);
             else
                 std::printf("level: auto, the coarsest within %g %% of the next finer level\n", 100 * scene.object.max_error.value_or(0.0));
+        } else if (const auto& two = scene.object.mixed_levels) {
+            // The elements per level where the run starts (the region then follows the tools).
+            const grid::BranchedGrid grid = sim::build_scene_grid(scene, labels, two->coarse);
+            const sim::RegionCells cells = sim::starting_region(scene, grid);
+            const std::unique_ptr<grid::MixedLevels> mixed = sim::mixed_levels(grid, *two, cells);
+            std::printf("levels %d within %g mm of the tools and %d elsewhere: where the run starts, %zu elements at level %d "
+                        "(%zu cells of %d^3 voxels refined) and %zu at level %d, %zu border nodes tied\n",
+                        two->fine, two->fine_radius_mm, two->coarse, mixed->fine_elements(), two->fine, cells.size(), 1 << two->coarse,
+                        mixed->coarse_elements(), two->coarse, mixed->ties().size());
         } else {
             std::printf("level %d: %zu occupied cells of %d^3 voxels\n", level, grid::occupied_cells(labels, level).size(),
                         1 << level);
