@@ -78,6 +78,7 @@ void add_run_command(CLI::App& app)
         std::string replay, record, resume;
         int render_every = 0;
         std::string camera = "iso", size = "960x720";
+        bool cage = false;
         std::string solver;
     };
     auto args = std::make_shared<Args>();
@@ -103,6 +104,9 @@ void add_run_command(CLI::App& app)
         ->check(CLI::PositiveNumber);
     cmd->add_option("--camera", args->camera, "Camera of the pictures (see `voxsculpt render --help`; default iso)");
     cmd->add_option("--size", args->size, "Size of the pictures, WIDTHxHEIGHT (default 960x720)");
+    cmd->add_flag("--cage", args->cage,
+                  "Draw the branched grid's element cage in the pictures, through a translucent surface (two levels: fine in orange, "
+                  "coarse in dark blue, border nodes tied to the coarse side in green)");
     cmd->callback([args] {
         io::Scene scene = io::load_scene(args->scene);
         if (!args->solver.empty()) io::use_method(scene, io::solver_type_named(args->solver));
@@ -110,6 +114,7 @@ void add_run_command(CLI::App& app)
         PictureOptions picture_options;
         picture_options.camera = render::parse_camera(args->camera);
         picture_options.camera.up = scene_up(scene);
+        picture_options.cage = args->cage;
         std::tie(picture_options.width, picture_options.height) = parse_size(args->size);
         if (!args->record.empty() && args->devices.empty() && args->replay.empty())
             throw InputError("--record: there is no device to record; add --device script or --replay FILE");

@@ -1,6 +1,7 @@
 #include "view/scene_pictures.hpp"
 
 #include "core/error.hpp"
+#include "sim/dbg_method.hpp"
 #include "sim/obstacles.hpp"
 
 #include <sstream>
@@ -104,6 +105,10 @@ void ScenePictures::write(const std::filesystem::path& path, const sim::Method& 
     std::vector<render::DrawMesh> meshes{surface_picture(method, m_options.smooth, scene.object.label_colors)};
     for (std::size_t k = 0; k < scene.tools.size(); ++k) add_tool_drawings(tools.placed(k), scene.tools[k].push_margin_mm, meshes);
     add_obstacle_drawings(method.obstacles(), meshes.front(), meshes);
+    if (const auto* dbg = dynamic_cast<const sim::DbgMethod*>(&method); dbg && m_options.cage) {
+        meshes.front().alpha = k_surface_alpha_over_cage;
+        meshes.push_back(element_cage(dbg->simulation()));
+    }
     write(path, meshes);
 }
 
@@ -130,12 +135,14 @@ render::DrawMesh voxel_boxes(const sim::DbgSimulation& sim)
     const cut::ModelSurface& surface = sim.surface();
     const grid::FineVoxels& voxels = surface.grid().voxels();
     const auto& x = sim.solver().positions();
-    const double half = sim.model().level() == 0 ? 0.5 : 0.5 / static_cast<double>(1 << sim.model().level()); // a voxel in local units
+    // Half a voxel in an element's local units (two levels: each element's own).
+    const auto half_voxel = [&](std::uint32_t e) { const int l = sim.model().elements()[e].level; return l == 0 ? 0.5 : 0.5 / static_cast<double>(1 << l); };
     for (std::uint32_t v = 0; v < voxels.slots(); ++v) {
         if (!voxels.alive(v)) continue;
         const grid::Coord c = voxels.coord(v);
         Eigen::Vector3d local;
         const std::uint32_t e = surface.voxel_element(v, local);
+        const double half = half_voxel(e);
         // A checkerboard of two shades, so that each voxel shows.
         const Eigen::Vector3f color = ((c.x() + c.y() + c.z()) % 2 == 0 ? 0.92f : 0.78f) * render::label_color(voxels.label(v));
         for (int axis = 0; axis < 3; ++axis)
@@ -170,7 +177,15 @@ render::DrawMesh element_cage(const sim::DbgSimulation& sim)
     d.lines = true;
     const auto& x = sim.solver().positions();
     for (const Eigen::Vector3d& p : x) d.positions.push_back((1e3 * p).cast<float>());
-    d.colors.assign(d.positions.size(), Eigen::Vector3f(0.15f, 0.2f, 0.3f));
+    d.colors.assign(d.positions.size(), k_cage_coarse);
+    // Two levels: the fine region's nodes in another colour, and the border nodes tied to the
+    // coarse side in a third, so the interface shows.
+    const fem::HexModel& model = sim.model();
+    if (model.mixed()) {
+        for (std::uint32_t n = 0; n < model.node_count(); ++n)
+            if (model.node_levels()[n] == model.level()) d.colors[n] = k_cage_fine;
+        for (const grid::MixedLevels::Tie& t : model.ties()) d.colors[t.node] = k_cage_tied;
+    }
     // The 12 edges of a hexahedron by corner numbers (bit 0: +x, bit 1: +y, bit 2: +z).
     static constexpr int edges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
     for (const fem::HexElement& e : sim.model().elements())

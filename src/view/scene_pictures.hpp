@@ -22,7 +22,11 @@ struct PictureOptions {
     render::CameraSpec camera;
     int width = 960, height = 720;
     int smooth = 30; ///< display smoothing of the surface (Taubin iterations; 0: the voxel steps as they are)
+    bool cage = false; ///< the branched grid's element cage drawn through a translucent surface (element_cage)
 };
+
+/// How translucent the surface is drawn over the element cage.
+inline constexpr float k_surface_alpha_over_cage = 0.35f;
 
 /// The picture's up for a scene: against gravity (a patient on the table is seen from above, the
 /// anterior side up), or +z without gravity.
@@ -45,8 +49,11 @@ using LabelColors = std::map<std::int32_t, Eigen::Vector3d>;
 /// neighbour (the object's outside, removed neighbours, faces a cut opened), each corner carried
 /// by its element's trilinear map; coloured by label.
 [[nodiscard]] render::DrawMesh voxel_boxes(const sim::DbgSimulation& sim);
-/// The simulated level's elements as a wire cage (their corner nodes where they are now).
+/// The simulated level's elements as a wire cage (their corner nodes where they are now), dark
+/// blue; on two levels, the fine region's in orange and its border nodes tied to the coarse side
+/// in green.
 [[nodiscard]] render::DrawMesh element_cage(const sim::DbgSimulation& sim);
+inline const Eigen::Vector3f k_cage_coarse{0.15f, 0.2f, 0.3f}, k_cage_fine{0.95f, 0.45f, 0.1f}, k_cage_tied{0.2f, 0.75f, 0.3f};
 /// A tool's shapes where it is placed: the inner one opaque, the pushing one (grown by
 /// `margin_mm`) translucent when the margin is visible.
 void add_tool_drawings(const contact::PlacedShape& tool, double margin_mm, std::vector<render::DrawMesh>& out);
@@ -62,7 +69,7 @@ public:
 
     /// Writes the picture of `meshes` to `path` (PNG), framing the camera on them the first time.
     void write(const std::filesystem::path& path, const std::vector<render::DrawMesh>& meshes);
-    /// The method's surface and the placed tools.
+    /// The method's surface and the placed tools (and the cage, with PictureOptions::cage).
     void write(const std::filesystem::path& path, const sim::Method& method, const sim::ToolPolicy& tools, const io::Scene& scene);
 
     [[nodiscard]] const std::string& context_description() const { return m_context.description(); }

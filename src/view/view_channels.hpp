@@ -22,8 +22,7 @@ namespace vox::view {
 struct RenderState {
     std::vector<render::DrawMesh> meshes; ///< the surface first, then the tools (and the cage)
     double t_s = 0.0;
-    std::size_t elements = 0;
-    int level = 0;
+    std::string model;                    ///< "442 elements, level 3", or per level on two levels
     std::string tool;                     ///< the active tool and what it does
     std::string notice;                   ///< a line the window shows until it is empty again (the resume offer)
     int smooth = 0;                       ///< display smoothing the window is to give the surface

@@ -253,7 +253,6 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     window.centre = bounds.center();
     window.radius = radius;
     window.tool_count = scene.tools.size();
-    window.level = level;
     window.now_s = now_s;
     run_window(window, channels, pointer, [&loop] { loop.start(); });
     requests.stop = true;

@@ -8,6 +8,7 @@
 #include "view/scene_pictures.hpp"
 
 #include <algorithm>
+#include <map>
 #include <stdexcept>
 
 namespace vox::view {
@@ -214,10 +215,18 @@ void ViewSimulation::make_picture()
     }
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) add_tool_drawings(m_tools.placed(k), m_scene.tools[k].push_margin_mm, r.meshes);
     add_obstacle_drawings(m_method->obstacles(), r.meshes.front(), r.meshes);
-    if (q.show_cage.load() && dbg) r.meshes.push_back(element_cage(dbg->simulation()));
+    if (q.show_cage.load() && dbg) {
+        r.meshes.front().alpha = k_surface_alpha_over_cage;
+        r.meshes.push_back(element_cage(dbg->simulation()));
+    }
     r.t_s = m_loop.frames() * m_scene.solver.dt_s;
-    r.elements = m_method->element_count();
-    r.level = m_level;
+    r.model = std::to_string(m_method->element_count()) + " elements";
+    if (const std::map<int, std::size_t> per = m_method->elements_per_level(); per.size() == 1) {
+        r.model += ", level " + std::to_string(m_level);
+    } else {
+        for (const auto& [level, count] : per)
+            r.model += (level == per.begin()->first ? ": " : ", ") + std::to_string(count) + " at level " + std::to_string(level);
+    }
     r.notice = m_options.offered && m_method->cut_count() == 0
                    ? "An earlier session with this scene left " + std::to_string(m_options.offered->strokes.size()) +
                          " stroke(s) in its journal: press J to resume them"

@@ -189,9 +189,9 @@ void run_window(const WindowSetup& setup, ViewChannels& ch, haptics::PointerDevi
         const RenderState* shown = have_picture ? &ch.pictures.read_slot() : nullptr;
         char status[512];
         std::snprintf(status, sizeof status,
-                      "simulation %.0f Hz%s   haptics %.0f Hz   drawing %.0f Hz\n%zu elements, level %d   surface %zu triangles%s\ntool %s%s   "
+                      "simulation %.0f Hz%s   haptics %.0f Hz   drawing %.0f Hz\n%s   surface %zu triangles%s\ntool %s%s   "
                       "H: keys",
-                      sim_rate, rq.paused.load() ? " (paused)" : "", haptic_rate, draw_rate, shown ? shown->elements : 0, shown ? shown->level : setup.level,
+                      sim_rate, rq.paused.load() ? " (paused)" : "", haptic_rate, draw_rate, shown ? shown->model.c_str() : "",
                       drawn.empty() ? 0 : drawn.front().indices.size() / 3, use_lod && lod && drawn.front().indices.size() / 3 < lod_source_triangles ? " (display level of detail)" : "",
                       shown ? shown->tool.c_str() : "", rq.show_cage.load() ? "   cage shown" : "");
         text.draw(status, 14, 14, width, height);

@@ -22,7 +22,6 @@ struct WindowSetup {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     double radius = 50.0;             ///< of the object, mm
     std::size_t tool_count = 1;       ///< TAB cycles through them
-    int level = 1;                    ///< shown until the first picture arrives
     std::function<double()> now_s;    ///< the session's wall time, s
 };
 
