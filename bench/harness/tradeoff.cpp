@@ -6,6 +6,9 @@
 
 #include "bench/harness/tradeoff.hpp"
 
+#include "bench/harness/log_plot.hpp"
+#include "bench/harness/surface_state.hpp"
+
 #include "core/atomic_file.hpp"
 #include "core/log.hpp"
 #include "io/scene_object.hpp"
@@ -24,8 +27,6 @@ namespace vox::bench {
 
 using sim::DbgSimulation;
 
-
-using sim::DbgSimulation;
 namespace {
 
 constexpr int k_liver_reference = 1;
@@ -33,8 +34,7 @@ constexpr int k_liver_reference = 1;
 /// Quasi-static equilibrium under gravity at one level: surface displacements and cost.
 struct Solution {
     int level = 0;
-    std::map<std::uint64_t, Eigen::Vector3d> displacement; ///< surface vertex key -> mm
-    std::map<std::uint64_t, Eigen::Vector3d> rest;         ///< surface vertex key -> world mm
+    SurfaceState surface;
     std::size_t elements = 0, dofs = 0;
     double solve_ms = 0.0;
     int cg_iterations = 0;
@@ -65,7 +65,6 @@ Solution solve_static(const nlohmann::json& document)
     sim::ToolPolicy tools(scene);
     const sim::StepFigures s = sim::FrameLoop(scene, method, tools).next().step;
     const DbgSimulation& sim = method.simulation();
-    const grid::BranchedGrid& g = method.grid();
 
     Solution out;
     out.level = level;
@@ -73,13 +72,7 @@ Solution solve_static(const nlohmann::json& document)
     out.dofs = sim.solver().dof_count();
     out.solve_ms = s.step_ms;
     out.cg_iterations = s.cg_iterations;
-    const std::vector<Eigen::Vector3d> u = sim.surface().displacements(sim.solver().positions());
-    const auto& vertices = sim.surface().embedded().vertices();
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        if (vertices[i].users == 0) continue;
-        out.displacement[vertices[i].key] = u[i] * 1e3;
-        out.rest[vertices[i].key] = g.voxels().world_mm(vertices[i].rest);
-    }
+    out.surface = surface_state(method);
     return out;
 }
 
@@ -87,9 +80,9 @@ Solution solve_static(const nlohmann::json& document)
 double relative_error(const Solution& s, const Solution& reference)
 {
     double diff = 0.0, norm = 0.0;
-    for (const auto& [key, u] : reference.displacement) {
-        const auto it = s.displacement.find(key);
-        if (it == s.displacement.end()) continue;
+    for (const auto& [key, u] : reference.surface.displacement_mm) {
+        const auto it = s.surface.displacement_mm.find(key);
+        if (it == s.surface.displacement_mm.end()) continue;
         diff += (it->second - u).squaredNorm();
         norm += u.squaredNorm();
     }
@@ -101,63 +94,12 @@ double tip_deflection(const Solution& s, double end_x)
 {
     double sum = 0.0;
     int n = 0;
-    for (const auto& [key, p] : s.rest)
+    for (const auto& [key, p] : s.surface.rest_mm)
         if (p.x() >= end_x) {
-            sum += s.displacement.at(key).z();
+            sum += s.surface.displacement_mm.at(key).z();
             ++n;
         }
     return n ? sum / n : 0.0;
-}
-
-std::string svg_plot(const std::vector<std::pair<std::string, std::vector<Solution>>>& series,
-                     const std::vector<std::vector<double>>& errors)
-{
-    // Log-log: x = solve time (ms), y = relative error (%).
-    const double w = 640, h = 420, left = 70, bottom = 50, top = 20, right = 20;
-    double x0 = 1e9, x1 = 0, y0 = 1e9, y1 = 0;
-    for (std::size_t s = 0; s < series.size(); ++s)
-        for (std::size_t i = 0; i < series[s].second.size(); ++i) {
-            if (errors[s][i] <= 0) continue;
-            x0 = std::min(x0, series[s].second[i].solve_ms);
-            x1 = std::max(x1, series[s].second[i].solve_ms);
-            y0 = std::min(y0, 100 * errors[s][i]);
-            y1 = std::max(y1, 100 * errors[s][i]);
-        }
-    x0 = std::pow(10, std::floor(std::log10(x0))), x1 = std::pow(10, std::ceil(std::log10(x1)));
-    y0 = std::pow(10, std::floor(std::log10(y0))), y1 = std::pow(10, std::ceil(std::log10(y1)));
-    auto px = [&](double x) { return left + (w - left - right) * std::log10(x / x0) / std::log10(x1 / x0); };
-    auto py = [&](double y) { return h - bottom - (h - bottom - top) * std::log10(y / y0) / std::log10(y1 / y0); };
-    std::ostringstream o;
-    o << "<svg xmlns='http://www.w3.org/2000/svg' width='" << w << "' height='" << h
-      << "' font-family='sans-serif' font-size='12'>\n<rect width='100%' height='100%' fill='white'/>\n";
-    for (double x = x0; x <= x1 * 1.001; x *= 10)
-        o << "<line x1='" << px(x) << "' y1='" << top << "' x2='" << px(x) << "' y2='" << h - bottom
-          << "' stroke='#ddd'/><text x='" << px(x) << "' y='" << h - bottom + 16 << "' text-anchor='middle'>" << x
-          << "</text>\n";
-    for (double y = y0; y <= y1 * 1.001; y *= 10)
-        o << "<line x1='" << left << "' y1='" << py(y) << "' x2='" << w - right << "' y2='" << py(y)
-          << "' stroke='#ddd'/><text x='" << left - 6 << "' y='" << py(y) + 4 << "' text-anchor='end'>" << y
-          << "</text>\n";
-    o << "<text x='" << (left + w - right) / 2 << "' y='" << h - 12
-      << "' text-anchor='middle'>quasi-static solve time, ms (log)</text>\n"
-      << "<text transform='translate(16," << (top + h - bottom) / 2
-      << ") rotate(-90)' text-anchor='middle'>relative error of the deformed surface, % (log)</text>\n";
-    const char* colours[] = {"#1f77b4", "#d62728"};
-    for (std::size_t s = 0; s < series.size(); ++s) {
-        std::string path;
-        for (std::size_t i = 0; i < series[s].second.size(); ++i) {
-            if (errors[s][i] <= 0) continue;
-            const double x = px(series[s].second[i].solve_ms), y = py(100 * errors[s][i]);
-            path += (path.empty() ? "M" : " L") + std::to_string(x) + " " + std::to_string(y);
-            o << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colours[s] << "'/><text x='" << x + 6
-              << "' y='" << y - 6 << "' fill='" << colours[s] << "'>L" << series[s].second[i].level << "</text>\n";
-        }
-        o << "<path d='" << path << "' fill='none' stroke='" << colours[s] << "'/>\n";
-        o << "<text x='" << w - right - 150 << "' y='" << top + 16 + 16 * s << "' fill='" << colours[s] << "'>"
-          << series[s].first << "</text>\n";
-    }
-    o << "</svg>\n";
-    return o.str();
 }
 
 } // namespace
@@ -208,8 +150,8 @@ void run_tradeoff(const std::filesystem::path& out, bool liver)
               "CG iterations |\n|---|---|---|---|---|---|---|\n";
         for (const Solution& s : liver_rows) {
             double rms = 0.0;
-            for (const auto& [key, u] : s.displacement) rms += u.squaredNorm();
-            rms = std::sqrt(rms / static_cast<double>(s.displacement.size()));
+            for (const auto& [key, u] : s.surface.displacement_mm) rms += u.squaredNorm();
+            rms = std::sqrt(rms / static_cast<double>(s.surface.displacement_mm.size()));
             const double error = s.level == k_liver_reference ? 0.0 : relative_error(s, liver_rows.front());
             liver_errors.push_back(error);
             char line[256];
@@ -236,8 +178,14 @@ void run_tradeoff(const std::filesystem::path& out, bool liver)
     std::filesystem::create_directories(out);
     write_atomically(out / "tradeoff.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << md.str(); });
     write_atomically(out / "tradeoff.json", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << data.dump(1) << '\n'; });
+    std::vector<PlotSeries> plot;
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        plot.push_back({series[k].first, {}});
+        for (std::size_t i = 0; i < series[k].second.size(); ++i)
+            plot.back().points.push_back({series[k].second[i].solve_ms, 100 * errors[k][i], std::string("L").append(std::to_string(series[k].second[i].level))});
+    }
     write_atomically(out / "tradeoff.svg", [&](const std::filesystem::path& tmp) {
-        std::ofstream(tmp) << svg_plot(series, errors);
+        std::ofstream(tmp) << log_log_plot(plot, "quasi-static solve time, ms (log)", "relative error of the deformed surface, % (log)");
     });
     std::printf("%s\nwrote %s and %s\n", md.str().c_str(), (out / "tradeoff.md").c_str(), (out / "tradeoff.svg").c_str());
 }

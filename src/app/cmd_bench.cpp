@@ -11,6 +11,7 @@
 #include "bench/harness/haptics.hpp"
 #include "bench/harness/stability.hpp"
 #include "bench/harness/tradeoff.hpp"
+#include "bench/harness/two_levels.hpp"
 #include "core/error.hpp"
 
 #include <CLI/CLI.hpp>
@@ -34,6 +35,15 @@ void add_bench_command(CLI::App& app)
     tradeoff->add_option("--out", *out, "Folder for tradeoff.md and tradeoff.svg (default out)");
     tradeoff->add_flag("--skip-liver", *skip_liver, "Only the beam (faster)");
     tradeoff->callback([out, skip_liver] { run_tradeoff(*out, !*skip_liver); });
+
+    auto levels_out = std::make_shared<std::string>("out");
+    auto levels_skip_liver = std::make_shared<bool>(false);
+    CLI::App* levels = bench->add_subcommand(
+        "levels", "Two levels (fine at the tools, coarse elsewhere) against the uniform fine and coarse levels, pressing and cutting a beam "
+                  "and the liver: tables and SVG plots");
+    levels->add_option("--out", *levels_out, "Folder for levels.md, levels.json and the plots (default out)");
+    levels->add_flag("--skip-liver", *levels_skip_liver, "Only the beam (a minute; the liver takes several: its uniform level 2 takes seconds a frame)");
+    levels->callback([levels_out, levels_skip_liver] { run_two_levels_bench(*levels_out, !*levels_skip_liver); });
 
     auto seconds = std::make_shared<double>(10.0);
     CLI::App* haptics = bench->add_subcommand("haptics", "Period error and force time of the 1 kHz loop beside a running simulation");
