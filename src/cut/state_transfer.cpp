@@ -11,6 +11,8 @@ namespace {
 std::uint64_t key(int level, std::uint32_t grid_element) { return (std::uint64_t{static_cast<std::uint32_t>(level)} << 32) | grid_element; }
 std::uint64_t key(const fem::HexElement& el) { return key(el.level, el.grid_element); }
 
+int node_level(const fem::HexModel& model, std::uint32_t n) { return model.node_levels().empty() ? model.level() : model.node_levels()[n]; }
+
 /// A model of two levels: its tied nodes placed and moving on the field of the coarse nodes they
 /// follow (the transfer gave them the old field, which a fine region may have bent past it).
 void follow_ties(const fem::HexModel& model, fem::ImplicitSolver& solver)
@@ -110,6 +112,30 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
     std::vector<Eigen::Vector3d>& v = new_solver.velocities();
     const auto& new_rest = new_model.rest_positions();
     std::vector<unsigned char> done(new_model.node_count(), 0);
+    // What both models have keeps its state as it is: a node on the same grid node of the same
+    // level, an element on the same grid element (a move of the fine region changes a few cells;
+    // searching every coarse element's thousands of voxels took most of a move on the liver).
+    std::array<std::vector<std::uint32_t>, 2> old_node; // per level of old_element: grid node -> old node
+    for (std::uint32_t n = 0; n < old_model.grid_node().size(); ++n) {
+        const int level = node_level(old_model, n);
+        const std::size_t k = level == old_element.front().first ? 0 : 1;
+        if (old_node[k].empty()) old_node[k].assign(grid.level(level).node_users.size(), grid::no_index);
+        old_node[k][old_model.grid_node()[n]] = n;
+    }
+    const auto twin = [&](int level, std::uint32_t id, bool node) {
+        for (std::size_t k = 0; k < old_element.size(); ++k) {
+            if (old_element[k].first != level) continue;
+            const std::vector<std::uint32_t>& ids = node ? old_node[k] : old_element[k].second;
+            return id < ids.size() ? ids[id] : grid::no_index;
+        }
+        return grid::no_index;
+    };
+    for (std::uint32_t n = 0; n < new_model.grid_node().size(); ++n)
+        if (const std::uint32_t o = twin(node_level(new_model, n), new_model.grid_node()[n], true); o != grid::no_index) {
+            x[n] = old_solver.positions()[o];
+            v[n] = old_solver.velocities()[o];
+            done[n] = 1;
+        }
     const bool wet = [&] {
         for (std::uint32_t e = 0; e < old_model.elements().size(); ++e)
             if (old_solver.water(e) > 0.0) return true;
@@ -117,6 +143,12 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
     }();
     for (std::uint32_t e = 0; e < new_model.elements().size(); ++e) {
         const fem::HexElement& me = new_model.elements()[e];
+        const std::uint32_t same = twin(me.level, me.grid_element, false);
+        if (same != grid::no_index) {
+            if (const double w = old_solver.water(same); w > 0.0) new_solver.set_water(e, w);
+            if (old_solver.has_plasticity()) new_solver.set_plastic_strain(e, old_solver.plastic_strain(same));
+            if (std::all_of(me.dof_node.begin(), me.dof_node.end(), [&](std::uint32_t n) { return done[n] != 0; })) continue;
+        }
         const grid::Element& ge = grid.level(me.level).elements[me.grid_element];
         // Per corner, the element's voxel nearest it (its material is what the node follows).
         std::array<Eigen::Vector3d, 8> corner;
@@ -133,7 +165,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
                     best[c] = d;
                     nearest[c] = voxel;
                 }
-            if (wet || old_solver.has_plasticity()) {
+            if (same == grid::no_index && (wet || old_solver.has_plasticity())) {
                 const std::uint32_t source = holding(voxel);
                 water += old_solver.water(source);
                 if (old_solver.has_plasticity()) plastic += old_solver.plastic_strain(source);
@@ -141,8 +173,8 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
         }
         if (ge.voxels.empty()) continue;
         const double voxels = static_cast<double>(ge.voxels.size());
-        if (water > 0.0) new_solver.set_water(e, water / voxels);
-        if (old_solver.has_plasticity()) new_solver.set_plastic_strain(e, plastic / voxels);
+        if (same == grid::no_index && water > 0.0) new_solver.set_water(e, water / voxels);
+        if (same == grid::no_index && old_solver.has_plasticity()) new_solver.set_plastic_strain(e, plastic / voxels);
         for (int c = 0; c < 8; ++c) {
             const std::uint32_t n = me.dof_node[static_cast<std::size_t>(c)];
             if (done[n]) continue;

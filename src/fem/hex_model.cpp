@@ -57,7 +57,8 @@ HexModel::HexModel(const grid::BranchedGrid& grid, int level, const HexModel& pr
     add_mass_floor(grid);
 }
 
-HexModel::HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed)
+HexModel::HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed, const HexModel* previous,
+                   const std::array<const std::vector<unsigned char>*, 2>& changed)
     : m_level(mixed.fine()), m_coarse_level(mixed.coarse()), m_materials(grid.materials()), m_ties(mixed.ties())
 {
     const Eigen::Matrix4d& t = grid.voxels().index_to_world();
@@ -65,17 +66,39 @@ HexModel::HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixe
     m_frame = t.topLeftCorner<3, 3>() * (h * 1e3).cwiseInverse().asDiagonal();
     for (const Eigen::Vector3d& p : mixed.rest_positions_mm()) m_rest_world.push_back(p * 1e-3);
     m_nodal_mass.assign(m_rest_world.size(), 0.0);
-    for (std::uint32_t n = 0; n < m_rest_world.size(); ++n) m_node_level.push_back(mixed.node_level(n));
+    for (std::uint32_t n = 0; n < m_rest_world.size(); ++n) {
+        m_node_level.push_back(mixed.node_level(n));
+        m_grid_node.push_back(mixed.grid_node(n));
+    }
     // Each level's full cells share their matrices (reserved first: elements point into them).
     const std::size_t materials = grid.materials().size();
     m_full_stiffness.reserve(2 * materials);
     for (int level : {mixed.fine(), mixed.coarse()})
         for (const grid::ElasticMaterial& m : grid.materials())
             m_full_stiffness.push_back(to_component_major(static_cast<double>(1 << level) * grid::hex8_stiffness(h, m.lame)));
+    // Elements of `previous` by level (fine, coarse) and grid element, for those the change left
+    // alone: a move of the fine region re-evaluates only the elements new to the model.
+    std::array<std::vector<std::uint32_t>, 2> kept;
+    if (previous)
+        for (std::uint32_t e = 0; e < previous->elements().size(); ++e) {
+            const HexElement& old = previous->elements()[e];
+            const int k = old.level == mixed.fine() ? 0 : old.level == mixed.coarse() ? 1 : -1;
+            if (k < 0) continue;
+            const std::vector<unsigned char>* flags = changed[static_cast<std::size_t>(k)];
+            if (flags && old.grid_element < flags->size() && (*flags)[old.grid_element]) continue;
+            std::vector<std::uint32_t>& ids = kept[static_cast<std::size_t>(k)];
+            if (ids.empty()) ids.assign(grid.level(old.level).elements.size(), grid::no_index);
+            if (old.grid_element < ids.size()) ids[old.grid_element] = e;
+        }
     m_partial_stiffness.reserve(mixed.elements().size());
     m_elements.reserve(mixed.elements().size());
-    for (const grid::MixedLevels::Element& el : mixed.elements())
-        add_grid_element(grid, el.level, el.element, el.nodes, m_full_stiffness.data() + (el.level == mixed.fine() ? 0 : materials), nullptr, nullptr);
+    for (const grid::MixedLevels::Element& el : mixed.elements()) {
+        const std::size_t k = el.level == mixed.fine() ? 0 : 1;
+        const std::uint32_t old = el.element < kept[k].size() ? kept[k][el.element] : grid::no_index;
+        add_grid_element(grid, el.level, el.element, el.nodes, m_full_stiffness.data() + k * materials,
+                         old == grid::no_index ? nullptr : &previous->elements()[old],
+                         old == grid::no_index ? nullptr : previous->m_partial_stiffness[old]);
+    }
     add_mass_floor(grid);
 }
 

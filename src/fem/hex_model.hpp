@@ -43,8 +43,13 @@ public:
     HexModel(const grid::BranchedGrid& grid, int level, const HexModel& previous, const std::vector<unsigned char>& changed);
     /// The model of two levels joined (grid/mixed_levels.hpp): its elements of both levels, its
     /// nodes numbered as `mixed` numbers them, and its border nodes tied to the coarse side.
-    /// level() is the fine level; grid_node() and dense_node() are empty.
-    HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed);
+    /// level() is the fine level; grid_node() holds each node's grid node at its own level
+    /// (node_levels()), and dense_node() is empty. Elements of `previous`
+    /// (a model of the same two levels: before the fine region moved, or before a cut) that
+    /// `changed` does not flag (per level, fine then coarse, per grid element; null: none changed)
+    /// keep their stiffness and mass.
+    HexModel(const grid::BranchedGrid& grid, const grid::MixedLevels& mixed, const HexModel* previous = nullptr,
+             const std::array<const std::vector<unsigned char>*, 2>& changed = {});
 
     [[nodiscard]] int level() const { return m_level; }
     /// The coarse level of a model of two levels; level() for one level.
@@ -60,7 +65,8 @@ public:
     /// Rest positions of the nodes, world frame, m.
     [[nodiscard]] const std::vector<Eigen::Vector3d>& rest_positions() const { return m_rest_world; }
     /// Grid node id of each dense node, and the dense index of each grid node id (or no_index);
-    /// empty at level 0, whose nodes exist only in this model.
+    /// empty at level 0, whose nodes exist only in this model. Two levels: the grid node at the
+    /// node's own level, and no dense index.
     [[nodiscard]] const std::vector<std::uint32_t>& grid_node() const { return m_grid_node; }
     [[nodiscard]] const std::vector<std::uint32_t>& dense_node() const { return m_dense_node; }
     /// Orthonormal part of the index-to-world map: world = frame * index-aligned (a reflection

@@ -151,7 +151,7 @@ void DbgSimulation::set_region(RegionCells cells)
     std::unique_ptr<fem::HexModel> old_model = std::move(m_model);
     std::unique_ptr<fem::ImplicitSolver> old_solver = std::move(m_solver);
     m_model_surface.reset(); // it refers to the old model
-    build(Build::region);
+    build(Build::region, old_model.get());
     cut::transfer_between_levels(*m_grid, *old_model, *old_solver, *m_model, *m_solver);
     rest_held_nodes();
     m_model_surface = std::make_unique<cut::ModelSurface>(*m_grid, *m_model, *m_surface);
@@ -348,12 +348,15 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     const grid::BranchedGrid& grid = *m_grid;
     const int level = m_level;
     std::vector<unsigned char> changed, changed_coarse; // per grid element of the level (and the coarse one): touched by the cut
-    if (previous && level >= 1) {
+    if (previous && report && level >= 1) {
         changed = changed_elements(grid, level, *report);
         if (m_mixed) changed_coarse = changed_elements(grid, m_mixed->coarse(), *report);
     }
     if (m_mixed) {
-        m_model = std::make_unique<fem::HexModel>(grid, *m_mixed);
+        // After a cut the elements it changed are evaluated again; after a move of the region, the
+        // elements new to the model.
+        m_model = std::make_unique<fem::HexModel>(grid, *m_mixed, previous,
+                                                  std::array<const std::vector<unsigned char>*, 2>{report ? &changed : nullptr, report ? &changed_coarse : nullptr});
     } else if (previous && level >= 1) {
         // The elements the change touched; all others keep their matrices.
         m_model = std::make_unique<fem::HexModel>(grid, level, *previous, changed);

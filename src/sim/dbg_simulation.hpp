@@ -112,7 +112,8 @@ private:
     /// A move of the fine region keeps the grid: what the boxes hold stays measured.
     enum class Build { first, level_change, cut, region };
     /// Model, solver, preconditioner, materials, constraints and loads at m_level. After a cut,
-    /// `previous` and `report` let unchanged elements keep their matrices, and `previous_solver`
+    /// `previous` and `report` let unchanged elements keep their matrices (after a move of the fine
+    /// region, `previous` alone: the grid is the same), and `previous_solver`
     /// lends its matrix pattern when the elements sit on the same nodes.
     void build(Build kind, const fem::HexModel* previous = nullptr, const grid::UpdateReport* report = nullptr,
                const fem::ImplicitSolver* previous_solver = nullptr);

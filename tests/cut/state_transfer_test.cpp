@@ -186,3 +186,79 @@ TEST(StateTransferTwoLevels, ACutOnTwoLevelsCarriesTheStateOver)
     cut::transfer_state(report, old_model, old_solver, new_model, new_solver);
     expect_fields(new_model, new_solver);
 }
+
+TEST(StateTransferTwoLevels, AModelRebuiltFromTheOldOneEqualsAFreshOne)
+{
+    // The fine region moved, then a cut: elements kept from the model before must carry the same
+    // matrices as those a fresh build evaluates.
+    grid::BranchedGrid grid = test::block_grid({16, 8, 8}, 3);
+    const fem::HexModel left(grid, refining(grid, 0));
+    const grid::MixedLevels right_cells = refining(grid, 1);
+    const fem::HexModel moved(grid, right_cells, &left), fresh(grid, right_cells);
+    const auto same = [](const fem::HexModel& a, const fem::HexModel& b) {
+        ASSERT_EQ(a.elements().size(), b.elements().size());
+        for (std::size_t e = 0; e < a.elements().size(); ++e) {
+            const fem::HexElement &x = a.elements()[e], &y = b.elements()[e];
+            EXPECT_EQ(x.level, y.level);
+            EXPECT_EQ(x.grid_element, y.grid_element);
+            EXPECT_EQ(*x.stiffness, *y.stiffness) << e;
+            EXPECT_EQ(x.mass, y.mass) << e;
+        }
+        EXPECT_EQ(a.nodal_mass(), b.nodal_mass());
+    };
+    same(moved, fresh);
+    // A slit through both cells: the elements it touched are evaluated again, the others kept.
+    std::vector<std::pair<grid::Coord, int>> faces;
+    for (int x = 0; x < 16; ++x)
+        for (int y = 0; y < 5; ++y) faces.emplace_back(grid::Coord(x, y, 4), 2);
+    const grid::UpdateReport report = grid.update({}, faces);
+    std::array<std::vector<unsigned char>, 2> changed;
+    for (int k = 0; k < 2; ++k) {
+        const int level = k == 0 ? 1 : 3;
+        changed[k].assign(grid.level(level).elements.size(), 0);
+        for (const auto& [e, from] : report.levels[static_cast<std::size_t>(level)].created) changed[k][e] = 1;
+        for (std::uint32_t e : report.levels[static_cast<std::size_t>(level)].updated) changed[k][e] = 1;
+    }
+    const grid::MixedLevels cut_cells = refining(grid, 1);
+    const fem::HexModel reused(grid, cut_cells, &fresh, {&changed[0], &changed[1]}), rebuilt(grid, cut_cells);
+    same(reused, rebuilt);
+}
+
+TEST(StateTransferTwoLevels, NodesBothModelsHaveKeepTheirStateAsItIs)
+{
+    // Any state, not only an affine one: a node on the same grid node of the same level in both
+    // models keeps its position and velocity exactly (unless it is now tied, then it follows its
+    // coarse nodes), whatever the fine region did elsewhere.
+    // Three level-3 cells along x: the region moves from cells 0 and 1 to cells 1 and 2.
+    const grid::BranchedGrid grid = test::block_grid({24, 8, 8}, 3);
+    const auto cells = [&](int lo, int hi) {
+        return grid::MixedLevels(grid, 1, 3, [&, lo, hi](std::uint32_t e) {
+            const int x = grid.level(3).elements[e].cell.x();
+            return x >= lo && x <= hi;
+        });
+    };
+    const fem::HexModel a(grid, cells(0, 1)), b(grid, cells(1, 2));
+    fem::SolverOptions o;
+    fem::ImplicitSolver sa(a, o), sb(b, o);
+    for (std::uint32_t n = 0; n < a.node_count(); ++n) {
+        sa.positions()[n] = a.rest_positions()[n] + 1e-4 * Eigen::Vector3d::Random();
+        sa.velocities()[n] = Eigen::Vector3d::Random();
+    }
+    cut::transfer_between_levels(grid, a, sa, b, sb);
+    std::vector<unsigned char> tied(b.node_count(), 0);
+    for (const grid::MixedLevels::Tie& t : b.ties()) tied[t.node] = 1;
+    std::size_t shared = 0;
+    for (std::uint32_t m = 0; m < b.node_count(); ++m)
+        for (std::uint32_t n = 0; n < a.node_count(); ++n)
+            if (!tied[m] && a.node_levels()[n] == b.node_levels()[m] && a.grid_node()[n] == b.grid_node()[m]) {
+                EXPECT_EQ(sb.positions()[m], sa.positions()[n]) << m;
+                EXPECT_EQ(sb.velocities()[m], sa.velocities()[n]) << m;
+                ++shared;
+            }
+    EXPECT_EQ(shared, 100u) << "cell 1's 125 fine nodes but the 25 tied to cell 0 in the new model";
+    for (const grid::MixedLevels::Tie& t : b.ties()) {
+        Eigen::Vector3d u = Eigen::Vector3d::Zero();
+        for (std::size_t c = 0; c < 8; ++c) u += t.weights[c] * (sb.positions()[t.masters[c]] - b.rest_positions()[t.masters[c]]);
+        EXPECT_LT((sb.positions()[t.node] - b.rest_positions()[t.node] - u).norm(), 1e-15);
+    }
+}
