@@ -414,8 +414,8 @@ void measure_slack(const PlacedShape& tool, double margin_mm, SurfacePoints& poi
         points.slack_radius_mm = std::max(points.slack_radius_mm, (points.positions_mm[i] - tool.position).norm());
     }
     PointGrid& grid = points.grid;
-    grid.point_slack.resize(grid.points.size());
-    for (std::size_t k = 0; k < grid.points.size(); ++k) grid.point_slack[k] = stored(distance[grid.points[k]] - margin_mm);
+    grid.point_slack.resize(points.count);
+    for (std::size_t k = 0; k < points.count; ++k) grid.point_slack[k] = stored(distance[k] - margin_mm);
     grid.edge_slack.resize(grid.edges.size());
     for (std::size_t k = 0; k < grid.edges.size(); ++k) {
         const auto a = static_cast<std::size_t>(grid.edges[k].ends[0]), b = static_cast<std::size_t>(grid.edges[k].ends[1]);

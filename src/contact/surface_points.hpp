@@ -42,7 +42,9 @@ struct PointGrid {
     double cell_mm = 0.0; ///< 0: no grid, every point and edge is visited
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();
     Eigen::Vector3i cells = Eigen::Vector3i::Zero();
-    std::vector<std::uint32_t> point_start, points; ///< per cell (and one more) into `points`: point indices
+    /// Per cell (and one more), where its points begin: index() stores the points cell by cell,
+    /// so cell c holds points point_start[c] .. point_start[c + 1] - 1.
+    std::vector<std::uint32_t> point_start;
     /// An edge as a tick reads it: its ends, and the ball around it (middle and half its length),
     /// which rejects most edges near the tool without reading their ends' positions.
     struct Edge {
@@ -52,9 +54,8 @@ struct PointGrid {
     };
     std::vector<std::uint32_t> edge_start; ///< per cell (and one more) into `edges`
     std::vector<Edge> edges;               ///< cell by cell
-    /// The slack (SurfacePoints::slack_pose) of each entry of `points` and of `edges`, mm, in the
-    /// same order, so that a tick reads the slack of what it leaves out and nothing more; empty:
-    /// no slack.
+    /// The slack (SurfacePoints::slack_pose) of each point and of each entry of `edges`, mm, so
+    /// that a tick reads the slack of what it leaves out and nothing more; empty: no slack.
     std::vector<float> point_slack, edge_slack;
     double longest_edge_mm = 0.0;
 };
@@ -96,8 +97,9 @@ struct SurfacePoints {
     }
     [[nodiscard]] std::size_t capacity() const { return positions_mm.size(); }
 
-    /// After the points and triangles are filled (simulation thread): the triangles' tree, their
-    /// edges and the points' grid.
+    /// After the points and triangles are filled (simulation thread): the points' grid, the
+    /// points reordered cell by cell (the triangles follow them), the triangles' tree and their
+    /// edges.
     void index();
 
     /// How far the points may have come nearer to `tool` (pushing margin `margin_mm`) than they
@@ -117,10 +119,10 @@ struct SurfacePoints {
             for (std::size_t i = 0; i < count; ++i) visit(i);
             return;
         }
-        const bool slack = spent < INFINITY && grid.point_slack.size() == grid.points.size();
+        const bool slack = spent < INFINITY && grid.point_slack.size() == count;
         for_each_cell(box, [&](std::size_t c) {
             for (std::uint32_t k = grid.point_start[c]; k < grid.point_start[c + 1]; ++k)
-                if (!slack || grid.point_slack[k] <= spent) visit(static_cast<std::size_t>(grid.points[k]));
+                if (!slack || grid.point_slack[k] <= spent) visit(static_cast<std::size_t>(k));
         });
     }
     /// Calls visit(edge) (its two ends) for every edge that may meet `box` (at least those that
