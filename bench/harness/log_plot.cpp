@@ -45,7 +45,7 @@ std::string log_log_plot(const std::vector<PlotSeries>& series, const std::strin
             o << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colour << "'/><text x='" << x + 6 << "' y='" << y - 6
               << "' fill='" << colour << "'>" << p.label << "</text>\n";
         }
-        o << "<path d='" << path << "' fill='none' stroke='" << colour << "'/>\n";
+        if (series[s].joined) o << "<path d='" << path << "' fill='none' stroke='" << colour << "'/>\n";
         o << "<text x='" << w - right - 190 << "' y='" << top + 16 + 16 * s << "' fill='" << colour << "'>" << series[s].name << "</text>\n";
     }
     o << "</svg>\n";

@@ -230,8 +230,8 @@ void run_two_levels_bench(const std::filesystem::path& out, bool liver)
               "faces opened (apart from the reference's) | frame median (ms) | frame p95 (ms) | time vs fine | region moves | converged frames |\n"
            << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         nlohmann::json rows = nlohmann::json::array();
-        force_plot.push_back({c.name, {}});
-        surface_plot.push_back({c.name, {}});
+        force_plot.push_back({c.name, {}, false}); // the rows are models, not a sequence
+        surface_plot.push_back({c.name, {}, false});
         for (const Run& r : runs) {
             const double fe = force_error(r, reference), se = surface_error(r, reference, c.near_mm);
             const double median = quantile(r.frame_ms, 0.5), p95 = quantile(r.frame_ms, 0.95);
