@@ -31,6 +31,46 @@ void follow_ties(const fem::HexModel& model, fem::ImplicitSolver& solver)
     }
 }
 
+/// A model's elements and nodes by level and grid id, for the one or two levels it has (fine
+/// first); no_index where it has none there.
+class ModelIndex {
+public:
+    ModelIndex(const grid::BranchedGrid& grid, const fem::HexModel& model) : m_grid(grid)
+    {
+        for (const int level : {model.level(), model.coarse_level()})
+            if (m_levels.empty() || m_levels.back().level != level)
+                m_levels.push_back({level, std::vector<std::uint32_t>(grid.level(level).elements.size(), grid::no_index),
+                                    std::vector<std::uint32_t>(grid.level(level).node_users.size(), grid::no_index)});
+        for (std::uint32_t e = 0; e < model.elements().size(); ++e)
+            at(model.elements()[e].level).elements[model.elements()[e].grid_element] = e;
+        for (std::uint32_t n = 0; n < model.grid_node().size(); ++n) at(node_level(model, n)).nodes[model.grid_node()[n]] = n;
+    }
+    [[nodiscard]] std::uint32_t element(int level, std::uint32_t id) const { return find(level, id, &Level::elements); }
+    [[nodiscard]] std::uint32_t node(int level, std::uint32_t id) const { return find(level, id, &Level::nodes); }
+    /// The element holding fine voxel `voxel` (the fine level's, else the coarse one's).
+    [[nodiscard]] std::uint32_t holding(std::uint32_t voxel) const
+    {
+        for (const Level& l : m_levels)
+            if (const std::uint32_t e = l.elements[m_grid.element_of(voxel, l.level)]; e != grid::no_index) return e;
+        throw std::logic_error("transfer_between_levels: a voxel in no element of the old model");
+    }
+
+private:
+    struct Level {
+        int level;
+        std::vector<std::uint32_t> elements, nodes; ///< by grid element, by grid node
+    };
+    Level& at(int level) { return m_levels.front().level == level ? m_levels.front() : m_levels.back(); }
+    std::uint32_t find(int level, std::uint32_t id, std::vector<std::uint32_t> Level::*ids) const
+    {
+        for (const Level& l : m_levels)
+            if (l.level == level) return id < (l.*ids).size() ? (l.*ids)[id] : grid::no_index;
+        return grid::no_index;
+    }
+    const grid::BranchedGrid& m_grid;
+    std::vector<Level> m_levels;
+};
+
 } // namespace
 
 void transfer_state(const grid::UpdateReport& report, const fem::HexModel& old_model, const fem::ImplicitSolver& old_solver,
@@ -74,23 +114,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
                              const fem::HexModel& new_model, fem::ImplicitSolver& new_solver)
 {
     if (old_model.level() < 1 || new_model.level() < 1) throw std::invalid_argument("transfer_between_levels: levels start at 1");
-    // The old model element holding a voxel: per level the old model has (one, or a model of
-    // two: fine first), grid element -> model element.
-    std::vector<std::pair<int, std::vector<std::uint32_t>>> old_element;
-    for (const int level : {old_model.level(), old_model.coarse_level()}) {
-        if (!old_element.empty() && old_element.back().first == level) continue;
-        old_element.emplace_back(level, std::vector<std::uint32_t>(grid.level(level).elements.size(), grid::no_index));
-    }
-    for (std::uint32_t e = 0; e < old_model.elements().size(); ++e) {
-        const fem::HexElement& el = old_model.elements()[e];
-        for (auto& [level, ids] : old_element)
-            if (level == el.level) ids[el.grid_element] = e;
-    }
-    const auto holding = [&](std::uint32_t voxel) {
-        for (const auto& [level, ids] : old_element)
-            if (const std::uint32_t e = ids[grid.element_of(voxel, level)]; e != grid::no_index) return e;
-        throw std::logic_error("transfer_between_levels: a voxel in no element of the old model");
-    };
+    const ModelIndex old_index(grid, old_model);
     const auto& old_x = old_solver.positions();
     const auto& old_v = old_solver.velocities();
     const auto& old_rest = old_model.rest_positions();
@@ -115,23 +139,8 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
     // What both models have keeps its state as it is: a node on the same grid node of the same
     // level, an element on the same grid element (a move of the fine region changes a few cells;
     // searching every coarse element's thousands of voxels took most of a move on the liver).
-    std::array<std::vector<std::uint32_t>, 2> old_node; // per level of old_element: grid node -> old node
-    for (std::uint32_t n = 0; n < old_model.grid_node().size(); ++n) {
-        const int level = node_level(old_model, n);
-        const std::size_t k = level == old_element.front().first ? 0 : 1;
-        if (old_node[k].empty()) old_node[k].assign(grid.level(level).node_users.size(), grid::no_index);
-        old_node[k][old_model.grid_node()[n]] = n;
-    }
-    const auto twin = [&](int level, std::uint32_t id, bool node) {
-        for (std::size_t k = 0; k < old_element.size(); ++k) {
-            if (old_element[k].first != level) continue;
-            const std::vector<std::uint32_t>& ids = node ? old_node[k] : old_element[k].second;
-            return id < ids.size() ? ids[id] : grid::no_index;
-        }
-        return grid::no_index;
-    };
     for (std::uint32_t n = 0; n < new_model.grid_node().size(); ++n)
-        if (const std::uint32_t o = twin(node_level(new_model, n), new_model.grid_node()[n], true); o != grid::no_index) {
+        if (const std::uint32_t o = old_index.node(node_level(new_model, n), new_model.grid_node()[n]); o != grid::no_index) {
             x[n] = old_solver.positions()[o];
             v[n] = old_solver.velocities()[o];
             done[n] = 1;
@@ -143,7 +152,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
     }();
     for (std::uint32_t e = 0; e < new_model.elements().size(); ++e) {
         const fem::HexElement& me = new_model.elements()[e];
-        const std::uint32_t same = twin(me.level, me.grid_element, false);
+        const std::uint32_t same = old_index.element(me.level, me.grid_element);
         if (same != grid::no_index) {
             if (const double w = old_solver.water(same); w > 0.0) new_solver.set_water(e, w);
             if (old_solver.has_plasticity()) new_solver.set_plastic_strain(e, old_solver.plastic_strain(same));
@@ -166,7 +175,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
                     nearest[c] = voxel;
                 }
             if (same == grid::no_index && (wet || old_solver.has_plasticity())) {
-                const std::uint32_t source = holding(voxel);
+                const std::uint32_t source = old_index.holding(voxel);
                 water += old_solver.water(source);
                 if (old_solver.has_plasticity()) plastic += old_solver.plastic_strain(source);
             }
@@ -180,7 +189,7 @@ void transfer_between_levels(const grid::BranchedGrid& grid, const fem::HexModel
             if (done[n]) continue;
             done[n] = 1;
             Eigen::Vector3d u, velocity;
-            field_at(old_model.elements()[holding(nearest[c])], corner[c], u, velocity);
+            field_at(old_model.elements()[old_index.holding(nearest[c])], corner[c], u, velocity);
             x[n] = new_rest[n] + u;
             v[n] = velocity;
         }
