@@ -1,5 +1,7 @@
 #include "contact/surface_points.hpp"
 
+#include <type_traits>
+
 namespace vox::contact {
 
 void SurfacePoints::index()
@@ -38,7 +40,7 @@ void SurfacePoints::index()
     for (std::size_t i = 0; i < count; ++i) moved_to[i] = static_cast<int>(fill[point_cell[i]]++);
     const auto reorder = [&](auto& values) {
         if (values.size() < count) return;
-        auto sorted = values;
+        std::remove_reference_t<decltype(values)> sorted(count); // the points in use, not the whole capacity
         for (std::size_t i = 0; i < count; ++i) sorted[static_cast<std::size_t>(moved_to[i])] = values[i];
         std::copy_n(sorted.begin(), count, values.begin());
     };

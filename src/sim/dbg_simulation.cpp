@@ -370,13 +370,13 @@ void DbgSimulation::build(Build kind, const fem::HexModel* previous, const grid:
     // The material each box holds: measured afresh, or after a cut in the elements it changed.
     // A move of the fine region keeps the grid, and so what the boxes hold.
     const bool after_cut = kind == Build::cut && previous && level >= 1 && !m_boxes.empty();
-    if (!after_cut && kind != Build::region) {
+    if (kind != Build::region && !after_cut) {
         m_boxes.clear();
         for (const io::Constraint& c : scene.constraints) m_boxes.emplace_back(c.box_min_mm, c.box_max_mm);
         for (const io::Load& l : scene.loads) m_boxes.emplace_back(l.box_min_mm, l.box_max_mm);
     }
     for (BoxMaterial& b : m_boxes) {
-        if (kind == Build::region) break;
+        if (kind == Build::region) continue; // measured already
         b.update(grid, level, after_cut ? &changed : nullptr);
         if (m_mixed) b.update(grid, m_mixed->coarse(), after_cut ? &changed_coarse : nullptr);
     }
