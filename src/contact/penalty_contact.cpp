@@ -334,6 +334,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     // +infinity.
     const double spent = points.slack_spent(tool, parameters.margin_mm);
     points.for_each_point_near(reach, [&](std::size_t i) {
+        if (points.is_replaced(i)) return; // the contact patch has it
         const Eigen::Vector3d& p = points.positions_mm[i];
         const bool inside = point_penalty(tool, nullptr, parameters_of(i), reach, p, points.areas_mm2[i], points.normals[i], pp);
         if (keep && pp.measured) distance[i] = pp.distance;
@@ -368,7 +369,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     auto for_each_pressed_edge = [&](auto&& visit) {
         points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
             const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-            if (b >= points.count || !may_reach_in(a, b)) return;
+            if (b >= points.count || points.is_replaced(a) || points.is_replaced(b) || !may_reach_in(a, b)) return;
             const double d_a = measured(a), d_b = measured(b);
             if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
                              points.areas_mm2[b], points.normals[a], points.normals[b], ep))
@@ -387,6 +388,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     const Eigen::Vector3d net = -out.force_on_tool_n;
     double magnitude = 0.0;
     points.for_each_point_near(reach, [&](std::size_t i) {
+        if (points.is_replaced(i)) return;
         if (!point_penalty(tool, nullptr, parameters_of(i), reach, points.positions_mm[i], points.areas_mm2[i], points.normals[i], pp))
             return;
         if (!carries_load(pp.force, net)) return;

@@ -8,6 +8,8 @@ void SurfacePoints::index()
 {
     grid = PointGrid{};
     slack_pose = PlacedShape{}; // measured anew for these positions, if at all
+    patch.count = patch.free = 0; // built anew around the contact, if at all (contact/contact_patch.hpp)
+    replaced.clear();
     if (count == 0) {
         triangle_tree.rebuild({}, {}, triangles);
         edges.clear();

@@ -60,6 +60,36 @@ struct PointGrid {
     double longest_edge_mm = 0.0;
 };
 
+/// The subdivided patch of surface at a tool's contact (contact/contact_patch.hpp), built with the
+/// snapshot in the simulation thread; the haptic thread displaces its points (ContactPatchState).
+/// Its points are the Loop-subdivided triangles around the contact: the first `free` move along
+/// their inward normal against home springs (to where the snapshot has them) and mesh springs
+/// (along the fine edges); the rest, its border on the snapshot's surface, stay.
+struct PatchLayer {
+    std::size_t count = 0;                    ///< points (0: no patch)
+    std::size_t free = 0;                     ///< the first `free` move
+    int level = 0;                            ///< Loop subdivisions of the snapshot's triangles
+    std::vector<Eigen::Vector3d> positions_mm, normals;
+    std::vector<double> areas_mm2;
+    std::vector<Eigen::Vector3i> triangles;
+    std::vector<Eigen::Vector2i> edges;       ///< of the triangles, each once
+    /// Per free point, its mesh neighbours (any point): neighbours[neighbour_start[i] ..].
+    std::vector<std::uint32_t> neighbour_start, neighbours;
+    std::vector<double> home_n_per_mm;        ///< per free point
+    double mesh_n_per_mm = 0.0;               ///< per edge
+    /// Per free point, the load (N, inward) the tool pressed it with where the patch was built:
+    /// the snapshot holds the deformation under it, so the springs carry only what changes.
+    std::vector<double> preload_n;
+    /// Per free point that is a snapshot point carried to the fine level: that point, else -1
+    /// (what the patch hands back: its displacement at the snapshot's points).
+    std::vector<std::int32_t> snapshot_point;
+    /// The FEM's compliance the springs were scaled to: load-weighted displacement per newton,
+    /// and the load's direction, world.
+    double compliance_mm_per_n = 0.0;
+    Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero(); ///< where it was built around
+    double radius_mm = 0.0;
+};
+
 struct SurfacePoints {
     double t_s = -1e300;                      ///< simulated time the positions are from
     std::size_t count = 0;                    ///< points in use (the vectors hold capacity())
@@ -80,6 +110,13 @@ struct SurfacePoints {
 
     /// The points' grid (index()).
     PointGrid grid;
+
+    /// The subdivided patch at the contact, if any (contact/contact_patch.hpp), and per point
+    /// whether the patch stands in for it (empty: none): the contact leaves those points, and the
+    /// edges with such an end, to the patch.
+    PatchLayer patch;
+    std::vector<unsigned char> replaced;
+    [[nodiscard]] bool is_replaced(std::size_t i) const noexcept { return i < replaced.size() && replaced[i] != 0; }
 
     /// What a tick of the 1 kHz loop may leave out (measure_slack, contact/penalty_contact.hpp,
     /// after index()): the tool's pose and margin the snapshot was measured against; per point

@@ -100,8 +100,12 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
     };
     // A triangle with a corner in the contact at the start of the tick is the penalty's (the tool
     // is already against it), left out before anything is computed for it: a knife deep in its
-    // cut lies against hundreds.
+    // cut lies against hundreds. So is one the contact patch stands in for (it gives way under the
+    // tool, which then goes deeper than the snapshot's surface there).
     auto held = [&](const Eigen::Vector3i& f) {
+        if (points.is_replaced(static_cast<std::size_t>(f[0])) || points.is_replaced(static_cast<std::size_t>(f[1])) ||
+            points.is_replaced(static_cast<std::size_t>(f[2])))
+            return true;
         return m_clearance[static_cast<std::size_t>(f[0])] == -INFINITY || m_clearance[static_cast<std::size_t>(f[1])] == -INFINITY ||
                m_clearance[static_cast<std::size_t>(f[2])] == -INFINITY;
     };

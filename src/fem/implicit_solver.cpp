@@ -1019,6 +1019,30 @@ StepStats ImplicitSolver::step()
     return s;
 }
 
+std::vector<Eigen::Vector3d> ImplicitSolver::response(const std::vector<Eigen::Vector3d>& load)
+{
+    if (m_integrator || load.size() != m_x.size()) return {};
+    const auto n = static_cast<Eigen::Index>(3 * m_x.size());
+    const double dt = m_options.dt_s;
+    // The step's system at the current positions, its contact terms (the tools' springs, which
+    // sit in series with what is measured, and the pairs') left out.
+    const double contact_scale = std::exchange(m_contact_scale, 0.0);
+    if (m_options.quasi_static) assemble(0.0, 1.0, system_output());
+    else assemble(1.0 + dt * m_options.rayleigh_mass_per_s, dt * m_options.rayleigh_stiffness_s + dt * dt, system_output());
+    Eigen::VectorXd rhs = Eigen::Map<const Eigen::VectorXd>(load.front().data(), n);
+    apply_constraints(rhs);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+    double residual = 0.0;
+    solve(rhs, x, residual, true); // the step's preconditioner, as it is
+    m_contact_scale = contact_scale;
+    m_matrix_current = false; // the next step assembles its own
+    if (!(residual <= std::max(m_options.cg_tolerance, 1e-3)) || !x.allFinite()) return {};
+    if (!m_options.quasi_static) x *= dt * dt; // a velocity change per unit impulse dt: dt^2 of displacement
+    std::vector<Eigen::Vector3d> out(m_x.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = x.segment<3>(static_cast<Eigen::Index>(3 * i));
+    return out;
+}
+
 Eigen::Vector3d ImplicitSolver::momentum() const
 {
     Eigen::VectorXd mv;

@@ -160,6 +160,13 @@ public:
 
     StepStats step();
 
+    /// How the nodes would move in one step (the quasi-static mode: at equilibrium) under extra
+    /// forces `load` (per node, N), the tools' contact springs left out: (m M + k K)^-1 load
+    /// scaled to a displacement, m (tied nodes following, held ones still). The condensed
+    /// compliance at a contact is load^T response(load). Empty with an integrator (no FEM
+    /// system) or when the solve does not converge (a free object in the quasi-static mode).
+    [[nodiscard]] std::vector<Eigen::Vector3d> response(const std::vector<Eigen::Vector3d>& load);
+
     [[nodiscard]] const std::vector<Eigen::Vector3d>& positions() const { return m_x; }
     [[nodiscard]] std::vector<Eigen::Vector3d>& positions()
     {

@@ -1,6 +1,7 @@
 #include "haptics/coupled_tool.hpp"
 
 #include <algorithm>
+#include <chrono>
 
 namespace vox::haptics {
 
@@ -35,6 +36,17 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     // below both need them.
     const std::span<double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
     m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false, distance);
+    m_patch_us = 0.0;
+    if (surface.patch.free > 0) { // the patch stands in for the snapshot's points at the contact
+        const auto start = std::chrono::steady_clock::now();
+        const contact::ContactTotals patch = m_patch.step(m_proxy, m_parameters, surface);
+        m_patch_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+        m_contact.force_on_tool_n += patch.force_on_tool_n;
+        m_contact.torque_on_tool_n_mm += patch.torque_on_tool_n_mm;
+        m_contact.stiffness_n_per_mm += patch.stiffness_n_per_mm;
+        m_contact.area_mm2 += patch.area_mm2;
+        m_contact.inner_reaches_surface = m_contact.inner_reaches_surface || patch.inner_reaches_surface;
+    }
     const Eigen::Matrix3d a = kc * Eigen::Matrix3d::Identity() + m_contact.stiffness_n_per_mm;
     const Eigen::Vector3d residual = kc * (device.position_mm - m_proxy.position) + m_contact.force_on_tool_n;
     Eigen::Vector3d step = a.ldlt().solve(residual);

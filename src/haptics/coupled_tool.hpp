@@ -12,8 +12,12 @@
 // thin tool cannot tunnel through the surface between ticks. A new snapshot moves the surface under
 // the proxy at once (the simulation stepped): what the user feels follows the proxy's move over as
 // many ticks as the snapshots come apart, not in one, so the force does not jump once a frame.
+// Where the snapshot carries a subdivided patch at the contact (contact/contact_patch.hpp), the
+// proxy presses the patch's spring layer there instead of the snapshot's rigid points, so the
+// surface gives under the tool between frames as the FEM would.
 // Everything here runs in the 1 kHz loop: no allocation, lock, log or throw.
 
+#include "contact/contact_patch.hpp"
 #include "contact/penalty_contact.hpp"
 #include "contact/tool_sweep.hpp"
 #include "haptics/device.hpp"
@@ -48,6 +52,9 @@ public:
     [[nodiscard]] const contact::ToolSweep& sweep() const { return m_sweep; }
     /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
     [[nodiscard]] const contact::ContactTotals& contact() const { return m_contact; }
+    /// The contact patch's layer as the last update left it, and how long it took to step, us.
+    [[nodiscard]] const contact::ContactPatchState& patch() const { return m_patch; }
+    [[nodiscard]] double patch_us() const { return m_patch_us; }
 
 private:
     contact::ContactParameters m_parameters;
@@ -56,6 +63,8 @@ private:
     contact::ContactTotals m_contact;
     contact::ToolSweep m_sweep;
     std::vector<double> m_distance; ///< per snapshot point, this tick's distance at the proxy
+    contact::ContactPatchState m_patch;
+    double m_patch_us = 0.0;
     Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_felt = Eigen::Vector3d::Zero();
     /// A new snapshot's move of the proxy not felt yet, and how much of it goes each tick.
     Eigen::Vector3d m_spread = Eigen::Vector3d::Zero(), m_spread_step = Eigen::Vector3d::Zero();

@@ -347,6 +347,11 @@ struct ToolSpec {
     /// removes 10 mm^3/s at 1 N and 50,000 rpm, the order of bone-drilling rates reported for
     /// otologic burrs.
     double drill_rate_mm3_per_n_rev = 0.012;
+    /// Haptic subdivision at the contact (contact/contact_patch.hpp): the Loop subdivisions, 0 to
+    /// 3, of the surface patch the haptic loop presses, which gives under the tool between
+    /// frames as the FEM would; -1: no patch (the snapshot stays rigid between frames). Default:
+    /// 1 for push tools, -1 for tools that cut or drill (their contact removes what it touches).
+    int haptic_subdivision = 1;
     /// Two-phase cutting (the sculpting paper's): while a cut tool touches the object, the object
     /// is held still and the tool marks its cut; when the cut condition is met the whole marked
     /// path is cut at once and the simulation resumes. Default false: cuts happen frame by frame.

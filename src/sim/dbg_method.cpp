@@ -469,6 +469,33 @@ void DbgMethod::sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpe
     cut::sample_surface(m_sim->surface(), goal, box, out, &stiffness);
 }
 
+std::optional<double> DbgMethod::contact_compliance_mm_per_n(std::size_t tool)
+{
+    constexpr int k_compliance_frames = 10;
+    if (tool >= m_touched.size() || !m_touched[tool] || m_touch[tool].nodes.empty()) {
+        if (tool < m_compliance.size()) m_compliance[tool] = {};
+        return std::nullopt;
+    }
+    if (m_compliance.size() <= tool) m_compliance.resize(tool + 1);
+    Compliance& c = m_compliance[tool];
+    if (c.mm_per_n && ++c.age < k_compliance_frames) return c.mm_per_n;
+    c.age = 0;
+    // The contact's load, one newton in all, spread over the nodes as it is.
+    const std::vector<fem::NodeContact>& nodes = m_touch[tool].nodes;
+    fem::ImplicitSolver& solver = m_sim->solver();
+    Eigen::Vector3d total = Eigen::Vector3d::Zero();
+    for (const fem::NodeContact& n : nodes) total += n.force_n;
+    if (!(total.norm() > 1e-9)) return c.mm_per_n = std::nullopt;
+    std::vector<Eigen::Vector3d> load(solver.positions().size(), Eigen::Vector3d::Zero());
+    for (const fem::NodeContact& n : nodes) load[n.node] += n.force_n / total.norm();
+    const std::vector<Eigen::Vector3d> u = solver.response(load);
+    if (u.empty()) return c.mm_per_n = std::nullopt;
+    double compliance = 0.0; // m/N
+    for (std::size_t i = 0; i < u.size(); ++i) compliance += load[i].dot(u[i]);
+    if (!(compliance > 0.0)) return c.mm_per_n = std::nullopt;
+    return c.mm_per_n = 1e3 * compliance;
+}
+
 std::size_t DbgMethod::piece_count() const { return cut::piece_count(m_sim->model()); }
 
 void DbgMethod::add_frame_figures(nlohmann::json& frame) const

@@ -66,6 +66,7 @@ public:
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements_mm() const override;
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override;
     void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
+    std::optional<double> contact_compliance_mm_per_n(std::size_t tool) override;
     [[nodiscard]] std::size_t piece_count() const override;
     [[nodiscard]] const std::vector<contact::Obstacle>& obstacles() const override { return m_obstacles; }
     [[nodiscard]] Eigen::Vector3d obstacle_force_n() const override { return m_obstacle_force; }
@@ -127,6 +128,14 @@ private:
     std::size_t m_region_moves = 0;
     std::vector<bool> m_touched;  ///< placed (and touched) this frame
     std::vector<bool> m_fresh;    ///< m_touch[k] is up to date with the model (no cut since)
+    /// Per tool: its contact's compliance as last measured (a solve of the step's system), and
+    /// the frames since; measured again every k_compliance_frames (it changes slowly with the
+    /// deformation) or when the tool comes into contact.
+    struct Compliance {
+        std::optional<double> mm_per_n;
+        int age = 0;
+    };
+    std::vector<Compliance> m_compliance;
     std::vector<double> m_drill_budget; ///< per tool: volume a drill may still remove, below one voxel's, mm^3
     /// A separating tool's cutting section at the previous frame (within a stroke that has cut,
     /// at its last cut), in rest space: a frame's cut opens what the section swept since.

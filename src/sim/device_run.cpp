@@ -3,6 +3,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "sim/haptic_snapshot.hpp"
 #include "haptics/virtual_device.hpp"
 
 #include <algorithm>
@@ -19,9 +20,6 @@ constexpr double k_tick_s = 1e-3;
 /// Surface points the snapshot can hold: a tool's neighbourhood on a fine scan is a few
 /// thousand; beyond this the snapshot says it was truncated.
 constexpr std::size_t k_snapshot_points = 50000;
-/// How far beyond the tool's pushing shape the snapshot reaches, mm: what the device can move
-/// into during one frame.
-constexpr double k_snapshot_margin_mm = 5.0;
 
 } // namespace
 
@@ -112,7 +110,7 @@ void DeviceRun::add_hand(std::size_t tool, std::unique_ptr<haptics::Device> devi
     m_hands.push_back(std::move(hand));
 }
 
-void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, double dt_s)
+void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_s)
 {
     if (!m_started) { // each proxy starts at its device; the readings are recorded so a replay starts alike
         for (std::size_t i = 0; i < m_hands.size(); ++i) {
@@ -127,9 +125,8 @@ void DeviceRun::frame(const Method& method, ToolPolicy& tools, double t0_s, doub
     // The snapshots: the surface around where each tool is, as the simulation has it at the frame's start.
     for (const std::unique_ptr<Hand>& hand : m_hands) {
         const io::ToolSpec& spec = m_scene.tools[hand->tool];
-        method.sample_surface(hand->coupled->proxy().world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), spec, hand->snapshot);
-        contact::measure_slack(hand->coupled->proxy(), spec.push_margin_mm, hand->snapshot);
-        hand->snapshot.t_s = t0_s;
+        const contact::PlacedShape& proxy = hand->coupled->proxy();
+        take_snapshot(method, hand->tool, spec, proxy, proxy.world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), t0_s, hand->snapshot);
         if (hand->snapshot.truncated && !hand->warned_truncated) {
             log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name,
                       hand->snapshot.capacity());

@@ -50,9 +50,9 @@ public:
     DeviceRun& operator=(const DeviceRun&) = delete;
 
     /// Runs the haptic ticks of the frame [t0, t0 + dt) of every device against the surface as
-    /// `method` has it now, then tells `tools` where the devices put their tools. Appends to
+    /// `method` has it now (sim/haptic_snapshot.hpp), then tells `tools` where the devices put their tools. Appends to
     /// forces() and recording().
-    void frame(const Method& method, ToolPolicy& tools, double t0_s, double dt_s);
+    void frame(Method& method, ToolPolicy& tools, double t0_s, double dt_s);
 
     [[nodiscard]] std::size_t device_count() const { return m_hands.size(); }
     /// The scene tool device `i` drives.

@@ -151,6 +151,13 @@ public:
     /// `tool` (at most out.capacity() points; out.truncated says when more were near).
     virtual void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const = 0;
 
+    /// The object's condensed compliance where tool `tool` touched it last frame: under that
+    /// contact's own load, spread as it is, the load-weighted displacement per newton one step
+    /// gives (the tools' contact springs left out), mm/N. What the haptic patch at the contact is
+    /// scaled to (contact/contact_patch.hpp). Nothing where the tool touched nothing or the method
+    /// has no such measure (Is-XFEM, shape matching: docs/haptics.md).
+    [[nodiscard]] virtual std::optional<double> contact_compliance_mm_per_n(std::size_t /*tool*/) { return std::nullopt; }
+
     /// Adds the frame's and the run's figures that only some methods have to stats.json: under
     /// the shared names where the branched grid's run named them first (scripts read those), the
     /// rest under the method's own key.

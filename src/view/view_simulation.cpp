@@ -5,6 +5,7 @@
 #include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "sim/dbg_method.hpp"
+#include "sim/haptic_snapshot.hpp"
 #include "view/scene_pictures.hpp"
 
 #include <algorithm>
@@ -166,12 +167,11 @@ bool ViewSimulation::step(double now_s)
         const Hand& hand = m_hands[d];
         HandChannel& channel = m_channels.hand(d);
         contact::SurfacePoints& out = channel.snapshots.write_slot();
-        const io::ToolSpec& held = m_scene.tools[hand.driven >= 0 ? static_cast<std::size_t>(hand.driven) : m_options.hands[d].tool];
-        Eigen::AlignedBox3d near = hand.pose.world_bounds(held.push_margin_mm + 5.0);
-        near.extend(contact::PlacedShape{hand.pose.shape, hand.heading, hand.pose.orientation}.world_bounds(held.push_margin_mm + 5.0));
-        m_method->sample_surface(near, held, out);
-        contact::measure_slack(hand.pose, held.push_margin_mm, out);
-        out.t_s = now_s;
+        const std::size_t tool = hand.driven >= 0 ? static_cast<std::size_t>(hand.driven) : m_options.hands[d].tool;
+        const io::ToolSpec& held = m_scene.tools[tool];
+        Eigen::AlignedBox3d near = hand.pose.world_bounds(held.push_margin_mm + sim::k_snapshot_margin_mm);
+        near.extend(contact::PlacedShape{hand.pose.shape, hand.heading, hand.pose.orientation}.world_bounds(held.push_margin_mm + sim::k_snapshot_margin_mm));
+        sim::take_snapshot(*m_method, tool, held, hand.pose, near, now_s, out);
         channel.snapshots.publish();
     }
     m_channels.simulation_t_s.store(m_loop.frames() * m_scene.solver.dt_s, std::memory_order_relaxed);

@@ -141,3 +141,50 @@ TEST(Multigrid, PreconditionedSolveMatchesJacobiWithFarFewerIterations)
     for (std::uint32_t n = 0; n < model.node_count(); ++n)
         EXPECT_LT((jacobi.positions()[n] - multigrid.positions()[n]).norm(), 1e-4 * a.max_displacement_m);
 }
+
+TEST(ImplicitSolver, ResponseIsTheBarsCondensedComplianceWithoutTheToolsSprings)
+{
+    // The bar above, held on its symmetry planes, one newton spread over its far end as a uniform
+    // traction: the load-weighted end displacement per newton is L / (E A). A stiff tool spring on
+    // the end does not change it (the response leaves the tools' springs out: the haptic patch
+    // sits in series with them). A dynamic step gives less (the mass resists), approaching the
+    // static compliance as the step grows.
+    const double h = 1e-3, length = 12e-3, side = 4e-3;
+    const auto grid = block_grid({12, 4, 4}, 1);
+    const HexModel model(grid, 0);
+    auto compliance = [&](bool quasi_static, double dt, bool tool_spring) {
+        SolverOptions o;
+        o.quasi_static = quasi_static;
+        o.dt_s = dt;
+        o.cg_tolerance = 1e-10;
+        o.cg_max_iterations = 4000;
+        ImplicitSolver solver(model, o);
+        const double x0 = -0.5 * h, y0 = -0.5 * h, z0 = -0.5 * h;
+        for (std::uint32_t n : nodes_at(model, 0, x0)) solver.fix(n, 1);
+        for (std::uint32_t n : nodes_at(model, 1, y0)) solver.fix(n, 2);
+        for (std::uint32_t n : nodes_at(model, 2, z0)) solver.fix(n, 4);
+        std::vector<Eigen::Vector3d> load(model.node_count(), Eigen::Vector3d::Zero());
+        std::vector<NodeContact> springs;
+        for (std::uint32_t n : nodes_at(model, 0, x0 + length)) {
+            const Eigen::Vector3d p = model.rest_positions()[n];
+            const bool ey = std::abs(p.y() - y0) < 1e-9 || std::abs(p.y() - (y0 + side)) < 1e-9;
+            const bool ez = std::abs(p.z() - z0) < 1e-9 || std::abs(p.z() - (z0 + side)) < 1e-9;
+            load[n] = Eigen::Vector3d((ey ? 1.0 : 2.0) * (ez ? 1.0 : 2.0) / 4.0 * h * h / (side * side), 0, 0);
+            springs.push_back({n, Eigen::Vector3d::Zero(), 1e6 * Eigen::Matrix3d::Identity()});
+        }
+        if (tool_spring) solver.set_contact(springs);
+        solver.step(); // at rest: nothing moves; the response is taken where the step left the bar
+        const std::vector<Eigen::Vector3d> u = solver.response(load);
+        EXPECT_EQ(u.size(), model.node_count());
+        double c = 0.0;
+        for (std::size_t i = 0; i < u.size(); ++i) c += load[i].dot(u[i]);
+        return c;
+    };
+    const double expected = length / (k_e * side * side);
+    EXPECT_NEAR(compliance(true, 0.01, false), expected, 1e-6 * expected);
+    EXPECT_NEAR(compliance(true, 0.01, true), expected, 1e-6 * expected);
+    const double frame = compliance(false, 0.01, false), long_step = compliance(false, 10.0, false);
+    EXPECT_LT(frame, expected);
+    EXPECT_GT(frame, 0.0);
+    EXPECT_NEAR(long_step, expected, 1e-3 * expected);
+}

@@ -1,0 +1,366 @@
+#include "contact/contact_patch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+
+namespace vox::contact {
+namespace {
+
+/// The patch's triangles as they are subdivided: positions, whether each point is held (on the
+/// patch's border), and a normal to orient the fine triangles' by.
+struct LocalMesh {
+    std::vector<Eigen::Vector3d> positions, reference_normals;
+    std::vector<unsigned char> held;
+    std::vector<Eigen::Vector3i> triangles;
+};
+
+/// One edge of a triangle, its ends in order (a < b) and the triangle's third corner.
+struct HalfEdge {
+    int a, b, opposite;
+};
+
+/// The edges of `triangles`, each with the corners opposite it (one on a border, two inside),
+/// sorted by their ends.
+std::vector<HalfEdge> half_edges(const std::vector<Eigen::Vector3i>& triangles)
+{
+    std::vector<HalfEdge> out;
+    out.reserve(3 * triangles.size());
+    for (const Eigen::Vector3i& t : triangles)
+        for (int k = 0; k < 3; ++k) out.push_back({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]), t[(k + 2) % 3]});
+    std::sort(out.begin(), out.end(), [](const HalfEdge& x, const HalfEdge& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+    return out;
+}
+
+/// One step of Loop subdivision: each edge gets a point (3/8 of its ends and 1/8 of the two
+/// corners across it; the middle of a border edge, held), each point inside moves to
+/// (1 - n beta) v + beta (sum of its n neighbours) with Warren's beta, held points stay, and each
+/// triangle becomes four. The border stays where the snapshot's surface has it, so the patch
+/// meets the surface around it without a crack.
+LocalMesh loop_subdivide(const LocalMesh& m)
+{
+    const std::vector<HalfEdge> edges = half_edges(m.triangles);
+    const std::size_t n = m.positions.size();
+    LocalMesh out;
+    out.positions = m.positions;
+    out.reference_normals = m.reference_normals;
+    out.held = m.held;
+    std::vector<std::vector<int>> neighbours(n);
+    struct Odd {
+        int a, b, index;
+    };
+    std::vector<Odd> odd;
+    for (std::size_t k = 0; k < edges.size();) {
+        std::size_t end = k;
+        while (end < edges.size() && edges[end].a == edges[k].a && edges[end].b == edges[k].b) ++end;
+        const HalfEdge& e = edges[k];
+        const Eigen::Vector3d &pa = m.positions[static_cast<std::size_t>(e.a)], &pb = m.positions[static_cast<std::size_t>(e.b)];
+        const bool inside = end - k == 2;
+        out.positions.push_back(inside ? Eigen::Vector3d(0.375 * (pa + pb) + 0.125 * (m.positions[static_cast<std::size_t>(e.opposite)] +
+                                                                                        m.positions[static_cast<std::size_t>(edges[k + 1].opposite)]))
+                                       : Eigen::Vector3d(0.5 * (pa + pb)));
+        out.reference_normals.push_back((m.reference_normals[static_cast<std::size_t>(e.a)] + m.reference_normals[static_cast<std::size_t>(e.b)]).normalized());
+        out.held.push_back(inside ? 0 : 1);
+        odd.push_back({e.a, e.b, static_cast<int>(out.positions.size() - 1)});
+        neighbours[static_cast<std::size_t>(e.a)].push_back(e.b);
+        neighbours[static_cast<std::size_t>(e.b)].push_back(e.a);
+        k = end;
+    }
+    for (std::size_t v = 0; v < n; ++v) {
+        if (m.held[v] || neighbours[v].empty()) continue;
+        const double valence = static_cast<double>(neighbours[v].size());
+        const double beta = neighbours[v].size() == 3 ? 3.0 / 16.0 : 3.0 / (8.0 * valence);
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (int w : neighbours[v]) sum += m.positions[static_cast<std::size_t>(w)];
+        out.positions[v] = (1.0 - valence * beta) * m.positions[v] + beta * sum;
+    }
+    auto odd_of = [&](int a, int b) {
+        const int lo = std::min(a, b), hi = std::max(a, b);
+        const auto it = std::lower_bound(odd.begin(), odd.end(), Odd{lo, hi, 0},
+                                         [](const Odd& x, const Odd& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+        return it->index;
+    };
+    out.triangles.reserve(4 * m.triangles.size());
+    for (const Eigen::Vector3i& t : m.triangles) {
+        const int m01 = odd_of(t[0], t[1]), m12 = odd_of(t[1], t[2]), m20 = odd_of(t[2], t[0]);
+        out.triangles.emplace_back(t[0], m01, m20);
+        out.triangles.emplace_back(t[1], m12, m01);
+        out.triangles.emplace_back(t[2], m20, m12);
+        out.triangles.emplace_back(m01, m12, m20);
+    }
+    return out;
+}
+
+/// The springs' product: out_i = k_h,i x_i + k_m sum over neighbours (x_i - x_j), x_j = 0 on the border.
+void spring_product(const PatchLayer& p, const Eigen::VectorXd& x, Eigen::VectorXd& out)
+{
+    for (std::size_t i = 0; i < p.free; ++i) {
+        double sum = p.home_n_per_mm[i] * x[static_cast<Eigen::Index>(i)];
+        for (std::uint32_t k = p.neighbour_start[i]; k < p.neighbour_start[i + 1]; ++k) {
+            const std::uint32_t j = p.neighbours[k];
+            sum += p.mesh_n_per_mm * (x[static_cast<Eigen::Index>(i)] - (j < p.free ? x[static_cast<Eigen::Index>(j)] : 0.0));
+        }
+        out[static_cast<Eigen::Index>(i)] = sum;
+    }
+}
+
+} // namespace
+
+double patch_compliance(const PatchLayer& patch, std::span<const double> load)
+{
+    const auto n = static_cast<Eigen::Index>(patch.free);
+    const Eigen::Map<const Eigen::VectorXd> b(load.data(), n);
+    const double total = b.sum();
+    if (n == 0 || !(total > 0.0)) return 0.0;
+    // Conjugate gradients on the springs (symmetric, positive definite: every point has a home spring).
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r = b, p = r, ap(n);
+    double rr = r.squaredNorm();
+    for (int k = 0; k < 10 * n && rr > 1e-28 * b.squaredNorm(); ++k) {
+        spring_product(patch, p, ap);
+        const double alpha = rr / p.dot(ap);
+        x += alpha * p;
+        r -= alpha * ap;
+        const double next = r.squaredNorm();
+        p = r + (next / rr) * p;
+        rr = next;
+    }
+    return b.dot(x) / (total * total);
+}
+
+bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParameters& contact, double compliance_mm_per_n,
+                 const PatchSettings& settings)
+{
+    PatchLayer& patch = s.patch;
+    patch.count = patch.free = 0;
+    s.replaced.clear();
+    if (!(compliance_mm_per_n > 0.0) || settings.levels < 0 || s.count == 0 || s.triangles.empty() || !s.stiffness_n_per_mm.empty())
+        return false;
+    const std::span<const Eigen::Vector3d> positions(s.positions_mm.data(), s.count), normals(s.normals.data(), s.count);
+    const std::span<const double> areas(s.areas_mm2.data(), s.count);
+    const ContactResult touching = penalty_contact(tool, contact, positions, areas, normals);
+    if (touching.points.empty()) return false;
+    // Around the contact's load-weighted middle, as far as it reaches and then settings.reach_mm.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    double load = 0.0;
+    for (const PointContact& c : touching.points) {
+        centre += c.force_n.norm() * positions[c.point];
+        load += c.force_n.norm();
+    }
+    if (!(load > 0.0)) return false;
+    centre /= load;
+    double radius = 0.0;
+    for (const PointContact& c : touching.points) radius = std::max(radius, (positions[c.point] - centre).norm());
+    radius += settings.reach_mm;
+
+    // The snapshot's triangles wholly within it, on their own points.
+    std::vector<int> local(s.count, -1);
+    LocalMesh mesh;
+    std::vector<std::size_t> global;
+    for (const Eigen::Vector3i& t : s.triangles) {
+        bool within = true;
+        for (int c = 0; c < 3; ++c) within = within && (positions[static_cast<std::size_t>(t[c])] - centre).norm() <= radius;
+        if (!within) continue;
+        Eigen::Vector3i lt;
+        for (int c = 0; c < 3; ++c) {
+            int& l = local[static_cast<std::size_t>(t[c])];
+            if (l < 0) {
+                l = static_cast<int>(global.size());
+                global.push_back(static_cast<std::size_t>(t[c]));
+                mesh.positions.push_back(positions[static_cast<std::size_t>(t[c])]);
+                mesh.reference_normals.push_back(normals[static_cast<std::size_t>(t[c])]);
+            }
+            lt[c] = l;
+        }
+        mesh.triangles.push_back(lt);
+    }
+    // A point on an edge with one triangle (the patch's outline, or the snapshot's) is held.
+    mesh.held.assign(mesh.positions.size(), 0);
+    const std::vector<HalfEdge> edges = half_edges(mesh.triangles);
+    for (std::size_t k = 0; k < edges.size();) {
+        std::size_t end = k;
+        while (end < edges.size() && edges[end].a == edges[k].a && edges[end].b == edges[k].b) ++end;
+        if (end - k != 2) mesh.held[static_cast<std::size_t>(edges[k].a)] = mesh.held[static_cast<std::size_t>(edges[k].b)] = 1;
+        k = end;
+    }
+    const std::size_t coarse_points = mesh.positions.size();
+    if (std::count(mesh.held.begin(), mesh.held.end(), 0) == 0) return false;
+    // As many levels as asked, fewer if the patch would hold more than max_points (each level
+    // multiplies the points by about four).
+    int level = 0;
+    for (std::size_t points = coarse_points; level < settings.levels && 4 * points <= settings.max_points; points *= 4) ++level;
+    for (int k = 0; k < level; ++k) mesh = loop_subdivide(mesh);
+
+    // Free points first, then the held ones.
+    const std::size_t n = mesh.positions.size();
+    std::vector<std::uint32_t> order(n);
+    std::size_t free = 0;
+    for (std::size_t v = 0; v < n; ++v)
+        if (!mesh.held[v]) order[v] = static_cast<std::uint32_t>(free++);
+    std::size_t next = free;
+    for (std::size_t v = 0; v < n; ++v)
+        if (mesh.held[v]) order[v] = static_cast<std::uint32_t>(next++);
+    patch.count = n;
+    patch.free = free;
+    patch.level = level;
+    patch.positions_mm.assign(n, Eigen::Vector3d::Zero());
+    patch.normals.assign(n, Eigen::Vector3d::Zero());
+    patch.areas_mm2.assign(n, 0.0);
+    patch.triangles.clear();
+    for (std::size_t v = 0; v < n; ++v) patch.positions_mm[order[v]] = mesh.positions[v];
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+        const Eigen::Vector3i ft(static_cast<int>(order[static_cast<std::size_t>(t[0])]), static_cast<int>(order[static_cast<std::size_t>(t[1])]),
+                                 static_cast<int>(order[static_cast<std::size_t>(t[2])]));
+        patch.triangles.push_back(ft);
+        const Eigen::Vector3d& a = patch.positions_mm[static_cast<std::size_t>(ft[0])];
+        const Eigen::Vector3d cross = (patch.positions_mm[static_cast<std::size_t>(ft[1])] - a).cross(patch.positions_mm[static_cast<std::size_t>(ft[2])] - a);
+        for (int c = 0; c < 3; ++c) {
+            patch.normals[static_cast<std::size_t>(ft[c])] += cross; // area-weighted (twice the area)
+            patch.areas_mm2[static_cast<std::size_t>(ft[c])] += cross.norm() / 6.0;
+        }
+    }
+    // The fine triangles' normals, facing the way the snapshot's do.
+    for (std::size_t v = 0; v < n; ++v) {
+        Eigen::Vector3d& normal = patch.normals[order[v]];
+        const Eigen::Vector3d& reference = mesh.reference_normals[v];
+        normal = normal.squaredNorm() > 0.0 ? normal.normalized() : reference;
+        if (normal.dot(reference) < 0.0) normal = -normal;
+    }
+    patch.edges = surface_edges(patch.triangles);
+    // Each free point's neighbours.
+    patch.neighbour_start.assign(free + 1, 0);
+    for (const Eigen::Vector2i& e : patch.edges)
+        for (int end : {e[0], e[1]})
+            if (static_cast<std::size_t>(end) < free) ++patch.neighbour_start[static_cast<std::size_t>(end) + 1];
+    for (std::size_t i = 0; i < free; ++i) patch.neighbour_start[i + 1] += patch.neighbour_start[i];
+    patch.neighbours.assign(patch.neighbour_start[free], 0);
+    std::vector<std::uint32_t> fill(patch.neighbour_start.begin(), patch.neighbour_start.end() - 1);
+    for (const Eigen::Vector2i& e : patch.edges)
+        for (int k = 0; k < 2; ++k)
+            if (static_cast<std::size_t>(e[k]) < free) patch.neighbours[fill[static_cast<std::size_t>(e[k])]++] = static_cast<std::uint32_t>(e[1 - k]);
+
+    // The load the tool presses each free point with now: the preload, and the load the springs
+    // are scaled under.
+    patch.preload_n.assign(free, 0.0);
+    const ContactResult pressed = penalty_contact(tool, contact, std::span<const Eigen::Vector3d>(patch.positions_mm.data(), free),
+                                                  std::span<const double>(patch.areas_mm2.data(), free),
+                                                  std::span<const Eigen::Vector3d>(patch.normals.data(), free));
+    for (const PointContact& c : pressed.points) patch.preload_n[c.point] = std::max(0.0, -c.force_n.dot(patch.normals[c.point]));
+    if (!(std::accumulate(patch.preload_n.begin(), patch.preload_n.end(), 0.0) > 0.0)) { // the contact is on the border only
+        patch.count = patch.free = 0;
+        return false;
+    }
+    // Springs at kappa = 1 (see the header), then kappa scaled to the FEM's compliance.
+    const double l = settings.decay_mm;
+    patch.home_n_per_mm.assign(free, 0.0);
+    for (std::size_t i = 0; i < free; ++i) patch.home_n_per_mm[i] = patch.areas_mm2[i];
+    patch.mesh_n_per_mm = l * l / std::sqrt(3.0);
+    const double kappa = patch_compliance(patch, patch.preload_n) / compliance_mm_per_n;
+    for (double& k : patch.home_n_per_mm) k *= kappa;
+    patch.mesh_n_per_mm *= kappa;
+    patch.compliance_mm_per_n = compliance_mm_per_n;
+    patch.centre_mm = centre;
+    patch.radius_mm = radius;
+
+    // The snapshot points the patch stands in for: its free points that were snapshot points.
+    s.replaced.assign(s.count, 0);
+    patch.snapshot_point.assign(free, -1);
+    for (std::size_t v = 0; v < coarse_points; ++v) {
+        if (mesh.held[v]) continue;
+        s.replaced[global[v]] = 1;
+        patch.snapshot_point[order[v]] = static_cast<std::int32_t>(global[v]);
+    }
+    return true;
+}
+
+ContactPatchState::ContactPatchState(std::size_t capacity)
+    : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
+      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0)
+{
+    m_displaced.edges.reserve(3 * capacity + 16); // a triangulated patch has about three edges a point
+}
+
+double ContactPatchState::max_displacement_mm() const noexcept
+{
+    double out = 0.0;
+    for (std::size_t i = 0; i < m_displaced.count; ++i) out = std::max(out, std::abs(m_u[i]));
+    return out;
+}
+
+ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot) noexcept
+{
+    const PatchLayer& p = snapshot.patch;
+    if (p.free == 0 || p.free > m_displaced.capacity() || p.edges.size() > m_displaced.edges.capacity()) {
+        m_displaced.count = 0;
+        return {};
+    }
+    if (snapshot.t_s != m_patch_t_s || m_displaced.count != p.free) { // a new patch: from rest, on the new snapshot
+        m_patch_t_s = snapshot.t_s;
+        m_displaced.count = p.free;
+        std::copy_n(p.normals.begin(), p.free, m_displaced.normals.begin());
+        std::copy_n(p.areas_mm2.begin(), p.free, m_displaced.areas_mm2.begin());
+        m_displaced.edges.assign(p.edges.begin(), p.edges.end()); // within the capacity reserved
+        std::fill_n(m_u.begin(), p.free, 0.0);
+    }
+    // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
+    // normal (the depth falls by what the point gives): the linearised contact of this tick.
+    const Eigen::AlignedBox3d reach = tool.world_bounds(contact.margin_mm);
+    const double k_per_area = contact.stiffness_n_per_mm / 100.0; // per mm^2
+    for (std::size_t i = 0; i < p.free; ++i) {
+        const Eigen::Vector3d x = p.positions_mm[i] - m_u[i] * p.normals[i];
+        m_distance[i] = reach.contains(x) ? contact.margin_mm - tool.signed_distance(x) + m_u[i] : -INFINITY;
+    }
+    // The layer under this tick's linearised contact, (K + C) u = C D - preload (C: each pressed
+    // point's contact stiffness; D: its depth at u = 0), by a few conjugate-gradient iterations
+    // from the last tick's u, Jacobi preconditioned: the warm start is close (a tick moves the
+    // tool micrometres), and a patch converges in about l / h iterations from rest.
+    const std::size_t n = p.free;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double k_contact = k_per_area * p.areas_mm2[i];
+        const bool pressed = m_distance[i] - m_u[i] > 0.0;
+        m_contact_k[i] = pressed ? k_contact : 0.0;
+        m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i];
+        m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
+    }
+    auto multiply = [&](const std::vector<double>& x, std::vector<double>& out) {
+        for (std::size_t i = 0; i < n; ++i) {
+            double pulled = 0.0;
+            for (std::uint32_t k = p.neighbour_start[i]; k < p.neighbour_start[i + 1]; ++k)
+                if (p.neighbours[k] < n) pulled += x[p.neighbours[k]];
+            out[i] = m_diagonal[i] * x[i] - p.mesh_n_per_mm * pulled;
+        }
+    };
+    multiply(m_u, m_ap);
+    double rz = 0.0, bb = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        m_r[i] = m_b[i] - m_ap[i];
+        m_p[i] = m_r[i] / m_diagonal[i];
+        rz += m_r[i] * m_p[i];
+        bb += m_b[i] * m_b[i] / m_diagonal[i];
+    }
+    for (int it = 0; it < k_iterations && rz > 1e-20 * bb; ++it) {
+        multiply(m_p, m_ap);
+        double pap = 0.0;
+        for (std::size_t i = 0; i < n; ++i) pap += m_p[i] * m_ap[i];
+        if (!(pap > 0.0)) break;
+        const double alpha = rz / pap;
+        double next = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            m_u[i] += alpha * m_p[i];
+            m_r[i] -= alpha * m_ap[i];
+            next += m_r[i] * m_r[i] / m_diagonal[i];
+        }
+        const double beta = next / rz;
+        for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
+        rz = next;
+    }
+    for (std::size_t i = 0; i < p.free; ++i) m_displaced.positions_mm[i] = p.positions_mm[i] - m_u[i] * p.normals[i];
+    ContactTotals out = penalty_totals(tool, contact, m_displaced, false);
+    // The tool feels the contact in series with the layer: for the proxy's step, the contact's
+    // stiffness k becomes k / (1 + k c), c the layer's compliance.
+    const double k = out.stiffness_n_per_mm.trace();
+    if (k > 0.0) out.stiffness_n_per_mm /= 1.0 + k * p.compliance_mm_per_n;
+    return out;
+}
+
+} // namespace vox::contact
