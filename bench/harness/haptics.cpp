@@ -137,6 +137,7 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices, 
         finger.shape = io::ToolShape::sphere;
         finger.radius_mm = 4.0;
         finger.action = io::default_tool_action(io::ToolShape::sphere);
+        finger.haptic_subdivision = 1; // the finger presses a subdivided patch (contact/contact_patch.hpp)
         scene.tools.push_back(finger);
     }
     io::use_method(scene, method_type);

@@ -274,7 +274,7 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
 }
 
 ContactPatchState::ContactPatchState(std::size_t capacity)
-    : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
+    : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_signed(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
       m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0)
 {
     m_displaced.edges.reserve(3 * capacity + 16); // a triangulated patch has about three edges a point
@@ -355,7 +355,8 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         rz = next;
     }
     for (std::size_t i = 0; i < p.free; ++i) m_displaced.positions_mm[i] = p.positions_mm[i] - m_u[i] * p.normals[i];
-    ContactTotals out = penalty_totals(tool, contact, m_displaced, false);
+    // The distances kept, so that the edges' test reads them instead of measuring again.
+    ContactTotals out = penalty_totals(tool, contact, m_displaced, false, std::span<double>(m_signed.data(), n));
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
     // stiffness k becomes k / (1 + k c), c the layer's compliance.
     const double k = out.stiffness_n_per_mm.trace();

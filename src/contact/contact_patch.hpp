@@ -40,8 +40,8 @@ struct PatchSettings {
     double decay_mm = 2.0;          ///< l: how far along the surface a point load spreads
     /// The patch reaches this far beyond the contact (what the tool can slide within a frame, plus
     /// the spread), mm.
-    double reach_mm = 6.0;
-    std::size_t max_points = 1200;  ///< fewer levels where the patch would hold more
+    double reach_mm = 4.0;
+    std::size_t max_points = 600;   ///< fewer levels where the patch would hold more (the tick's budget)
 };
 
 /// Builds snapshot.patch around `tool`'s contact and marks the snapshot points it stands in for
@@ -76,7 +76,7 @@ public:
 
 private:
     SurfacePoints m_displaced;
-    std::vector<double> m_u, m_distance;
+    std::vector<double> m_u, m_distance, m_signed;
     std::vector<double> m_contact_k, m_b, m_diagonal, m_r, m_p, m_ap; ///< the tick's solve, per free point
     double m_patch_t_s = -1e300; ///< the snapshot whose patch m_displaced holds
 };

@@ -659,7 +659,7 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
     t.burr_speed_rpm = r.optional("burr_speed_rpm", t.burr_speed_rpm, half_open_range(0.0, 1e6));
     t.drill_rate_mm3_per_n_rev = r.optional("drill_rate_mm3_per_n_rev", t.drill_rate_mm3_per_n_rev, half_open_range(0.0, 1.0));
-    t.haptic_subdivision = r.optional("haptic_subdivision", t.action == ToolAction::push ? 1 : -1, closed_range(-1, 3));
+    t.haptic_subdivision = r.optional("haptic_subdivision", t.haptic_subdivision, closed_range(-1, 3));
     if (const std::optional<JsonNode> node = r.optional_node("two_phase")) {
         t.two_phase = as<bool>(*node);
         if (t.two_phase && (t.action != ToolAction::cut || t.cut_mode != CutMode::separate))

@@ -349,9 +349,9 @@ struct ToolSpec {
     double drill_rate_mm3_per_n_rev = 0.012;
     /// Haptic subdivision at the contact (contact/contact_patch.hpp): the Loop subdivisions, 0 to
     /// 3, of the surface patch the haptic loop presses, which gives under the tool between
-    /// frames as the FEM would; -1: no patch (the snapshot stays rigid between frames). Default:
-    /// 1 for push tools, -1 for tools that cut or drill (their contact removes what it touches).
-    int haptic_subdivision = 1;
+    /// frames as the FEM would; -1 (the default): no patch, the snapshot stays rigid between
+    /// frames (docs/haptics.md says why it is not on by default yet).
+    int haptic_subdivision = -1;
     /// Two-phase cutting (the sculpting paper's): while a cut tool touches the object, the object
     /// is held still and the tool marks its cut; when the cut condition is met the whole marked
     /// path is cut at once and the simulation resumes. Default false: cuts happen frame by frame.

@@ -133,6 +133,7 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
             hand->warned_truncated = true;
         }
     }
+    for (const std::unique_ptr<Hand>& hand : m_hands) hand->patch_us_max = 0.0;
     const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
     m_tick_s = dt_s / ticks;
     for (int k = 1; k <= ticks; ++k) {
@@ -144,9 +145,29 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
             const Eigen::Vector3d& f = m_loop->force(i);
             m_recording.push_back({m_loop->state(i), f, method.level(), change, static_cast<int>(i), m_scene.tools[hand.tool].name});
             hand.forces.push_back({t, hand.coupled->proxy().position, f});
+            hand.patch_us_max = std::max(hand.patch_us_max, hand.coupled->patch_us());
         }
     }
     for (const std::unique_ptr<Hand>& hand : m_hands) tools.drive(hand->tool, hand->coupled->proxy().position, hand->coupled->proxy().orientation);
+}
+
+std::vector<PatchFrame> DeviceRun::patches() const
+{
+    std::vector<PatchFrame> out;
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        const contact::PatchLayer& patch = hand->snapshot.patch;
+        PatchFrame p;
+        p.tool = m_scene.tools[hand->tool].name;
+        if (patch.free > 0) {
+            p.points = patch.free;
+            p.level = patch.level;
+            p.compliance_mm_per_n = patch.compliance_mm_per_n;
+            p.displacement_mm = hand->coupled->patch().max_displacement_mm();
+            p.step_us_max = hand->patch_us_max;
+        }
+        out.push_back(p);
+    }
+    return out;
 }
 
 namespace {

@@ -6,6 +6,7 @@
 // stage; the proxies' poses are where the simulation puts the tools. Every tick of every device
 // can be recorded (docs/recording-format.md) and replayed bit for bit.
 
+#include "sim/frame_loop.hpp"
 #include "sim/level_governor.hpp"
 #include "sim/method.hpp"
 #include "sim/tool_policy.hpp"
@@ -62,6 +63,8 @@ public:
     /// Every device's ticks, tick by tick.
     [[nodiscard]] const std::vector<haptics::RecordedTick>& recording() const { return m_recording; }
     [[nodiscard]] std::string device_name(std::size_t i = 0) const { return m_hands[i]->device->name(); }
+    /// Each device's contact patch over the last frame.
+    [[nodiscard]] std::vector<PatchFrame> patches() const;
 
     /// A recording is being replayed: the run follows its levels, not a governor.
     [[nodiscard]] bool replaying() const { return !m_replayed.empty(); }
@@ -80,6 +83,7 @@ private:
         std::unique_ptr<haptics::CoupledTool> coupled;
         contact::SurfacePoints snapshot;
         std::vector<ForceSample> forces;
+        double patch_us_max = 0.0; ///< this frame's longest patch step
         bool warned_truncated = false;
     };
     void add_hand(std::size_t tool, std::unique_ptr<haptics::Device> device, const ToolPolicy& tools);

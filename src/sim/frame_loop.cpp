@@ -30,7 +30,10 @@ FrameStats FrameLoop::next()
     }
     m_pending.reset();
     out.level = m_method->level();
-    if (m_device) m_device->frame(*m_method, m_tools, (m_frame - 1) * dt, dt);
+    if (m_device) {
+        m_device->frame(*m_method, m_tools, (m_frame - 1) * dt, dt);
+        out.patches = m_device->patches();
+    }
     out.tools = m_tools.frame(*m_method, out.t_s, dt);
     if (!out.tools.hold_object) out.step = m_method->step(); // held: a two-phase cut is being marked
     const StepFigures& s = out.step;

@@ -13,12 +13,23 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace vox::sim {
 
 class DeviceRun;
 
 /// One frame, as every method reports it.
+/// One device's contact patch over a frame (contact/contact_patch.hpp; device runs).
+struct PatchFrame {
+    std::string tool;
+    std::size_t points = 0;            ///< the patch's moving points (0: no patch this frame)
+    int level = 0;                     ///< its Loop subdivisions
+    double compliance_mm_per_n = 0.0;  ///< the FEM's at the contact, which its springs were scaled to
+    double displacement_mm = 0.0;      ///< its largest give at the frame's last tick, handed on with the tool's pose
+    double step_us_max = 0.0;          ///< its longest step in the frame's ticks
+};
+
 struct FrameStats {
     int frame = 0;   ///< from 1
     double t_s = 0.0; ///< simulated time at its end
@@ -27,6 +38,7 @@ struct FrameStats {
     ToolsFrame tools;
     StepFigures step; ///< zero (and converged) while the object is held
     double frame_ms = 0.0; ///< the whole frame, wall clock: device ticks, tools, cuts and step
+    std::vector<PatchFrame> patches; ///< per device (device runs)
 };
 
 /// A step whose state is no longer finite: what follows cannot be computed (an InputError, so a

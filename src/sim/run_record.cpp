@@ -112,6 +112,12 @@ void RunRecord::add(const FrameStats& f, const Method& method)
         frame["piece_contact"] = {{"contacts", c.contacts}, {"edge_contacts", c.edge_contacts}, {"tested_vertices", c.tested_vertices}, {"force_n", c.force_n}, {"ms", c.ms},
                                   {"max_depth_mm", c.max_depth_mm}};
     }
+    for (const PatchFrame& p : f.patches) {
+        if (p.points == 0) continue;
+        ++m_patch_frames;
+        frame["haptic_patch"].push_back({{"tool", p.tool}, {"points", p.points}, {"level", p.level}, {"compliance_mm_per_n", p.compliance_mm_per_n},
+                                         {"displacement_mm", p.displacement_mm}, {"step_us_max", p.step_us_max}});
+    }
     method.add_frame_figures(frame);
     m_document["frames"].push_back(std::move(frame));
 }
@@ -133,6 +139,7 @@ void RunRecord::finish(const Method& method)
                            {"separated_faces", m_separated_faces},
                            {"separated_voxels", m_separated_voxels},
                            {"cutting_frames", m_cutting_ms.size()},
+                           {"haptic_patch_frames", m_patch_frames},
                            {"cutting_ms_p95", quantile(m_cutting_ms, 0.95)},
                            {"final_elements", method.element_count()},
                            {"final_dofs", method.dof_count()},

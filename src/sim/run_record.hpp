@@ -42,6 +42,7 @@ private:
     std::size_t m_projected = 0;      ///< frames whose step lost the energy it created (StepFigures::energy_projected)
     std::vector<double> m_frame_ms;   ///< whole frames, wall clock
     std::vector<double> m_cutting_ms; ///< frames that cut: collision + propagation + grid update + remesh
+    std::size_t m_patch_frames = 0;   ///< device frames with a contact patch (per device)
     StepFigures m_last;
 };
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 using namespace vox;
 
@@ -101,6 +102,8 @@ TEST(ContactPatch, AStaticPressGivesTheSameForceBeforeAndAfterSubdivision)
     const double preload = contact::penalty_totals(touching, {k_margin, k_stiffness}, rigid).force_on_tool_n.z();
     std::vector<Settled> with;
     for (int levels : {0, 1, 2}) with.push_back(press(punch, wall_with_patch(touching, levels), touching.position, pressed));
+    std::printf("static press, 2 mm past touching: rigid snapshot %.4f N; patch at levels 0, 1, 2: %.4f, %.4f, %.4f N (proxy %.4f, %.4f, %.4f mm)\n",
+                without.force.z(), with[0].force.z(), with[1].force.z(), with[2].force.z(), with[0].proxy.z(), with[1].proxy.z(), with[2].proxy.z());
     for (std::size_t k = 1; k < with.size(); ++k) {
         EXPECT_NEAR(with[k].force.z(), with[0].force.z(), 0.01 * with[0].force.z()) << "level " << k;
         EXPECT_NEAR(with[k].proxy.z(), with[0].proxy.z(), 0.01 * (touching.position.z() - with[0].proxy.z())) << "level " << k;
@@ -160,6 +163,8 @@ TEST(ContactPatch, TheForceDoesNotStepWhenThePatchMovesOrRefines)
         refined += next.patch.level != p.level;
         surface = std::move(next);
     }
+    std::printf("sliding 10 mm, a new patch every 10 ticks (%d refined or coarsened): largest force %.4f N, largest change in a tick %.5f N\n",
+                refined, largest_force, largest_step);
     EXPECT_GT(largest_force, 0.3);
     EXPECT_GT(refined, 50);
     EXPECT_LT(largest_step, 0.01) << "largest force " << largest_force;
