@@ -18,6 +18,28 @@ using test::k_e;
 using test::k_nu;
 using test::nodes_at;
 
+/// The bar of the tests below (12 x 4 x 4 elements of h, its near corner at -h/2 on every axis):
+/// its three symmetry planes held by slide constraints.
+void hold_symmetry_planes(const HexModel& model, ImplicitSolver& solver, double h)
+{
+    for (int axis = 0; axis < 3; ++axis)
+        for (std::uint32_t n : nodes_at(model, axis, -0.5 * h)) solver.fix(n, 1u << axis);
+}
+
+/// The consistent loads of a uniform traction adding up to `force` N along x over the bar's far
+/// end face (side x side, at x = length - h/2): each element face gives a quarter to its corners.
+std::vector<Eigen::Vector3d> end_traction(const HexModel& model, int level, double force, double h, double length, double side)
+{
+    const double y0 = -0.5 * h, z0 = -0.5 * h, cell = (1 << level) * h;
+    std::vector<Eigen::Vector3d> load(model.node_count(), Eigen::Vector3d::Zero());
+    for (std::uint32_t n : nodes_at(model, 0, -0.5 * h + length)) {
+        const Eigen::Vector3d p = model.rest_positions()[n];
+        const bool ey = std::abs(p.y() - y0) < 1e-9 || std::abs(p.y() - (y0 + side)) < 1e-9;
+        const bool ez = std::abs(p.z() - z0) < 1e-9 || std::abs(p.z() - (z0 + side)) < 1e-9;
+        load[n] = Eigen::Vector3d(force * (ey ? 1.0 : 2.0) * (ez ? 1.0 : 2.0) / 4.0 * cell * cell / (side * side), 0, 0);
+    }
+    return load;
+}
 
 } // namespace
 
@@ -52,18 +74,8 @@ TEST(ImplicitSolver, UniaxialCompressionMatchesFLOverEAAndPatchTest)
     o.cg_max_iterations = 2000;
     ImplicitSolver solver(model, o);
     const double x0 = -0.5 * h, y0 = -0.5 * h, z0 = -0.5 * h;
-    for (std::uint32_t n : nodes_at(model, 0, x0)) solver.fix(n, 1);
-    for (std::uint32_t n : nodes_at(model, 1, y0)) solver.fix(n, 2);
-    for (std::uint32_t n : nodes_at(model, 2, z0)) solver.fix(n, 4);
-    // Consistent loads of a uniform traction on the end face: each element face gives a quarter.
-    const double cell = (1 << level) * h;
-    for (std::uint32_t n : nodes_at(model, 0, x0 + length)) {
-        const Eigen::Vector3d p = model.rest_positions()[n];
-        const bool ey = std::abs(p.y() - y0) < 1e-9 || std::abs(p.y() - (y0 + side)) < 1e-9;
-        const bool ez = std::abs(p.z() - z0) < 1e-9 || std::abs(p.z() - (z0 + side)) < 1e-9;
-        const double share = (ey ? 1.0 : 2.0) * (ez ? 1.0 : 2.0) / 4.0 * cell * cell / (side * side);
-        solver.external_forces()[n] = Eigen::Vector3d(force * share, 0, 0);
-    }
+    hold_symmetry_planes(model, solver, h);
+    solver.external_forces() = end_traction(model, level, force, h, length, side);
     const StepStats s = solver.step();
     ASSERT_TRUE(s.converged);
     // Uniform strain exactly: u_x = eps x, u_y = -nu eps y, u_z = -nu eps z, eps = F / (E A).
@@ -159,19 +171,10 @@ TEST(ImplicitSolver, ResponseIsTheBarsCondensedComplianceWithoutTheToolsSprings)
         o.cg_tolerance = 1e-10;
         o.cg_max_iterations = 4000;
         ImplicitSolver solver(model, o);
-        const double x0 = -0.5 * h, y0 = -0.5 * h, z0 = -0.5 * h;
-        for (std::uint32_t n : nodes_at(model, 0, x0)) solver.fix(n, 1);
-        for (std::uint32_t n : nodes_at(model, 1, y0)) solver.fix(n, 2);
-        for (std::uint32_t n : nodes_at(model, 2, z0)) solver.fix(n, 4);
-        std::vector<Eigen::Vector3d> load(model.node_count(), Eigen::Vector3d::Zero());
+        hold_symmetry_planes(model, solver, h);
+        const std::vector<Eigen::Vector3d> load = end_traction(model, 0, 1.0, h, length, side);
         std::vector<NodeContact> springs;
-        for (std::uint32_t n : nodes_at(model, 0, x0 + length)) {
-            const Eigen::Vector3d p = model.rest_positions()[n];
-            const bool ey = std::abs(p.y() - y0) < 1e-9 || std::abs(p.y() - (y0 + side)) < 1e-9;
-            const bool ez = std::abs(p.z() - z0) < 1e-9 || std::abs(p.z() - (z0 + side)) < 1e-9;
-            load[n] = Eigen::Vector3d((ey ? 1.0 : 2.0) * (ez ? 1.0 : 2.0) / 4.0 * h * h / (side * side), 0, 0);
-            springs.push_back({n, Eigen::Vector3d::Zero(), 1e6 * Eigen::Matrix3d::Identity()});
-        }
+        for (std::uint32_t n : nodes_at(model, 0, -0.5 * h + length)) springs.push_back({n, Eigen::Vector3d::Zero(), 1e6 * Eigen::Matrix3d::Identity()});
         if (tool_spring) solver.set_contact(springs);
         solver.step(); // at rest: nothing moves; the response is taken where the step left the bar
         const std::vector<Eigen::Vector3d> u = solver.response(load);
