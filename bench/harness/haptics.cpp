@@ -125,8 +125,12 @@ struct Hand {
 
 } // namespace
 
-void run_haptics_bench(double seconds, io::SolverType method_type, int devices, bool lockstep)
+void run_haptics_bench(const HapticsBenchOptions& options)
 {
+    const double seconds = options.seconds;
+    const io::SolverType method_type = options.method;
+    const int devices = options.devices;
+    const bool lockstep = options.lockstep;
     // The press-and-cut scene one level coarser (2 mm -> 4 mm elements), so that the simulation
     // thread alone keeps its snapshots fresh (under the 50 ms the safety stage allows).
     io::Scene scene = io::load_scene(VOX_DATA_DIR "/scenes/press_and_cut.json");
@@ -137,7 +141,7 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices, 
         finger.shape = io::ToolShape::sphere;
         finger.radius_mm = 4.0;
         finger.action = io::default_tool_action(io::ToolShape::sphere);
-        finger.haptic_subdivision = 1; // the finger presses a subdivided patch (contact/contact_patch.hpp)
+        finger.haptic_subdivision = options.finger_subdivision;
         scene.tools.push_back(finger);
     }
     io::use_method(scene, method_type);
@@ -184,7 +188,7 @@ void run_haptics_bench(double seconds, io::SolverType method_type, int devices, 
                                     }
                                     ++tick;
                                 }
-                                hand->poses.write_slot() = hand->coupled.proxy();
+                                hand->poses.write_slot() = hand->coupled.handed_pose();
                                 hand->poses.publish();
                                 return f;
                             },

@@ -59,8 +59,13 @@ void add_bench_command(CLI::App& app)
     auto lockstep = std::make_shared<bool>(false);
     haptics->add_flag("--lockstep", *lockstep,
                       "No threads: the simulation and the ticks take turns in simulated time, the same ticks every run (force time only)");
-    haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep] {
-        run_haptics_bench(*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices, *lockstep);
+    auto finger_subdivision = std::make_shared<int>(-1);
+    haptics->add_option("--haptic-subdivision", *finger_subdivision,
+                        "With --devices 2: the finger's haptic_subdivision, -1 (off, default) or 0 - 3, to time its contact patch")
+        ->check(CLI::Range(-1, 3));
+    haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep, finger_subdivision] {
+        run_haptics_bench({*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices, *lockstep,
+                           *finger_subdivision});
     });
 
     auto glide_out = std::make_shared<std::string>("out");

@@ -105,15 +105,12 @@ void spring_product(const PatchLayer& p, const Eigen::VectorXd& x, Eigen::Vector
     }
 }
 
-} // namespace
-
-double patch_compliance(const PatchLayer& patch, std::span<const double> load)
+/// The springs' displacement under `load` (per free point, N), by conjugate gradients (symmetric,
+/// positive definite: every point has a home spring).
+Eigen::VectorXd spring_give(const PatchLayer& patch, std::span<const double> load)
 {
     const auto n = static_cast<Eigen::Index>(patch.free);
     const Eigen::Map<const Eigen::VectorXd> b(load.data(), n);
-    const double total = b.sum();
-    if (n == 0 || !(total > 0.0)) return 0.0;
-    // Conjugate gradients on the springs (symmetric, positive definite: every point has a home spring).
     Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r = b, p = r, ap(n);
     double rr = r.squaredNorm();
     for (int k = 0; k < 10 * n && rr > 1e-28 * b.squaredNorm(); ++k) {
@@ -125,7 +122,18 @@ double patch_compliance(const PatchLayer& patch, std::span<const double> load)
         p = r + (next / rr) * p;
         rr = next;
     }
-    return b.dot(x) / (total * total);
+    return x;
+}
+
+} // namespace
+
+double patch_compliance(const PatchLayer& patch, std::span<const double> load)
+{
+    const auto n = static_cast<Eigen::Index>(patch.free);
+    const Eigen::Map<const Eigen::VectorXd> b(load.data(), n);
+    const double total = b.sum();
+    if (n == 0 || !(total > 0.0)) return 0.0;
+    return b.dot(spring_give(patch, load)) / (total * total);
 }
 
 bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParameters& contact, double compliance_mm_per_n,
@@ -246,7 +254,8 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
                                                   std::span<const double>(patch.areas_mm2.data(), free),
                                                   std::span<const Eigen::Vector3d>(patch.normals.data(), free));
     for (const PointContact& c : pressed.points) patch.preload_n[c.point] = std::max(0.0, -c.force_n.dot(patch.normals[c.point]));
-    if (!(std::accumulate(patch.preload_n.begin(), patch.preload_n.end(), 0.0) > 0.0)) { // the contact is on the border only
+    const double total_preload = std::accumulate(patch.preload_n.begin(), patch.preload_n.end(), 0.0);
+    if (!(total_preload > 0.0)) { // the contact is on the border only
         patch.count = patch.free = 0;
         return false;
     }
@@ -255,12 +264,14 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
     patch.home_n_per_mm.assign(free, 0.0);
     for (std::size_t i = 0; i < free; ++i) patch.home_n_per_mm[i] = patch.areas_mm2[i];
     patch.mesh_n_per_mm = l * l / std::sqrt(3.0);
-    const double kappa = patch_compliance(patch, patch.preload_n) / compliance_mm_per_n;
+    const Eigen::VectorXd give = spring_give(patch, patch.preload_n); // at kappa = 1
+    const double kappa = Eigen::Map<const Eigen::VectorXd>(patch.preload_n.data(), static_cast<Eigen::Index>(free)).dot(give) /
+                         (total_preload * total_preload) / compliance_mm_per_n;
     for (double& k : patch.home_n_per_mm) k *= kappa;
     patch.mesh_n_per_mm *= kappa;
     patch.compliance_mm_per_n = compliance_mm_per_n;
-    patch.centre_mm = centre;
-    patch.radius_mm = radius;
+    patch.preload_give_mm.assign(give.data(), give.data() + free);
+    for (double& g : patch.preload_give_mm) g /= kappa;
 
     // The snapshot points the patch stands in for: its free points that were snapshot points.
     s.replaced.assign(s.count, 0);
@@ -275,7 +286,7 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
 
 ContactPatchState::ContactPatchState(std::size_t capacity)
     : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_signed(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
-      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0)
+      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0), m_carried(capacity, 0.0)
 {
     m_displaced.edges.reserve(3 * capacity + 16); // a triangulated patch has about three edges a point
 }
@@ -287,14 +298,46 @@ double ContactPatchState::max_displacement_mm() const noexcept
     return out;
 }
 
-ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot) noexcept
+void ContactPatchState::take_over(const PatchLayer& p, double k_per_area) noexcept
+{
+    // The normal load the new patch's points carry undisplaced (the rigid snapshot's), and how
+    // fast it falls as they give along the preload's shape (pressed points only: linear in beta).
+    double rigid = 0.0, per_beta = 0.0;
+    for (std::size_t i = 0; i < p.free; ++i)
+        if (m_distance[i] > 0.0) {
+            rigid += k_per_area * p.areas_mm2[i] * m_distance[i];
+            per_beta += k_per_area * p.areas_mm2[i] * p.preload_give_mm[i];
+        }
+    // Displaced by beta times that shape so the load is the last patch's: the FEM behind the new
+    // snapshot has not yet taken all the load the layer held. Never the other way (beta < 0, the
+    // layer bulging out to hold a load the FEM has dropped, as under a tool lifting off faster
+    // than the surface follows it): the FEM's own lag is the physics there. A patch after none
+    // (the tool's first contact there) takes the snapshot's points' load as is.
+    const double beta = m_had_patch && per_beta > 0.0 ? std::clamp((rigid - m_load_n) / per_beta, 0.0, 2.0) : 0.0;
+    // The carried load makes that the layer's equilibrium: per point, its contact less the
+    // springs' pull, (1 + beta) times the preload (the springs give the preload's shape under it).
+    for (std::size_t i = 0; i < p.free; ++i) {
+        m_u[i] = beta * p.preload_give_mm[i];
+        const double depth = m_distance[i] - m_u[i];
+        m_carried[i] = (depth > 0.0 ? k_per_area * p.areas_mm2[i] * depth : 0.0) - (1.0 + beta) * p.preload_n[i];
+    }
+}
+
+ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s) noexcept
 {
     const PatchLayer& p = snapshot.patch;
     if (p.free == 0 || p.free > m_displaced.capacity() || p.edges.size() > m_displaced.edges.capacity()) {
         m_displaced.count = 0;
+        m_had_patch = false;
+        m_load_n = m_give_mm = 0.0;
         return {};
     }
-    if (snapshot.t_s != m_patch_t_s || m_displaced.count != p.free) { // a new patch: from rest, on the new snapshot
+    // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
+    // normal (the depth falls by what the point gives): the linearised contact of this tick.
+    const Eigen::AlignedBox3d reach = tool.world_bounds(contact.margin_mm);
+    const double k_per_area = contact.stiffness_n_per_mm / 100.0; // per mm^2
+    const bool fresh = snapshot.t_s != m_patch_t_s || m_displaced.count != p.free;
+    if (fresh) { // a new patch, on the new snapshot
         m_patch_t_s = snapshot.t_s;
         m_displaced.count = p.free;
         std::copy_n(p.normals.begin(), p.free, m_displaced.normals.begin());
@@ -302,24 +345,24 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         m_displaced.edges.assign(p.edges.begin(), p.edges.end()); // within the capacity reserved
         std::fill_n(m_u.begin(), p.free, 0.0);
     }
-    // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
-    // normal (the depth falls by what the point gives): the linearised contact of this tick.
-    const Eigen::AlignedBox3d reach = tool.world_bounds(contact.margin_mm);
-    const double k_per_area = contact.stiffness_n_per_mm / 100.0; // per mm^2
     for (std::size_t i = 0; i < p.free; ++i) {
         const Eigen::Vector3d x = p.positions_mm[i] - m_u[i] * p.normals[i];
         m_distance[i] = reach.contains(x) ? contact.margin_mm - tool.signed_distance(x) + m_u[i] : -INFINITY;
     }
-    // The layer under this tick's linearised contact, (K + C) u = C D - preload (C: each pressed
-    // point's contact stiffness; D: its depth at u = 0), by a few conjugate-gradient iterations
-    // from the last tick's u, Jacobi preconditioned: the warm start is close (a tick moves the
-    // tool micrometres), and a patch converges in about l / h iterations from rest.
+    if (fresh) take_over(p, k_per_area);
+    // The carried load fades as the FEM takes it up, over k_handoff_s.
+    const double fade = std::exp(-(dt_s > 0.0 ? dt_s : 1e-3) / k_handoff_s);
+    for (std::size_t i = 0; i < p.free; ++i) m_carried[i] *= fade;
+    // The layer under this tick's linearised contact, (K + C) u = C D - preload - carried (C: each
+    // pressed point's contact stiffness; D: its depth at u = 0), by a few conjugate-gradient
+    // iterations from the last tick's u, Jacobi preconditioned: the warm start is close (a tick
+    // moves the tool micrometres), and a patch converges in about l / h iterations from rest.
     const std::size_t n = p.free;
     for (std::size_t i = 0; i < n; ++i) {
         const double k_contact = k_per_area * p.areas_mm2[i];
         const bool pressed = m_distance[i] - m_u[i] > 0.0;
         m_contact_k[i] = pressed ? k_contact : 0.0;
-        m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i];
+        m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i] - m_carried[i];
         m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
     }
     auto multiply = [&](const std::vector<double>& x, std::vector<double>& out) {
@@ -354,7 +397,18 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
         rz = next;
     }
-    for (std::size_t i = 0; i < p.free; ++i) m_displaced.positions_mm[i] = p.positions_mm[i] - m_u[i] * p.normals[i];
+    // Where the points are, and the load and its give for the handoff (the next patch, the pose
+    // the simulation is given).
+    double load = 0.0, moment = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        m_displaced.positions_mm[i] = p.positions_mm[i] - m_u[i] * p.normals[i];
+        const double f = m_contact_k[i] * std::max(0.0, m_distance[i] - m_u[i]);
+        load += f;
+        moment += f * m_u[i];
+    }
+    m_had_patch = true;
+    m_load_n = load;
+    m_give_mm = load > 0.0 ? moment / load : 0.0;
     // The distances kept, so that the edges' test reads them instead of measuring again.
     ContactTotals out = penalty_totals(tool, contact, m_displaced, false, std::span<double>(m_signed.data(), n));
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
@@ -365,3 +419,4 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
 }
 
 } // namespace vox::contact
+

@@ -19,10 +19,17 @@
 //
 // The snapshot already holds the deformation under the load the tool pressed with when it was
 // taken, so each point's springs carry only what changed since: its preload (that load) is
-// subtracted. When the tool stays, the layer stays at rest; pressing on, it gives; the next
-// frame's snapshot, the FEM having taken the load (the proxy hands the tool's pose over), starts
-// the layer again from rest. The layer is massless: solved each tick, its contact linearised, by a
-// few conjugate-gradient iterations warm started from the last tick.
+// subtracted. When the tool stays, the layer stays at rest; pressing on, it gives.
+//
+// The handoff to the simulation, both ways. The simulation is handed the tool backed out of the
+// patch by the layer's give (CoupledTool::handed_pose), so the FEM is loaded with the force the
+// user feels rather than with the proxy's depth in the rigid snapshot (which, the contact being
+// far stiffer than the object, would overload it and feed a frame-rate oscillation). A new
+// patch starts displaced along its preload's give so the load carries on from the last patch's,
+// with a carried load per point keeping that in balance; the carried load fades over
+// k_handoff_s as the dynamic FEM behind the snapshots takes it up. The layer is massless: solved
+// each tick, its contact linearised, by a few conjugate-gradient iterations warm started from the
+// last tick.
 
 #include "contact/penalty_contact.hpp"
 #include "contact/surface_points.hpp"
@@ -65,20 +72,33 @@ public:
     /// under the contact, and the contact of the tool with the displaced patch is returned (its
     /// stiffness the contact's in series with the layer's: what the proxy's step needs). A
     /// snapshot with no patch, or one too large for the capacity: zero totals.
-    ContactTotals step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot) noexcept;
+    ContactTotals step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s = 1e-3) noexcept;
     /// The patch's free points where they are now (count: its free points).
     [[nodiscard]] const SurfacePoints& displaced() const { return m_displaced; }
     /// Per free point, how far it has given inward since the snapshot, mm.
     [[nodiscard]] std::span<const double> displacement() const { return {m_u.data(), m_displaced.count}; }
     [[nodiscard]] double max_displacement_mm() const noexcept;
+    /// How far the layer gives under the tool, load-weighted, as the last step left it, mm: the
+    /// simulation is handed the tool this much back from the proxy (CoupledTool::handed_pose), so
+    /// the FEM is loaded with what the user feels, not with the proxy's depth in the rigid surface.
+    [[nodiscard]] double give_mm() const noexcept { return m_give_mm; }
     /// Conjugate-gradient iterations a tick, at most.
     static constexpr int k_iterations = 8;
+    /// A new patch carries on the load of the last (its layer displaced and a carried load in
+    /// balance with it), which fades with this time constant as the FEM takes it up, s.
+    static constexpr double k_handoff_s = 0.03;
 
 private:
+    /// A new patch, its points' depths measured undisplaced: starts where the last left off.
+    void take_over(const PatchLayer& patch, double k_per_area) noexcept;
+
     SurfacePoints m_displaced;
     std::vector<double> m_u, m_distance, m_signed;
     std::vector<double> m_contact_k, m_b, m_diagonal, m_r, m_p, m_ap; ///< the tick's solve, per free point
-    double m_patch_t_s = -1e300; ///< the snapshot whose patch m_displaced holds
+    std::vector<double> m_carried; ///< per free point, the load carried over from the last patch, N
+    double m_patch_t_s = -1e300;   ///< the snapshot whose patch m_displaced holds
+    bool m_had_patch = false;      ///< the last step had a patch
+    double m_load_n = 0.0, m_give_mm = 0.0; ///< the last step's normal load on the layer and its give
 };
 
 } // namespace vox::contact

@@ -86,8 +86,10 @@ struct PatchLayer {
     /// The FEM's compliance the springs were scaled to: load-weighted displacement per newton,
     /// and the load's direction, world.
     double compliance_mm_per_n = 0.0;
-    Eigen::Vector3d centre_mm = Eigen::Vector3d::Zero(); ///< where it was built around
-    double radius_mm = 0.0;
+    /// Per free point, how far the springs give under the preload alone, mm: the shape the
+    /// haptic side starts a new patch displaced along, so the force carries on from the last
+    /// patch's instead of jumping to the new snapshot's (ContactPatchState::step).
+    std::vector<double> preload_give_mm;
 };
 
 struct SurfacePoints {

@@ -12,6 +12,14 @@ CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::Contact
     m_proxy.shape = &shape;
 }
 
+contact::PlacedShape CoupledTool::handed_pose() const
+{
+    contact::PlacedShape out = m_proxy;
+    const double force = m_patch_force.norm();
+    if (force > 0.0) out.position += m_patch.give_mm() / force * m_patch_force;
+    return out;
+}
+
 Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept
 {
     if (!m_started) {
@@ -37,10 +45,12 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     const std::span<double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
     m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false, distance);
     m_patch_us = 0.0;
+    m_patch_force = Eigen::Vector3d::Zero();
     if (surface.patch.free > 0) { // the patch stands in for the snapshot's points at the contact
         const auto start = std::chrono::steady_clock::now();
-        const contact::ContactTotals patch = m_patch.step(m_proxy, m_parameters, surface);
+        const contact::ContactTotals patch = m_patch.step(m_proxy, m_parameters, surface, dt_s);
         m_patch_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+        m_patch_force = patch.force_on_tool_n;
         m_contact.force_on_tool_n += patch.force_on_tool_n;
         m_contact.torque_on_tool_n_mm += patch.torque_on_tool_n_mm;
         m_contact.stiffness_n_per_mm += patch.stiffness_n_per_mm;

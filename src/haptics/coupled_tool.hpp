@@ -43,6 +43,10 @@ public:
 
     /// The proxy: where the tool is in the simulation.
     [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
+    /// Where the simulation is to put the tool: the proxy, backed out of a contact patch by how
+    /// far its layer gives (the FEM takes up the layer's give itself, from the load the user
+    /// feels; contact/contact_patch.hpp). Without a patch, the proxy.
+    [[nodiscard]] contact::PlacedShape handed_pose() const;
     /// A new snapshot's move is spread over at most this many ticks (the safety stage fades the
     /// force of a snapshot 50 ms old).
     static constexpr int k_max_spread_ticks = 50;
@@ -65,6 +69,7 @@ private:
     std::vector<double> m_distance; ///< per snapshot point, this tick's distance at the proxy
     contact::ContactPatchState m_patch;
     double m_patch_us = 0.0;
+    Eigen::Vector3d m_patch_force = Eigen::Vector3d::Zero(); ///< the patch's part of m_contact
     Eigen::Vector3d m_previous_device = Eigen::Vector3d::Zero(), m_previous_felt = Eigen::Vector3d::Zero();
     /// A new snapshot's move of the proxy not felt yet, and how much of it goes each tick.
     Eigen::Vector3d m_spread = Eigen::Vector3d::Zero(), m_spread_step = Eigen::Vector3d::Zero();

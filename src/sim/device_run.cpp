@@ -125,8 +125,8 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
     // The snapshots: the surface around where each tool is, as the simulation has it at the frame's start.
     for (const std::unique_ptr<Hand>& hand : m_hands) {
         const io::ToolSpec& spec = m_scene.tools[hand->tool];
-        const contact::PlacedShape& proxy = hand->coupled->proxy();
-        take_snapshot(method, hand->tool, spec, proxy, proxy.world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), t0_s, hand->snapshot);
+        const contact::PlacedShape pose = hand->coupled->handed_pose(); // where the simulation has the tool
+        take_snapshot(method, hand->tool, spec, pose, pose.world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), t0_s, hand->snapshot);
         if (hand->snapshot.truncated && !hand->warned_truncated) {
             log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name,
                       hand->snapshot.capacity());
@@ -148,7 +148,10 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
             hand.patch_us_max = std::max(hand.patch_us_max, hand.coupled->patch_us());
         }
     }
-    for (const std::unique_ptr<Hand>& hand : m_hands) tools.drive(hand->tool, hand->coupled->proxy().position, hand->coupled->proxy().orientation);
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        const contact::PlacedShape pose = hand->coupled->handed_pose();
+        tools.drive(hand->tool, pose.position, pose.orientation);
+    }
 }
 
 std::vector<PatchFrame> DeviceRun::patches() const

@@ -199,7 +199,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                               const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
                               haptics::CoupledTool& tool = *coupled[static_cast<std::size_t>(k)];
                               const Eigen::Vector3d f = tool.update(s, surface, 1e-3);
-                              hand.proxies.write_slot() = {k, tool.proxy(), mouse ? pointer.target() : s.position_mm};
+                              hand.proxies.write_slot() = {k, tool.handed_pose(), mouse ? pointer.target() : s.position_mm};
                               hand.proxies.publish();
                               if (d == 0) requests.ticks.fetch_add(1, std::memory_order_relaxed);
                               return f;

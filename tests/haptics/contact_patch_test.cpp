@@ -158,7 +158,7 @@ TEST(ContactPatch, TheForceDoesNotStepWhenThePatchMovesOrRefines)
         next.t_s = t;
         next.index();
         settings.levels = 1 + (tick / 10) % 2;
-        ASSERT_TRUE(contact::build_patch(next, coupled.proxy(), {k_margin, k_stiffness}, k_compliance, settings))
+        ASSERT_TRUE(contact::build_patch(next, coupled.handed_pose(), {k_margin, k_stiffness}, k_compliance, settings))
             << "tick " << tick << ", proxy " << coupled.proxy().position.transpose();
         refined += next.patch.level != p.level;
         surface = std::move(next);
@@ -168,4 +168,46 @@ TEST(ContactPatch, TheForceDoesNotStepWhenThePatchMovesOrRefines)
     EXPECT_GT(largest_force, 0.3);
     EXPECT_GT(refined, 50);
     EXPECT_LT(largest_step, 0.01) << "largest force " << largest_force;
+}
+
+TEST(ContactPatch, ANewPatchOnALaggingSnapshotCarriesTheForceOnAndHandsItOver)
+{
+    // The punch pressed 1 mm into a patch and settled. The simulation is handed the tool backed
+    // out by the layer's give. The next snapshot has not moved at all (a FEM that has not yet
+    // taken up any of the give): the new patch, built where the simulation has the tool, starts
+    // from the last patch's load, not from the rigid snapshot's (larger) one, and its carried load
+    // fades over ContactPatchState::k_handoff_s into the new patch's own settled force.
+    const contact::ToolShape punch = contact::ToolShape::box({6, 6, 4});
+    const contact::PlacedShape touching = punch_at(punch, 0.3, -0.2, 0.2);
+    const Eigen::Vector3d device = touching.position - Eigen::Vector3d(0, 0, 1.0);
+    const contact::SurfacePoints first = wall_with_patch(touching, 1);
+    haptics::CoupledTool tool(punch, {k_margin, k_stiffness}, {0.5, 0.0}, first.capacity());
+    tool.update(device_at(touching.position, 0.0), first, 1e-3);
+    Eigen::Vector3d settled;
+    for (int tick = 1; tick <= 4000; ++tick) settled = tool.update(device_at(device, tick * 1e-3), first, 1e-3);
+    const double give = tool.patch().give_mm();
+    ASSERT_GT(give, 0.05);
+    const contact::PlacedShape handed = tool.handed_pose();
+    EXPECT_NEAR((handed.position - tool.proxy().position).z(), give, 1e-9); // backed out along the contact's force, +z
+    EXPECT_NEAR((handed.position - tool.proxy().position).head<2>().norm(), 0.0, 1e-6);
+
+    contact::SurfacePoints next = wall_with_patch(handed, 1);
+    next.t_s = first.t_s + 0.01;
+    contact::SurfacePoints wall = test::flat_wall(41, true);
+    wall.index();
+    const Eigen::Vector3d rigid = contact::penalty_totals(tool.proxy(), {k_margin, k_stiffness}, wall).force_on_tool_n; // a restart from rest
+    Eigen::Vector3d previous = settled, f;
+    double largest_step = 0.0;
+    for (int tick = 1; tick <= 300; ++tick) {
+        f = tool.update(device_at(device, 4.0 + tick * 1e-3), next, 1e-3);
+        largest_step = std::max(largest_step, (f - previous).norm());
+        previous = f;
+    }
+    const Settled own = press(punch, next, handed.position, device);
+    std::printf("handoff: settled %.4f N (give %.4f mm); on the lagging snapshot a rigid restart %.4f N, the largest change in a tick %.5f N, "
+                "after 0.3 s %.4f N (the new patch settled alone: %.4f N)\n",
+                settled.z(), give, rigid.z(), largest_step, f.z(), own.force.z());
+    EXPECT_GT(rigid.z() - settled.z(), 0.05) << "the lagging snapshot would step the force";
+    EXPECT_LT(largest_step, 0.01);
+    EXPECT_NEAR(f.z(), own.force.z(), 0.01 * own.force.z());
 }
