@@ -286,7 +286,8 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
 
 ContactPatchState::ContactPatchState(std::size_t capacity)
     : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_signed(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
-      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0), m_carried(capacity, 0.0)
+      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0), m_carried(capacity, 0.0),
+      m_measured_u(capacity, 0.0), m_free_edge(3 * capacity + 16, Eigen::Vector2i::Zero())
 {
     m_displaced.edges.reserve(3 * capacity + 16); // a triangulated patch has about three edges a point
 }
@@ -344,10 +345,17 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         std::copy_n(p.areas_mm2.begin(), p.free, m_displaced.areas_mm2.begin());
         m_displaced.edges.assign(p.edges.begin(), p.edges.end()); // within the capacity reserved
         std::fill_n(m_u.begin(), p.free, 0.0);
+        // The mesh springs between two free points (those to a held one add nothing to the
+        // springs' product beyond the diagonal: it stays at u = 0), so the product below is one
+        // straight loop over them.
+        m_free_edges = 0;
+        for (const Eigen::Vector2i& e : p.edges)
+            if (static_cast<std::size_t>(e[0]) < p.free && static_cast<std::size_t>(e[1]) < p.free) m_free_edge[m_free_edges++] = e;
     }
     for (std::size_t i = 0; i < p.free; ++i) {
         const Eigen::Vector3d x = p.positions_mm[i] - m_u[i] * p.normals[i];
         m_distance[i] = reach.contains(x) ? contact.margin_mm - tool.signed_distance(x) + m_u[i] : -INFINITY;
+        m_measured_u[i] = m_u[i];
     }
     if (fresh) take_over(p, k_per_area);
     // The carried load fades as the FEM takes it up, over k_handoff_s.
@@ -366,51 +374,71 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
     }
     auto multiply = [&](const std::vector<double>& x, std::vector<double>& out) {
-        for (std::size_t i = 0; i < n; ++i) {
-            double pulled = 0.0;
-            for (std::uint32_t k = p.neighbour_start[i]; k < p.neighbour_start[i + 1]; ++k)
-                if (p.neighbours[k] < n) pulled += x[p.neighbours[k]];
-            out[i] = m_diagonal[i] * x[i] - p.mesh_n_per_mm * pulled;
+        for (std::size_t i = 0; i < n; ++i) out[i] = m_diagonal[i] * x[i];
+        const double k = p.mesh_n_per_mm;
+        for (std::size_t e = 0; e < m_free_edges; ++e) {
+            const auto a = static_cast<std::size_t>(m_free_edge[e][0]), b = static_cast<std::size_t>(m_free_edge[e][1]);
+            out[a] -= k * x[b];
+            out[b] -= k * x[a];
         }
     };
     multiply(m_u, m_ap);
-    double rz = 0.0, bb = 0.0;
+    double rz = 0.0, rr = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         m_r[i] = m_b[i] - m_ap[i];
         m_p[i] = m_r[i] / m_diagonal[i];
         rz += m_r[i] * m_p[i];
-        bb += m_b[i] * m_b[i] / m_diagonal[i];
+        rr += m_r[i] * m_r[i];
     }
-    for (int it = 0; it < k_iterations && rz > 1e-20 * bb; ++it) {
+    // Until the points' unbalanced forces are far below what a hand feels (k_residual_n in all).
+    for (int it = 0; it < k_iterations && rr > k_residual_n * k_residual_n; ++it) {
         multiply(m_p, m_ap);
         double pap = 0.0;
         for (std::size_t i = 0; i < n; ++i) pap += m_p[i] * m_ap[i];
         if (!(pap > 0.0)) break;
         const double alpha = rz / pap;
         double next = 0.0;
+        rr = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
             m_u[i] += alpha * m_p[i];
             m_r[i] -= alpha * m_ap[i];
             next += m_r[i] * m_r[i] / m_diagonal[i];
+            rr += m_r[i] * m_r[i];
         }
         const double beta = next / rz;
         for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
         rz = next;
     }
-    // Where the points are, and the load and its give for the handoff (the next patch, the pose
-    // the simulation is given).
+    // The tool's contact with the displaced points, and the load and its give for the handoff
+    // (the next patch, the pose the simulation is given). A point that moved less than
+    // k_linear_mm in this tick takes its linearised depth, D - u (measuring it again would change
+    // nothing felt); one that moved more, or was out of the tool's reach where it was measured
+    // (the layer springing back under a tool that left), is measured where it is. The edges' pass
+    // reads the distances so found.
+    ContactTotals out;
     double load = 0.0, moment = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-        m_displaced.positions_mm[i] = p.positions_mm[i] - m_u[i] * p.normals[i];
-        const double f = m_contact_k[i] * std::max(0.0, m_distance[i] - m_u[i]);
-        load += f;
-        moment += f * m_u[i];
+        const Eigen::Vector3d x = p.positions_mm[i] - m_u[i] * p.normals[i];
+        m_displaced.positions_mm[i] = x;
+        double depth = -INFINITY;
+        if (m_distance[i] > -INFINITY && std::abs(m_u[i] - m_measured_u[i]) <= k_linear_mm) depth = m_distance[i] - m_u[i];
+        else if (reach.contains(x)) depth = contact.margin_mm - tool.signed_distance(x);
+        m_signed[i] = depth > -INFINITY ? contact.margin_mm - depth : INFINITY;
+        if (!(depth > 0.0)) continue;
+        const double k = k_per_area * p.areas_mm2[i];
+        const Eigen::Vector3d f = k * depth * p.normals[i]; // on the tool, out of the surface
+        out.force_on_tool_n += f;
+        out.torque_on_tool_n_mm += (x - tool.position).cross(f);
+        out.stiffness_n_per_mm += k * p.normals[i] * p.normals[i].transpose();
+        out.area_mm2 += p.areas_mm2[i];
+        out.inner_reaches_surface = out.inner_reaches_surface || depth > contact.margin_mm;
+        load += k * depth;
+        moment += k * depth * m_u[i];
     }
     m_had_patch = true;
     m_load_n = load;
     m_give_mm = load > 0.0 ? moment / load : 0.0;
-    // The distances kept, so that the edges' test reads them instead of measuring again.
-    ContactTotals out = penalty_totals(tool, contact, m_displaced, false, std::span<double>(m_signed.data(), n));
+    add_edge_totals(tool, contact, m_displaced, std::span<double>(m_signed.data(), n), out);
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
     // stiffness k becomes k / (1 + k c), c the layer's compliance.
     const double k = out.stiffness_n_per_mm.trace();
@@ -419,4 +447,6 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
 }
 
 } // namespace vox::contact
+
+
 

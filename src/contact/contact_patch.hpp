@@ -82,8 +82,10 @@ public:
     /// simulation is handed the tool this much back from the proxy (CoupledTool::handed_pose), so
     /// the FEM is loaded with what the user feels, not with the proxy's depth in the rigid surface.
     [[nodiscard]] double give_mm() const noexcept { return m_give_mm; }
-    /// Conjugate-gradient iterations a tick, at most.
+    /// Conjugate-gradient iterations a tick, at most, and the residual (the norm of the points'
+    /// unbalanced forces, N) they stop at.
     static constexpr int k_iterations = 8;
+    static constexpr double k_residual_n = 1e-4;
     /// A new patch carries on the load of the last (its layer displaced and a carried load in
     /// balance with it), which fades with this time constant as the FEM takes it up, s.
     static constexpr double k_handoff_s = 0.03;
@@ -96,6 +98,12 @@ private:
     std::vector<double> m_u, m_distance, m_signed;
     std::vector<double> m_contact_k, m_b, m_diagonal, m_r, m_p, m_ap; ///< the tick's solve, per free point
     std::vector<double> m_carried; ///< per free point, the load carried over from the last patch, N
+    std::vector<double> m_measured_u; ///< per free point, its u where the tick measured its distance
+    std::vector<Eigen::Vector2i> m_free_edge; ///< the patch's edges between two free points (the first m_free_edges)
+    std::size_t m_free_edges = 0;
+    /// A point that moves less than this in a tick keeps its linearised depth (its error is of
+    /// the order of the move squared over the tool's radius of curvature), mm.
+    static constexpr double k_linear_mm = 0.005;
     double m_patch_t_s = -1e300;   ///< the snapshot whose patch m_displaced holds
     bool m_had_patch = false;      ///< the last step had a patch
     double m_load_n = 0.0, m_give_mm = 0.0; ///< the last step's normal load on the layer and its give

@@ -113,6 +113,29 @@ bool convex_reach(const PlacedShape& shape, const Eigen::Vector3d& a, const Eige
     return true;
 }
 
+/// A ball (its distance |x - c| - R): the nearest point of the edge to the centre, and where the
+/// edge crosses the sphere of radius R + margin, in closed form (convex_reach's answer, exact).
+bool ball_reach(const PlacedShape& ball, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double margin, EdgeReach& out) noexcept
+{
+    const Eigen::Vector3d c = ball.position, e = b - a, ac = a - c;
+    const double radius = -ball.signed_distance(c), ee = e.squaredNorm();
+    const double t = ee > 0.0 ? std::clamp(-ac.dot(e) / ee, 0.0, 1.0) : 0.0;
+    out.lower = (ac + t * e).norm() - radius;
+    if (!(out.lower < margin)) return false;
+    out.t = t;
+    // |ac + s e|^2 = (R + margin)^2: a quadratic in s with a root on each side of t.
+    const double r = radius + margin, half_b = ac.dot(e), disc = std::max(0.0, half_b * half_b - ee * (ac.squaredNorm() - r * r));
+    const double root = std::sqrt(disc);
+    out.share = ee > 0.0 ? std::clamp((-half_b + root) / ee, 0.0, 1.0) - std::clamp((-half_b - root) / ee, 0.0, 1.0) : 0.0;
+    return true;
+}
+
+/// Where an edge reaches into a convex tool: in closed form for a ball, else by cutting planes.
+bool convex_edge_reach(const PlacedShape& shape, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double margin, EdgeReach& out) noexcept
+{
+    return shape.shape->kind() == ToolShape::Kind::sphere ? ball_reach(shape, a, b, margin, out) : convex_reach(shape, a, b, margin, out);
+}
+
 /// Any shape (a mesh tool's distance need not be convex): halving the edge while the distance's
 /// Lipschitz bound leaves room, then a golden-section search for the deepest point and bisections
 /// for where the edge leaves the margin on each side.
@@ -175,8 +198,8 @@ bool edge_penalty(const PlacedShape& tool, const PlacedShape* from, const Contac
     // (the end's, if both).
     const bool convex = tool.shape && tool.shape->kind() != ToolShape::Kind::mesh;
     EdgeReach reach;
-    const bool in_now = convex ? convex_reach(tool, a, b, margin, reach) : general_reach(tool, a, b, d_a, d_b, margin, reach);
-    if (!in_now && !(from && (convex ? convex_reach(*from, a, b, margin, reach) : general_reach(*from, a, b, from_a, from_b, margin, reach))))
+    const bool in_now = convex ? convex_edge_reach(tool, a, b, margin, reach) : general_reach(tool, a, b, d_a, d_b, margin, reach);
+    if (!in_now && !(from && (convex ? convex_edge_reach(*from, a, b, margin, reach) : general_reach(*from, a, b, from_a, from_b, margin, reach))))
         return false;
     const double t = reach.t;
     out.at = a + t * (b - a);
@@ -204,7 +227,7 @@ double edge_slack(const PlacedShape& tool, double margin, const Eigen::Vector3d&
     double lower = 0.5 * (d_a + d_b - (b - a).norm()); // 1-Lipschitz
     EdgeReach reach;
     if (tool.shape->kind() != ToolShape::Kind::mesh) {
-        if (convex_reach(tool, a, b, margin, reach)) return 0.0;
+        if (convex_edge_reach(tool, a, b, margin, reach)) return 0.0;
         lower = std::max(lower, reach.lower);
     } else if (lower < margin && general_reach(tool, a, b, d_a, d_b, margin, reach)) {
         return 0.0;
@@ -310,6 +333,60 @@ ContactResult penalty_contact(const PlacedShape& tool, const ContactParameters& 
     return out;
 }
 
+namespace {
+
+/// The edges' pass of penalty_totals (both of its passes): calls visit(ep) for each edge that is
+/// pressed, its ends' distances read from `distance` where measured (kept), else measured here.
+template <class Visit>
+void for_each_pressed_edge(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points, const Eigen::AlignedBox3d& reach,
+                           double spent, std::span<double> distance, Visit&& visit) noexcept
+{
+    const bool keep = distance.size() >= points.count;
+    const bool own = points.stiffness_n_per_mm.size() >= points.count;
+    ContactParameters at = parameters;
+    auto edge_parameters = [&](std::size_t a, std::size_t b) -> const ContactParameters& {
+        if (own) at.stiffness_n_per_mm = 0.5 * (points.stiffness_n_per_mm[a] + points.stiffness_n_per_mm[b]);
+        return at;
+    };
+    // An end outside the pushing shape's box is measured here (and kept for the continuous check).
+    auto measured = [&](std::size_t i) {
+        if (keep && distance[i] < INFINITY) return distance[i];
+        const double d = tool.signed_distance(points.positions_mm[i]);
+        if (keep) distance[i] = d;
+        return d;
+    };
+    // Cheap tests first (the loop visits every edge of the snapshot each tick): with both ends
+    // measured, an end inside (its point contact has it) or the Lipschitz bound; else the box.
+    auto may_reach_in = [&](std::size_t a, std::size_t b) {
+        const Eigen::Vector3d &p = points.positions_mm[a], &q = points.positions_mm[b];
+        if (keep && distance[a] < INFINITY && distance[b] < INFINITY) {
+            const double margin = parameters.margin_mm, room = distance[a] + distance[b] - 2.0 * margin;
+            return distance[a] >= margin && distance[b] >= margin && room * room < (q - p).squaredNorm();
+        }
+        return reach.intersects(Eigen::AlignedBox3d(p.cwiseMin(q), p.cwiseMax(q)));
+    };
+    EdgePenalty ep;
+    points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
+        const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
+        if (b >= points.count || points.is_replaced(a) || points.is_replaced(b) || !may_reach_in(a, b)) return;
+        const double d_a = measured(a), d_b = measured(b);
+        if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
+                         points.areas_mm2[b], points.normals[a], points.normals[b], ep))
+            visit(ep);
+    }, spent);
+}
+
+void add_edge(const PlacedShape& tool, const EdgePenalty& e, ContactTotals& out)
+{
+    out.force_on_tool_n -= e.force;
+    out.torque_on_tool_n_mm -= (e.at - tool.position).cross(e.force);
+    out.stiffness_n_per_mm += e.stiffness * e.normal * e.normal.transpose();
+    out.area_mm2 += e.area;
+    out.inner_reaches_surface = out.inner_reaches_surface || e.distance < 0.0;
+}
+
+} // namespace
+
 ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
                              bool with_pressure, std::span<double> distance) noexcept
 {
@@ -323,10 +400,6 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     ContactParameters at = parameters;
     auto parameters_of = [&](std::size_t i) -> const ContactParameters& {
         if (own) at.stiffness_n_per_mm = points.stiffness_n_per_mm[i];
-        return at;
-    };
-    auto edge_parameters = [&](std::size_t a, std::size_t b) -> const ContactParameters& {
-        if (own) at.stiffness_n_per_mm = 0.5 * (points.stiffness_n_per_mm[a] + points.stiffness_n_per_mm[b]);
         return at;
     };
     // Only the points and edges near the tool are visited (the snapshot's grid), and of those only
@@ -347,42 +420,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     }, spent);
     // The edges, as penalty_contact takes them (their ends' distances from the pass above when
     // kept, else measured again).
-    EdgePenalty ep;
-    // An end outside the pushing shape's box is measured here (and kept for the continuous check).
-    auto measured = [&](std::size_t i) {
-        if (keep && distance[i] < INFINITY) return distance[i];
-        const double d = tool.signed_distance(points.positions_mm[i]);
-        if (keep) distance[i] = d;
-        return d;
-    };
-    // Cheap tests first (the loop visits every edge of the snapshot each tick): with both ends
-    // measured, an end inside (its point contact has it) or the Lipschitz bound; else the box.
-    auto may_reach_in = [&](std::size_t a, std::size_t b) {
-        const Eigen::Vector3d &p = points.positions_mm[a], &q = points.positions_mm[b];
-        if (keep && distance[a] < INFINITY && distance[b] < INFINITY) {
-            const double margin = parameters.margin_mm, room = distance[a] + distance[b] - 2.0 * margin;
-            return distance[a] >= margin && distance[b] >= margin && room * room < (q - p).squaredNorm();
-        }
-        return reach.intersects(Eigen::AlignedBox3d(p.cwiseMin(q), p.cwiseMax(q)));
-    };
-    // Calls visit(ep) for each edge pressed (both passes).
-    auto for_each_pressed_edge = [&](auto&& visit) {
-        points.for_each_edge_near(reach, [&](const Eigen::Vector2i& edge) {
-            const auto a = static_cast<std::size_t>(edge[0]), b = static_cast<std::size_t>(edge[1]);
-            if (b >= points.count || points.is_replaced(a) || points.is_replaced(b) || !may_reach_in(a, b)) return;
-            const double d_a = measured(a), d_b = measured(b);
-            if (edge_penalty(tool, nullptr, edge_parameters(a, b), points.positions_mm[a], points.positions_mm[b], d_a, d_b, points.areas_mm2[a],
-                             points.areas_mm2[b], points.normals[a], points.normals[b], ep))
-                visit(ep);
-        }, spent);
-    };
-    for_each_pressed_edge([&](const EdgePenalty& e) {
-        out.force_on_tool_n -= e.force;
-        out.torque_on_tool_n_mm -= (e.at - tool.position).cross(e.force);
-        out.stiffness_n_per_mm += e.stiffness * e.normal * e.normal.transpose();
-        out.area_mm2 += e.area;
-        out.inner_reaches_surface = out.inner_reaches_surface || e.distance < 0.0;
-    });
+    for_each_pressed_edge(tool, parameters, points, reach, spent, distance, [&](const EdgePenalty& e) { add_edge(tool, e, out); });
     if (!with_pressure || out.area_mm2 == 0.0) return out;
     // A second pass for the load-carrying part: nothing is stored per point.
     const Eigen::Vector3d net = -out.force_on_tool_n;
@@ -395,7 +433,7 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
         magnitude += pp.force.norm();
         out.load_area_mm2 += points.areas_mm2[i];
     }, spent);
-    for_each_pressed_edge([&](const EdgePenalty& e) {
+    for_each_pressed_edge(tool, parameters, points, reach, spent, distance, [&](const EdgePenalty& e) {
         if (!carries_load(e.force, net)) return;
         magnitude += e.force.norm();
         out.load_area_mm2 += e.area;
@@ -403,6 +441,13 @@ ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& p
     out.load_area_mm2 = within_shadow(tool, parameters.margin_mm, net, out.load_area_mm2);
     out.pressure_pa = out.load_area_mm2 > 0.0 ? 1e6 * magnitude / out.load_area_mm2 : 0.0;
     return out;
+}
+
+void add_edge_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points, std::span<double> distance,
+                     ContactTotals& out) noexcept
+{
+    for_each_pressed_edge(tool, parameters, points, tool.world_bounds(parameters.margin_mm), points.slack_spent(tool, parameters.margin_mm), distance,
+                          [&](const EdgePenalty& e) { add_edge(tool, e, out); });
 }
 
 void measure_slack(const PlacedShape& tool, double margin_mm, SurfacePoints& points)

@@ -96,6 +96,12 @@ struct ContactTotals {
 [[nodiscard]] ContactTotals penalty_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points,
                                            bool with_pressure = true, std::span<double> distance = {}) noexcept;
 
+/// penalty_totals' edges alone, added to `out`: for a caller that has the points' part already
+/// (the contact patch, from its linearised contact). `distance` as penalty_totals fills it (the
+/// points' distances where measured, else +infinity); ends not measured are measured and kept.
+void add_edge_totals(const PlacedShape& tool, const ContactParameters& parameters, const SurfacePoints& points, std::span<double> distance,
+                     ContactTotals& out) noexcept;
+
 /// Measures a snapshot's slack against `tool` where it is now, pushing with margin `margin_mm`
 /// (SurfacePoints::slack_pose; after index()), in the simulation thread: per point and edge, how
 /// far the tool may move before it can take part in penalty_totals' contact, so that the 1 kHz
