@@ -192,7 +192,9 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
         k = end;
     }
     const std::size_t coarse_points = mesh.positions.size();
-    if (std::count(mesh.held.begin(), mesh.held.end(), 0) == 0) return false;
+    // None where the snapshot's own points there pass the tick's budget (a large tool on a fine
+    // surface): the rigid snapshot serves.
+    if (coarse_points > settings.max_points || std::count(mesh.held.begin(), mesh.held.end(), 0) == 0) return false;
     // As many levels as asked, fewer if the patch would hold more than max_points (each level
     // multiplies the points by about four).
     int level = 0;

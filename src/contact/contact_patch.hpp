@@ -48,7 +48,9 @@ struct PatchSettings {
     /// The patch reaches this far beyond the contact (what the tool can slide within a frame, plus
     /// the spread), mm.
     double reach_mm = 4.0;
-    std::size_t max_points = 600;   ///< fewer levels where the patch would hold more (the tick's budget)
+    /// Fewer levels where the patch would hold more (the tick's budget); no patch where the
+    /// snapshot's own points there already do.
+    std::size_t max_points = 600;
 };
 
 /// Builds snapshot.patch around `tool`'s contact and marks the snapshot points it stands in for

@@ -659,7 +659,14 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
     t.burr_speed_rpm = r.optional("burr_speed_rpm", t.burr_speed_rpm, half_open_range(0.0, 1e6));
     t.drill_rate_mm3_per_n_rev = r.optional("drill_rate_mm3_per_n_rev", t.drill_rate_mm3_per_n_rev, half_open_range(0.0, 1.0));
-    t.haptic_subdivision = r.optional("haptic_subdivision", t.haptic_subdivision, closed_range(-1, 3));
+    if (const std::optional<JsonNode> node = r.optional_node("haptic_subdivision")) {
+        t.haptic_subdivision = r.optional("haptic_subdivision", t.haptic_subdivision, closed_range(-1, 3));
+        // The patch's layer sits on the surface it was built on: a cut or a burr changes that
+        // surface under it every frame (measured: a blade's patch swung its force by 1 N a tick).
+        if (t.haptic_subdivision >= 0 && (t.action == ToolAction::cut || t.action == ToolAction::drill))
+            node->fail("haptic subdivision is for tools that push or wet: a tool that cuts or drills changes the surface under its patch every "
+                       "frame (give this tool \"action\": \"push\", or leave the key out)");
+    }
     if (const std::optional<JsonNode> node = r.optional_node("two_phase")) {
         t.two_phase = as<bool>(*node);
         if (t.two_phase && (t.action != ToolAction::cut || t.cut_mode != CutMode::separate))

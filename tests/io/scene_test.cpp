@@ -678,6 +678,9 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
               "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, burr_speed_rpm, "
               "drill_rate_mm3_per_n_rev, haptic_subdivision, two_phase)");
     EXPECT_EQ(with_key("haptic_subdivision", 4).rfind("s.json: tools[1].haptic_subdivision: must be in [-1, 3]", 0), 0u);
+    // (A blade cuts by default.)
+    EXPECT_EQ(with_key("haptic_subdivision", 1).rfind("s.json: tools[1].haptic_subdivision: haptic subdivision is for tools that push or wet", 0),
+              0u);
     // NaN cannot be in a file but can be in a document built in code.
     EXPECT_EQ(with_key("push_margin_mm", std::nan("")).rfind("s.json: tools[1].push_margin_mm: must be in [0, 100]", 0),
               0u);
