@@ -360,9 +360,8 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         m_measured_u[i] = m_u[i];
     }
     if (fresh) take_over(p, k_per_area);
-    // The carried load fades as the FEM takes it up, over k_handoff_s.
+    // The carried load fades as the FEM takes it up, over k_handoff_s (in the loop below).
     const double fade = std::exp(-(dt_s > 0.0 ? dt_s : 1e-3) / k_handoff_s);
-    for (std::size_t i = 0; i < p.free; ++i) m_carried[i] *= fade;
     // The layer under this tick's linearised contact, (K + C) u = C D - preload - carried (C: each
     // pressed point's contact stiffness; D: its depth at u = 0), by a few conjugate-gradient
     // iterations from the last tick's u, Jacobi preconditioned: the warm start is close (a tick
@@ -372,6 +371,7 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         const double k_contact = k_per_area * p.areas_mm2[i];
         const bool pressed = m_distance[i] - m_u[i] > 0.0;
         m_contact_k[i] = pressed ? k_contact : 0.0;
+        m_carried[i] *= fade;
         m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i] - m_carried[i];
         m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
     }
