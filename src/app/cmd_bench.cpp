@@ -64,6 +64,8 @@ void add_bench_command(CLI::App& app)
                         "With --devices 2: the finger's haptic_subdivision, -1 (off, default) or 0 - 3, to time its contact patch")
         ->check(CLI::Range(-1, 3));
     haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep, finger_subdivision] {
+        if (*finger_subdivision >= 0 && *devices < 2)
+            throw CLI::ValidationError("--haptic-subdivision", "times the finger's contact patch, and the finger is the second device: add --devices 2");
         run_haptics_bench({*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices, *lockstep,
                            *finger_subdivision});
     });
