@@ -12,8 +12,10 @@
 //    surface near each tool, and keeps simulated time in pace with wall time. The scene is
 //    press_and_cut.json one level coarser, which one core steps in real time: the snapshots stay
 //    fresher than the safety stage's 50 ms.
-// They share only triple buffers. Prints period error and force-computation time (p50, p99,
-// max; a tick's force time covers every device), with the cutting and the snapshots' sizes.
+// They share only triple buffers. Prints period error, force time (from reading the first device
+// to sending the last force) and the tick's whole work (the contacts the couplings prepare for the
+// next tick after the forces are sent included), p50, p99 and max over every device, with the
+// cutting and the snapshots' sizes.
 
 #include "bench/harness/haptics.hpp"
 #include "sim/frame_loop.hpp"
@@ -163,7 +165,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
     // Written by the haptic thread only (sized here), read after it has stopped. The knife's mesh
     // sweeps are counted per tick.
-    std::size_t stale_ticks = 0, tick = 0;
+    std::size_t stale_ticks = 0, prepared_ticks = 0, tick = 0;
     const std::size_t capacity = static_cast<std::size_t>(seconds * 1000) + 1000;
     std::vector<unsigned char> swept_mesh(capacity, 0), stopped_by_mesh(capacity, 0); // per tick
     // Per tick, the time the contact patches took (contact/contact_patch.hpp), all devices.
@@ -175,10 +177,12 @@ void run_haptics_bench(const HapticsBenchOptions& options)
         const bool knife = i == 0;
         channels.push_back({&hand->device,
                             [&, hand, knife](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
-                                const contact::SurfacePoints& surface = hand->snapshots.latest();
+                                // The snapshot the last tick's prepare took (and measured the contact on).
+                                const contact::SurfacePoints& surface = hand->snapshots.read_slot();
                                 age = now_s() - surface.t_s;
                                 stale_ticks += age > stale_s;
                                 const Eigen::Vector3d f = hand->coupled.update(s, surface, 1e-3);
+                                prepared_ticks += hand->coupled.used_prepared();
                                 // The knife's channel runs first and counts the tick.
                                 if (const std::size_t at = knife ? tick : tick - 1; at < capacity) patch_us[at] += hand->coupled.patch_us();
                                 if (knife) {
@@ -192,14 +196,15 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                                 hand->poses.publish();
                                 return f;
                             },
-                            haptics::SafetySettings{}});
+                            haptics::SafetySettings{},
+                            [hand](const haptics::DeviceState& s) { hand->coupled.prepare(s, hand->snapshots.latest(), 1e-3); }});
     }
     haptics::HapticLoop loop(std::move(channels), capacity);
 
     log::info("bench haptics: 1 kHz loop for {} s, {} device(s), against a cutting simulation ({}, {}){}", seconds, hands.size(), scene.source,
               io::solver_type_name(method_type), lockstep ? ", lockstep" : "");
     if (!lockstep) loop.start();
-    std::vector<double> lockstep_force_us;
+    std::vector<double> lockstep_force_us, lockstep_work_us;
     int frames = 0, cutting_frames = 0;
     std::vector<double> snapshot_points, frame_ms;
     for (const std::unique_ptr<Hand>& hand : hands) { // the devices' first poses, until the loop reports
@@ -231,9 +236,9 @@ void run_haptics_bench(const HapticsBenchOptions& options)
             const int ticks_per_frame = static_cast<int>(std::lround(scene.solver.dt_s / 1e-3));
             for (int k = 1; k <= ticks_per_frame; ++k) {
                 simulated_s = (frames - 1) * scene.solver.dt_s + k * 1e-3;
-                const auto t0 = clock::now();
                 loop.tick(simulated_s);
-                lockstep_force_us.push_back(std::chrono::duration<double, std::micro>(clock::now() - t0).count());
+                lockstep_force_us.push_back(loop.last_force_us());
+                lockstep_work_us.push_back(loop.last_work_us());
             }
             continue;
         }
@@ -244,6 +249,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     const Percentiles period = percentiles(lockstep ? std::vector<double>{0.0} : loop.timings().period_error_ms);
     const std::vector<double>& force_us = lockstep ? lockstep_force_us : loop.timings().force_us;
     const Percentiles force = percentiles(force_us);
+    const Percentiles work = percentiles(lockstep ? lockstep_work_us : loop.timings().work_us);
     // The ticks that swept the knife's mesh (the costliest kind), on their own.
     std::vector<double> mesh_force_us;
     std::size_t mesh_stops = 0;
@@ -263,13 +269,15 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                 machine_description().c_str(), noise.p50, noise.p99, noise.max);
     const std::size_t ticks = force_us.size();
     std::printf("| ticks | simulation frames (median) | cutting frames | snapshot points, all devices (median) | device ticks on a stale snapshot | "
-                "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | ticks that swept the knife's mesh (stopped by it) | "
-                "their force time p50 / p99 / max | devices |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
-    std::printf("| %zu | %d (%.1f ms) | %d | %.0f | %.1f %% | %s | %.4f / %.4f / %.3f ms | %.1f / %.1f / %.1f us | %zu (%zu) | %.1f / %.1f / %.1f us | %zu |\n",
+                "real-time priority | period error p50 / p99 / max | force time p50 / p99 / max | tick's work p50 / p99 / max | "
+                "ticks that swept the knife's mesh (stopped by it) | their force time p50 / p99 / max | devices |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("| %zu | %d (%.1f ms) | %d | %.0f | %.1f %% | %s | %.4f / %.4f / %.3f ms | %.1f / %.1f / %.1f us | %.1f / %.1f / %.1f us | %zu (%zu) | %.1f / %.1f / %.1f us | %zu |\n",
                 ticks, frames, quantile(frame_ms, 0.5), cutting_frames, quantile(snapshot_points, 0.5),
                 100.0 * static_cast<double>(stale_ticks) / static_cast<double>(std::max<std::size_t>(ticks * hands.size(), 1)),
                 loop.timings().realtime_priority ? "yes" : "no (not permitted)", period.p50, period.p99, period.max, force.p50, force.p99,
-                force.max, mesh_force_us.size(), mesh_stops, mesh_force.p50, mesh_force.p99, mesh_force.max, hands.size());
+                force.max, work.p50, work.p99, work.max, mesh_force_us.size(), mesh_stops, mesh_force.p50, mesh_force.p99, mesh_force.max, hands.size());
+    std::printf("\ndevice ticks answered from the contact prepared after the tick before: %.1f %%\n",
+                100.0 * static_cast<double>(prepared_ticks) / static_cast<double>(std::max<std::size_t>(ticks * hands.size(), 1)));
     std::printf("\ncontact patches (haptic subdivision): stepped in %zu ticks, %.1f / %.1f / %.1f us of the tick (p50 / p99 / max)\n",
                 patch_ticks_us.size(), patch.p50, patch.p99, patch.max);
     std::printf("\ntargets: p99 period error under 0.1 ms (%s), p99 force time under 100 us (%s), p99 patch time under 30 us (%s)\n",

@@ -20,6 +20,36 @@ contact::PlacedShape CoupledTool::handed_pose() const
     return out;
 }
 
+void CoupledTool::measure_contact(const contact::SurfacePoints& surface, double dt_s) noexcept
+{
+    // The points' distances at the proxy, measured once: the contact and the continuous check
+    // both need them.
+    const std::span<double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
+    m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false, distance);
+    m_patch_us = 0.0;
+    m_patch_force = Eigen::Vector3d::Zero();
+    if (surface.patch.free == 0) return;
+    // The patch stands in for the snapshot's points at the contact.
+    const auto start = std::chrono::steady_clock::now();
+    const contact::ContactTotals patch = m_patch.step(m_proxy, m_parameters, surface, dt_s);
+    m_patch_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    m_patch_force = patch.force_on_tool_n;
+    m_contact.force_on_tool_n += patch.force_on_tool_n;
+    m_contact.torque_on_tool_n_mm += patch.torque_on_tool_n_mm;
+    m_contact.stiffness_n_per_mm += patch.stiffness_n_per_mm;
+    m_contact.area_mm2 += patch.area_mm2;
+    m_contact.inner_reaches_surface = m_contact.inner_reaches_surface || patch.inner_reaches_surface;
+}
+
+void CoupledTool::prepare(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept
+{
+    if (!m_started) return;
+    m_proxy.orientation = device.orientation;
+    measure_contact(surface, dt_s);
+    m_prepared_on = &surface;
+    m_prepared_t_s = surface.t_s;
+}
+
 Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept
 {
     if (!m_started) {
@@ -35,28 +65,18 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     }
     ++m_ticks_on_snapshot;
     const Eigen::Vector3d felt_before = felt_position();
-    m_proxy.orientation = device.orientation;
+    // The contact at the proxy: prepared after the last tick on this very snapshot, or measured now.
+    m_used_prepared = m_prepared_on == &surface && m_prepared_t_s == surface.t_s;
+    if (!m_used_prepared) {
+        m_proxy.orientation = device.orientation;
+        measure_contact(surface, dt_s);
+    }
+    m_prepared_on = nullptr;
+    const std::span<const double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
     const double kc = m_coupling.stiffness_n_per_mm;
     // One Newton step a tick on k_c (x_d - x) + F(x) = 0, F linearised at the proxy: warm started
     // from the last tick, the proxy converges within a few ticks of any change (a millisecond
     // moves the device a few micrometres).
-    // The points' distances at the proxy, measured once: the contact and the continuous check
-    // below both need them.
-    const std::span<double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
-    m_contact = contact::penalty_totals(m_proxy, m_parameters, surface, false, distance);
-    m_patch_us = 0.0;
-    m_patch_force = Eigen::Vector3d::Zero();
-    if (surface.patch.free > 0) { // the patch stands in for the snapshot's points at the contact
-        const auto start = std::chrono::steady_clock::now();
-        const contact::ContactTotals patch = m_patch.step(m_proxy, m_parameters, surface, dt_s);
-        m_patch_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
-        m_patch_force = patch.force_on_tool_n;
-        m_contact.force_on_tool_n += patch.force_on_tool_n;
-        m_contact.torque_on_tool_n_mm += patch.torque_on_tool_n_mm;
-        m_contact.stiffness_n_per_mm += patch.stiffness_n_per_mm;
-        m_contact.area_mm2 += patch.area_mm2;
-        m_contact.inner_reaches_surface = m_contact.inner_reaches_surface || patch.inner_reaches_surface;
-    }
     const Eigen::Matrix3d a = kc * Eigen::Matrix3d::Identity() + m_contact.stiffness_n_per_mm;
     const Eigen::Vector3d residual = kc * (device.position_mm - m_proxy.position) + m_contact.force_on_tool_n;
     Eigen::Vector3d step = a.ldlt().solve(residual);

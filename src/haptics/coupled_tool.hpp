@@ -15,6 +15,12 @@
 // Where the snapshot carries a subdivided patch at the contact (contact/contact_patch.hpp), the
 // proxy presses the patch's spring layer there instead of the snapshot's rigid points, so the
 // surface gives under the tool between frames as the FEM would.
+// The contact at the proxy does not depend on the device's new state: the loop measures it after
+// the tick's forces are sent (prepare(), in the rest of the millisecond), for the next tick, which
+// then reads the device and answers with the proxy's step, the continuous check and the spring
+// alone. The work per tick is the same; what the user waits for between reading the device and
+// feeling the force is not the contact's. The proxy takes the device's orientation of the tick
+// before (1 ms later than its position): a turn is not felt as a force.
 // Everything here runs in the 1 kHz loop: no allocation, lock, log or throw.
 
 #include "contact/contact_patch.hpp"
@@ -40,6 +46,10 @@ public:
     /// One tick of `dt_s`: moves the proxy for the device's new state against `surface` and
     /// returns the force for the device, N. The first call puts the proxy at the device.
     Eigen::Vector3d update(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept;
+    /// After the tick's forces are sent: the contact of the proxy, turned to `device`'s
+    /// orientation, with `surface` (the newest snapshot), which the next update() on that same
+    /// snapshot starts from instead of measuring it then. Before the first update(): nothing.
+    void prepare(const DeviceState& device, const contact::SurfacePoints& surface, double dt_s) noexcept;
 
     /// The proxy: where the tool is in the simulation.
     [[nodiscard]] const contact::PlacedShape& proxy() const { return m_proxy; }
@@ -54,6 +64,8 @@ public:
     [[nodiscard]] Eigen::Vector3d felt_position() const { return m_proxy.position + m_spread; }
     /// The continuous check of the last update (whether it swept the tool's mesh, and stopped on it).
     [[nodiscard]] const contact::ToolSweep& sweep() const { return m_sweep; }
+    /// Whether the last update started from the contact prepare() measured (else it measured it).
+    [[nodiscard]] bool used_prepared() const { return m_used_prepared; }
     /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
     [[nodiscard]] const contact::ContactTotals& contact() const { return m_contact; }
     /// The contact patch's layer as the last update left it, and how long it took to step, us.
@@ -61,6 +73,9 @@ public:
     [[nodiscard]] double patch_us() const { return m_patch_us; }
 
 private:
+    /// The contact (and the patch's step) at the proxy where it is now: m_contact, m_distance.
+    void measure_contact(const contact::SurfacePoints& surface, double dt_s) noexcept;
+
     contact::ContactParameters m_parameters;
     CouplingSettings m_coupling;
     contact::PlacedShape m_proxy;
@@ -77,6 +92,10 @@ private:
     int m_ticks_on_snapshot = 0;  ///< updates since the snapshot changed
     int m_spread_ticks = 1;       ///< updates between the last two snapshots: the move's spread
     bool m_started = false;
+    /// The snapshot prepare() measured the contact on (its time), or none.
+    const contact::SurfacePoints* m_prepared_on = nullptr;
+    double m_prepared_t_s = 0.0;
+    bool m_used_prepared = false;
 };
 
 } // namespace vox::haptics

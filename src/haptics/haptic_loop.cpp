@@ -10,9 +10,11 @@ namespace vox::haptics {
 HapticLoop::HapticLoop(std::vector<HapticChannel> channels, std::size_t capacity)
 {
     m_channels.reserve(channels.size());
-    for (HapticChannel& c : channels) m_channels.push_back({c.device, std::move(c.model), ForceSafety(c.safety), {}, Eigen::Vector3d::Zero()});
+    for (HapticChannel& c : channels)
+        m_channels.push_back({c.device, std::move(c.model), std::move(c.prepare), ForceSafety(c.safety), {}, Eigen::Vector3d::Zero()});
     m_timings.period_error_ms.resize(capacity);
     m_timings.force_us.resize(capacity);
+    m_timings.work_us.resize(capacity);
 }
 
 HapticLoop::HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity)
@@ -24,6 +26,8 @@ HapticLoop::~HapticLoop() { stop(); }
 
 Eigen::Vector3d HapticLoop::tick(double t_s) noexcept
 {
+    using clock = std::chrono::steady_clock;
+    const auto begin = clock::now();
     for (Served& c : m_channels) {
         c.device->read(t_s, c.state);
         double age = 0.0;
@@ -36,6 +40,16 @@ Eigen::Vector3d HapticLoop::tick(double t_s) noexcept
         c.force = c.safety.filter(f, t_s, age);
         c.device->send(c.force, Eigen::Vector3d::Zero());
     }
+    const auto sent = clock::now();
+    for (Served& c : m_channels) {
+        if (!c.prepare) continue;
+        try {
+            c.prepare(c.state);
+        } catch (...) { // as a model's: the next tick measures for itself
+        }
+    }
+    m_last_force_us = std::chrono::duration<double, std::micro>(sent - begin).count();
+    m_last_work_us = std::chrono::duration<double, std::micro>(clock::now() - begin).count();
     return m_channels.empty() ? Eigen::Vector3d::Zero() : m_channels.front().force;
 }
 
@@ -52,6 +66,7 @@ void HapticLoop::stop()
     if (m_thread.joinable()) m_thread.join();
     m_timings.period_error_ms.resize(m_recorded);
     m_timings.force_us.resize(m_recorded);
+    m_timings.work_us.resize(m_recorded);
 }
 
 void HapticLoop::run()
@@ -69,13 +84,12 @@ void HapticLoop::run()
         while (clock::now() < deadline) {
         }
         const auto now = clock::now();
-        const auto begin = now;
         tick(std::chrono::duration<double>(now - start).count());
-        const auto end = clock::now();
         if (m_recorded < m_timings.force_us.size()) {
             m_timings.period_error_ms[m_recorded] =
                 std::abs(std::chrono::duration<double, std::milli>(now - previous).count() - 1.0);
-            m_timings.force_us[m_recorded] = std::chrono::duration<double, std::micro>(end - begin).count();
+            m_timings.force_us[m_recorded] = m_last_force_us;
+            m_timings.work_us[m_recorded] = m_last_work_us;
             ++m_recorded;
         }
         previous = now;

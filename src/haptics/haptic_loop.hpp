@@ -7,6 +7,10 @@
 //    force computation (all devices) into preallocated buffers;
 //  - lockstep: tick(t) called by the simulation thread a fixed number of times per step, in
 //    simulated time, so headless runs and replays are deterministic.
+// A tick reads every device and sends every force first; then each channel may prepare the next
+// tick's work that does not depend on its device (its contact, haptics/coupled_tool.hpp) in the
+// rest of the millisecond. The force time is the first part, what the user waits for; the tick's
+// work is both.
 // The tick never allocates, locks, logs or throws.
 
 #include "haptics/device.hpp"
@@ -25,15 +29,22 @@ using ForceModel = std::function<Eigen::Vector3d(const DeviceState& state, doubl
 
 struct LoopTimings {
     std::vector<double> period_error_ms; ///< |actual period - 1 ms| per tick (live mode)
-    std::vector<double> force_us;        ///< force computation time per tick
+    std::vector<double> force_us;        ///< per tick: from reading the first device to sending the last force
+    std::vector<double> work_us;         ///< per tick: all of it, the channels' preparing included
     bool realtime_priority = false;      ///< SCHED_FIFO was granted
 };
 
-/// One device the loop serves: its force model and its own safety stage.
+/// After every force of a tick is sent, with the state the device was read in: the next tick's
+/// work that does not depend on its device's next state. Must not allocate, lock or throw.
+using Prepare = std::function<void(const DeviceState& state)>;
+
+/// One device the loop serves: its force model, its own safety stage and, optionally, what it
+/// prepares for the next tick.
 struct HapticChannel {
     Device* device = nullptr;
     ForceModel model;
     SafetySettings safety;
+    Prepare prepare;
 };
 
 class HapticLoop {
@@ -55,6 +66,9 @@ public:
     /// The live thread's timings so far (call after stop()).
     [[nodiscard]] const LoopTimings& timings() const { return m_timings; }
     [[nodiscard]] std::size_t device_count() const { return m_channels.size(); }
+    /// The last tick's force time and whole work, us (LoopTimings), in either mode.
+    [[nodiscard]] double last_force_us() const { return m_last_force_us; }
+    [[nodiscard]] double last_work_us() const { return m_last_work_us; }
     /// Device i's state read and force sent at the last tick.
     [[nodiscard]] const DeviceState& state(std::size_t i = 0) const { return m_channels[i].state; }
     [[nodiscard]] const Eigen::Vector3d& force(std::size_t i = 0) const { return m_channels[i].force; }
@@ -63,6 +77,7 @@ private:
     struct Served {
         Device* device;
         ForceModel model;
+        Prepare prepare;
         ForceSafety safety;
         DeviceState state;
         Eigen::Vector3d force = Eigen::Vector3d::Zero();
@@ -72,6 +87,7 @@ private:
     std::vector<Served> m_channels;
     LoopTimings m_timings;
     std::size_t m_recorded = 0;
+    double m_last_force_us = 0.0, m_last_work_us = 0.0;
     std::atomic<bool> m_running{false};
     std::thread m_thread;
 };

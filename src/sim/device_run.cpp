@@ -89,7 +89,8 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const Devi
                                 age = state.t_s - hand->snapshot.t_s;
                                 return hand->coupled->update(state, hand->snapshot, m_tick_s);
                             },
-                            safety});
+                            safety,
+                            [this, hand](const haptics::DeviceState& state) { hand->coupled->prepare(state, hand->snapshot, m_tick_s); }});
     }
     m_loop = std::make_unique<haptics::HapticLoop>(std::move(channels), 0);
 }

@@ -194,7 +194,9 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
         served.push_back({devices[d],
                           [&, d, mouse](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
                               HandChannel& hand = channels.hand(d);
-                              const contact::SurfacePoints& surface = hand.snapshots.latest();
+                              // The snapshot the last tick's prepare took, the contact measured on it
+                              // (a newer one is taken after this tick's force is sent).
+                              const contact::SurfacePoints& surface = hand.snapshots.read_slot();
                               age = now_s() - surface.t_s;
                               const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
                               haptics::CoupledTool& tool = *coupled[static_cast<std::size_t>(k)];
@@ -204,7 +206,11 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                               if (d == 0) requests.ticks.fetch_add(1, std::memory_order_relaxed);
                               return f;
                           },
-                          safety});
+                          safety,
+                          [&, d](const haptics::DeviceState& s) {
+                              const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
+                              coupled[static_cast<std::size_t>(k)]->prepare(s, channels.hand(d).snapshots.latest(), 1e-3);
+                          }});
     }
     haptics::HapticLoop loop(std::move(served));
 

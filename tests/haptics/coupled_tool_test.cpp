@@ -122,3 +122,57 @@ TEST(CoupledTool, ANeedleIsHeldAtAFaceBetweenDistantPoints)
     EXPECT_NEAR(f.z(), 0.5 * (tool.proxy().position.z() + 2.0), 1e-9);
     EXPECT_GT(f.z(), 1.0);
 }
+
+TEST(CoupledTool, AContactPreparedAfterTheTickGivesTheForcesOfOneMeasuredInIt)
+{
+    // The loop measures the contact at the proxy after sending the force (prepare), for the next
+    // tick: the same blade driven through a press, a slide and a jab (swept against the mesh)
+    // feels the same forces, bit for bit, as one that measures in every tick; where the next
+    // tick comes with another snapshot, the prepared contact is not used.
+    const contact::SurfacePoints wall = test::flat_wall(41, true), lower = [] {
+        contact::SurfacePoints s = test::flat_wall(41, true);
+        for (std::size_t i = 0; i < s.count; ++i) s.positions_mm[i].z() -= 0.3;
+        s.t_s = 1.0;
+        s.index();
+        return s;
+    }();
+    const contact::ToolShape blade = contact::ToolShape::box({10, 0.5, 4});
+    haptics::CoupledTool measured(blade, {0.25, 5.0}, {}, wall.capacity()), prepared(blade, {0.25, 5.0}, {}, wall.capacity());
+    auto device = [](int k) {
+        haptics::DeviceState d;
+        const double t = 1e-3 * k;
+        d.position_mm = t < 0.2 ? Eigen::Vector3d(0, 0, 5 - 20 * t) : t < 0.3 ? Eigen::Vector3d(20 * (t - 0.2), 0, 1) : Eigen::Vector3d(2, 0, k < 301 ? 5 : -2);
+        return d;
+    };
+    int swept = 0;
+    for (int k = 0; k < 400; ++k) {
+        const contact::SurfacePoints& surface = k < 250 ? wall : lower; // a new snapshot at tick 250
+        const Eigen::Vector3d a = measured.update(device(k), surface, 1e-3), b = prepared.update(device(k), surface, 1e-3);
+        ASSERT_EQ(a, b) << "tick " << k;
+        ASSERT_EQ(measured.proxy().position, prepared.proxy().position) << "tick " << k;
+        swept += prepared.sweep().swept_mesh();
+        EXPECT_EQ(prepared.used_prepared(), k != 0 && k != 250) << "tick " << k;
+        // Prepared on the snapshot the next tick uses, except before the new one arrives.
+        prepared.prepare(device(k), k == 249 ? wall : (k + 1 < 250 ? wall : lower), 1e-3);
+    }
+    EXPECT_GT(swept, 0);
+    EXPECT_GT(prepared.contact().force_on_tool_n.norm(), 0.05); // in contact at the end
+}
+
+TEST(CoupledTool, APreparedProxyTakesTheDeviceOrientationOfTheTickBefore)
+{
+    const contact::ToolShape blade = contact::ToolShape::box({10, 0.5, 4});
+    haptics::CoupledTool tool(blade, {0.25, 5.0}, {}, 16);
+    const contact::SurfacePoints nothing(16);
+    haptics::DeviceState d;
+    d.position_mm = Eigen::Vector3d(0, 0, 5);
+    tool.update(d, nothing, 1e-3); // unprepared: the device's own orientation
+    EXPECT_TRUE(tool.proxy().orientation.isApprox(d.orientation));
+    for (int k = 1; k <= 3; ++k) {
+        const Eigen::Quaterniond before = d.orientation;
+        tool.prepare(d, nothing, 1e-3);
+        d.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitX()));
+        tool.update(d, nothing, 1e-3);
+        EXPECT_TRUE(tool.proxy().orientation.isApprox(before)) << k;
+    }
+}

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <thread>
+#include <vector>
 
 using namespace vox::haptics;
 using Eigen::Vector3d;
@@ -153,6 +155,39 @@ TEST(HapticLoop, AFaultyModelNeverReachesTheDevice)
     for (int k = 0; k < 10; ++k) EXPECT_EQ(loop.tick(5.0 + k * 1e-3), Vector3d::Zero());
 }
 
+TEST(HapticLoop, EachChannelPreparesAfterEveryForceIsSent)
+{
+    // Two devices: a tick reads and answers both before either prepares, each prepare gets the
+    // state its model was given, and the force time ends before the tick's work does.
+    VirtualDevice a({{0.0, {0, 0, 1}, Eigen::Quaterniond::Identity()}, {1.0, {0, 0, -1}, Eigen::Quaterniond::Identity()}});
+    VirtualDevice b({{0.0, {5, 0, 1}, Eigen::Quaterniond::Identity()}});
+    std::vector<std::string> calls;
+    std::vector<Vector3d> modelled, prepared;
+    auto channel = [&](VirtualDevice& device, std::string name) {
+        HapticChannel c;
+        c.device = &device;
+        c.model = [&, name](const DeviceState& s, double& age) {
+            calls.push_back("model " + name);
+            modelled.push_back(s.position_mm);
+            return floor_spring(s, age);
+        };
+        c.prepare = [&, name](const DeviceState& s) {
+            calls.push_back("prepare " + name);
+            prepared.push_back(s.position_mm);
+        };
+        return c;
+    };
+    std::vector<HapticChannel> channels;
+    channels.push_back(channel(a, "a"));
+    channels.push_back(channel(b, "b"));
+    HapticLoop loop(std::move(channels), 0);
+    loop.tick(0.5);
+    EXPECT_EQ(calls, (std::vector<std::string>{"model a", "model b", "prepare a", "prepare b"}));
+    EXPECT_EQ(prepared, modelled);
+    EXPECT_GE(loop.last_work_us(), loop.last_force_us());
+    EXPECT_GT(loop.last_force_us(), 0.0);
+}
+
 TEST(HapticLoop, LiveThreadTicksAndRecordsItsTimings)
 {
     VirtualDevice device({{0.0, {0, 0, 1}, Eigen::Quaterniond::Identity()}});
@@ -163,5 +198,7 @@ TEST(HapticLoop, LiveThreadTicksAndRecordsItsTimings)
     // Not a timing test: only that the thread ran and recorded what it measured.
     EXPECT_GT(loop.timings().period_error_ms.size(), 50u);
     EXPECT_EQ(loop.timings().period_error_ms.size(), loop.timings().force_us.size());
+    ASSERT_EQ(loop.timings().work_us.size(), loop.timings().force_us.size());
+    for (std::size_t k = 0; k < loop.timings().work_us.size(); ++k) EXPECT_GE(loop.timings().work_us[k], loop.timings().force_us[k]);
     for (double e : loop.timings().period_error_ms) EXPECT_TRUE(std::isfinite(e));
 }

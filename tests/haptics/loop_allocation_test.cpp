@@ -97,8 +97,11 @@ TEST(HapticLoop, OneLoopServesTwoDevicesEachWithItsOwnSafetyWithoutAllocating)
     haptics::SafetySettings firm;
     firm.ramp_s = 0.0;
     std::vector<haptics::HapticChannel> channels;
-    channels.push_back({&a, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return left.update(s, wall, 1e-3); }, firm});
-    channels.push_back({&b, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return right.update(s, wall, 1e-3); }, gentle});
+    // Each measures its next contact after the forces are sent (prepare), as a live session does.
+    channels.push_back({&a, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return left.update(s, wall, 1e-3); }, firm,
+                        [&](const haptics::DeviceState& s) { left.prepare(s, wall, 1e-3); }});
+    channels.push_back({&b, [&](const haptics::DeviceState& s, double& age) { age = 0.0; return right.update(s, wall, 1e-3); }, gentle,
+                        [&](const haptics::DeviceState& s) { right.prepare(s, wall, 1e-3); }});
     haptics::HapticLoop loop(std::move(channels), 0);
     ASSERT_EQ(loop.device_count(), 2u);
     loop.tick(0.0);
