@@ -12,12 +12,15 @@ struct Motion {
     std::array<IVec3, 4> start, end;
 };
 
+/// An input point as an interval vector, its own rounding included.
+IVec3 lift(const Eigen::Vector3d& p, double ulps)
+{
+    return IVec3{Interval::widened(p.x(), p.x(), ulps), Interval::widened(p.y(), p.y(), ulps), Interval::widened(p.z(), p.z(), ulps)};
+}
+
 Motion motion(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, double ulps)
 {
-    auto lift = [ulps](const Eigen::Vector3d& p) {
-        return IVec3{Interval::widened(p.x(), p.x(), ulps), Interval::widened(p.y(), p.y(), ulps),
-                     Interval::widened(p.z(), p.z(), ulps)};
-    };
+    auto lift = [ulps](const Eigen::Vector3d& p) { return contact::lift(p, ulps); };
     Motion m;
     for (int i = 0; i < 4; ++i) {
         m.start[static_cast<std::size_t>(i)] = lift(at0[static_cast<std::size_t>(i)]);
@@ -126,6 +129,64 @@ double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array
         return s.below_zero() || (nn - s).below_zero() || u.below_zero() || (nn - u).below_zero();
     };
     return first_surviving(excluded, 0.0, 1.0, 0, options.max_depth, before);
+}
+
+namespace {
+
+/// Where in [0, 1] a coplanarity condition linear in t, value + t rate, is zero: the bound of its
+/// root, empty (lo > hi) when it has none there; `exact` false when the rate may be zero or the
+/// bound is wider than the general search would resolve (the general query must answer).
+struct Root {
+    double lo = 1.0, hi = 0.0;
+    bool exact = false;
+};
+
+Root linear_root(const Interval& value, const Interval& rate, const CcdOptions& options)
+{
+    if (rate.contains_zero()) return {};
+    const Interval t = Interval(0.0) - value / rate;
+    Root r{std::max(t.lo, 0.0), std::min(t.hi, 1.0), true};
+    r.exact = r.lo > r.hi || r.hi - r.lo <= std::ldexp(1.0, -options.max_depth);
+    return r;
+}
+
+} // namespace
+
+double translating_vertex_face_toi(const Eigen::Vector3d& vertex, const Eigen::Vector3d& move, const std::array<Eigen::Vector3d, 3>& face,
+                                   const CcdOptions& options, double before) noexcept
+{
+    const double ulps = options.input_ulps;
+    const IVec3 p = lift(vertex, ulps), d = lift(move, ulps), a = lift(face[0], ulps), b = lift(face[1], ulps) - a, c = lift(face[2], ulps) - a;
+    const IVec3 n = cross(b, c);
+    // (p + t d - a) . n = 0.
+    const Root root = linear_root(dot(p - a, n), dot(d, n), options);
+    if (!root.exact)
+        return vertex_face_toi({vertex, face[0], face[1], face[2]}, {vertex + move, face[0], face[1], face[2]}, options, before);
+    if (root.lo > root.hi || root.lo >= before) return std::numeric_limits<double>::infinity();
+    // Inside the triangle while on its plane, as the general query's conditions (corner a at 0).
+    const IVec3 q = p + Interval(root.lo, root.hi) * d - a;
+    if (dot(cross(b, q), n).below_zero() || dot(cross(q, c), n).below_zero() || dot(cross(c - b, q - b), n).below_zero())
+        return std::numeric_limits<double>::infinity();
+    return root.lo;
+}
+
+double translating_edge_edge_toi(const std::array<Eigen::Vector3d, 2>& edge, const Eigen::Vector3d& move, const std::array<Eigen::Vector3d, 2>& other,
+                                 const CcdOptions& options, double before) noexcept
+{
+    const double ulps = options.input_ulps;
+    const IVec3 a0 = lift(edge[0], ulps), ea = lift(edge[1], ulps) - a0, d = lift(move, ulps), b0 = lift(other[0], ulps),
+                eb = lift(other[1], ulps) - b0;
+    const IVec3 n = cross(ea, eb);
+    // (b0 - a0 - t d) . n = 0.
+    const Root root = linear_root(Interval(0.0) - dot(b0 - a0, n), dot(d, n), options);
+    if (!root.exact)
+        return edge_edge_toi({edge[0], edge[1], other[0], other[1]}, {edge[0] + move, edge[1] + move, other[0], other[1]}, options, before);
+    if (root.lo > root.hi || root.lo >= before) return std::numeric_limits<double>::infinity();
+    // The crossing point within both edges, as the general query's conditions.
+    const IVec3 w = b0 - (a0 + Interval(root.lo, root.hi) * d);
+    const Interval nn = dot(n, n), s = dot(cross(w, eb), n), u = dot(cross(w, ea), n);
+    if (s.below_zero() || (nn - s).below_zero() || u.below_zero() || (nn - u).below_zero()) return std::numeric_limits<double>::infinity();
+    return root.lo;
 }
 
 bool vertex_face_ccd(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, const CcdOptions& options)

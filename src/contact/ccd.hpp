@@ -42,4 +42,18 @@ struct CcdOptions {
 [[nodiscard]] double edge_edge_toi(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1,
                                    const CcdOptions& options = {}, double before = 2.0) noexcept;
 
+/// The same two queries when one side translates by `move` over the step and the other stays (the
+/// haptic proxy's step against a snapshot). The coplanarity condition is then linear in t: its
+/// root is bounded directly, and the inside conditions checked over that bound, instead of halving
+/// [0, 1] towards it; as conservative as the general queries, and tighter than they are at any
+/// depth. Where the motion keeps the four points coplanar, or the root is not bounded to within
+/// 2^-max_depth (a move almost parallel to the face or to both edges), the general query answers.
+/// Vertex `vertex` against the still face `face`; edge `edge` against the still edge `other`.
+[[nodiscard]] double translating_vertex_face_toi(const Eigen::Vector3d& vertex, const Eigen::Vector3d& move,
+                                                 const std::array<Eigen::Vector3d, 3>& face, const CcdOptions& options = {},
+                                                 double before = 2.0) noexcept;
+[[nodiscard]] double translating_edge_edge_toi(const std::array<Eigen::Vector3d, 2>& edge, const Eigen::Vector3d& move,
+                                               const std::array<Eigen::Vector3d, 2>& other, const CcdOptions& options = {},
+                                               double before = 2.0) noexcept;
+
 } // namespace vox::contact

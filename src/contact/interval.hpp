@@ -36,6 +36,13 @@ inline Interval operator*(const Interval& a, const Interval& b)
     return Interval::widened(*std::min_element(p, p + 4), *std::max_element(p, p + 4));
 }
 
+/// a / b for a b that does not contain zero.
+inline Interval operator/(const Interval& a, const Interval& b)
+{
+    const double q[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
+    return Interval::widened(*std::min_element(q, q + 4), *std::max_element(q, q + 4));
+}
+
 /// A 3-vector of intervals.
 struct IVec3 {
     Interval x, y, z;

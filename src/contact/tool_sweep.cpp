@@ -85,6 +85,10 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
     // holds the tool; deeper halvings would cost more than the whole tick's budget.
     CcdOptions ccd;
     ccd.max_depth = std::clamp(static_cast<int>(std::ceil(std::log2(4.0 * speed / std::max(m_margin, 0.01)))), 4, 24);
+    // The proxy's step moves the tool without turning it: every corner moves by the same vector,
+    // and the exact tests take their closed-form root (ccd.hpp's translating queries).
+    const bool translating = from.orientation.coeffs() == to.orientation.coeffs();
+    const Eigen::Vector3d move = to.position - from.position;
     // Heights of tool corner v over the plane through `origin` with normal `normal`, at both ends.
     auto heights = [&](const Eigen::Vector3d& normal, const Eigen::Vector3d& origin, std::size_t v) {
         return std::pair{normal.dot(m_start[v] - origin), normal.dot(m_end[v] - origin)};
@@ -118,7 +122,8 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
             const Eigen::Vector3d normal = (b - a).cross(c - a);
             const auto [h0, h1] = heights(normal, a, v);
             if (plane_entry(h0, h1, h0, h1, 1e-9 * normal.norm()) >= std::min(toi, 1.0 + 1e-9) || !reachable(f, from, points, speed)) return;
-            toi = std::min(toi, vertex_face_toi(Points{m_start[v], a, b, c}, Points{m_end[v], a, b, c}, ccd, toi));
+            toi = std::min(toi, translating ? translating_vertex_face_toi(m_start[v], move, {a, b, c}, ccd, toi)
+                                            : vertex_face_toi(Points{m_start[v], a, b, c}, Points{m_end[v], a, b, c}, ccd, toi));
         });
     }
     for (const auto& [e0, e1] : m_edges) {
@@ -135,7 +140,8 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
             for (int j = 0; j < 3; ++j) { // a surface edge shared by two triangles is tested from both
                 const Eigen::Vector3d &a = p[static_cast<std::size_t>(f[j])], &b = p[static_cast<std::size_t>(f[(j + 1) % 3])];
                 if (sweep.intersects(Eigen::AlignedBox3d(a).extend(b)))
-                    toi = std::min(toi, edge_edge_toi(Points{m_start[v0], m_start[v1], a, b}, Points{m_end[v0], m_end[v1], a, b}, ccd, toi));
+                    toi = std::min(toi, translating ? translating_edge_edge_toi({m_start[v0], m_start[v1]}, move, {a, b}, ccd, toi)
+                                                    : edge_edge_toi(Points{m_start[v0], m_start[v1], a, b}, Points{m_end[v0], m_end[v1], a, b}, ccd, toi));
             }
         });
     }
