@@ -56,8 +56,6 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
 {
     m_swept_mesh = m_stopped_by_mesh = false;
     const std::size_t n = std::min(points.count, m_clearance.size());
-    double first = first_missed_contact(from, to, m_margin, points, std::span<double>(m_clearance.data(), n), from_distance);
-    if (points.triangles.empty() || n < points.count) return first;
     double speed = 0.0; // largest distance a tool vertex moves over the tick, mm
     for (std::size_t v = 0; v < m_local.positions.size(); ++v) {
         m_start[v] = from.position + from.orientation * m_local.positions[v];
@@ -67,8 +65,12 @@ double ToolSweep::first_stop(const PlacedShape& from, const PlacedShape& to, con
     // Only a move longer than the margin can carry a thin tool through a thin wall between its
     // points (a jump: the proxy catching up with a fast hand). Slower, the tool's edge entering a
     // face between points is the point contact's approximation, and cutting relies on it: the
-    // blade must reach the points it then cuts.
-    if (!(speed > m_margin)) return first;
+    // blade must reach the points it then cuts. The points' clearances are kept only for the mesh
+    // test (most ticks have none).
+    const bool mesh = !points.triangles.empty() && n == points.count && speed > m_margin;
+    double first = first_missed_contact(from, to, m_margin, points, mesh ? std::span<double>(m_clearance.data(), n) : std::span<double>(),
+                                        from_distance);
+    if (!mesh) return first;
     m_swept_mesh = true;
     // Surface points the tool's mesh meets are inside the pushing shape then (the inner shape lies
     // within it), so the point test has them already: only tool corners against surface faces and
