@@ -375,28 +375,40 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i] - m_carried[i];
         m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
     }
-    auto multiply = [&](const std::vector<double>& x, std::vector<double>& out) {
-        for (std::size_t i = 0; i < n; ++i) out[i] = m_diagonal[i] * x[i];
-        const double k = p.mesh_n_per_mm;
+    // The mesh springs between free points: out -= k x over each, and the sum of x_a x_b over them
+    // (x . A x = sum diagonal x^2 - 2 k that sum), in the one pass over the edges.
+    const double k_mesh = p.mesh_n_per_mm;
+    auto add_springs = [&](const std::vector<double>& x, std::vector<double>& out) {
+        double pairs = 0.0;
         for (std::size_t e = 0; e < m_free_edges; ++e) {
             const auto a = static_cast<std::size_t>(m_free_edge[e][0]), b = static_cast<std::size_t>(m_free_edge[e][1]);
-            out[a] -= k * x[b];
-            out[b] -= k * x[a];
+            out[a] -= k_mesh * x[b];
+            out[b] -= k_mesh * x[a];
+            pairs += x[a] * x[b];
         }
+        return pairs;
     };
-    multiply(m_u, m_ap);
+    for (std::size_t i = 0; i < n; ++i) m_ap[i] = m_diagonal[i] * m_u[i];
+    add_springs(m_u, m_ap);
     double rz = 0.0, rr = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         m_r[i] = m_b[i] - m_ap[i];
-        m_p[i] = m_r[i] / m_diagonal[i];
-        rz += m_r[i] * m_p[i];
+        m_p[i] = 0.0; // the first direction is the preconditioned residual alone (beta = 0 below)
+        rz += m_r[i] * m_r[i] / m_diagonal[i];
         rr += m_r[i] * m_r[i];
     }
     // Until the points' unbalanced forces are far below what a hand feels (k_residual_n in all).
+    // Each iteration is two passes over the points and one over the springs: the new direction,
+    // its product and p . A p together, then the step.
+    double beta = 0.0;
     for (int it = 0; it < k_iterations && rr > k_residual_n * k_residual_n; ++it) {
-        multiply(m_p, m_ap);
         double pap = 0.0;
-        for (std::size_t i = 0; i < n; ++i) pap += m_p[i] * m_ap[i];
+        for (std::size_t i = 0; i < n; ++i) {
+            m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
+            m_ap[i] = m_diagonal[i] * m_p[i];
+            pap += m_ap[i] * m_p[i];
+        }
+        pap -= 2.0 * k_mesh * add_springs(m_p, m_ap);
         if (!(pap > 0.0)) break;
         const double alpha = rz / pap;
         double next = 0.0;
@@ -407,8 +419,7 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
             next += m_r[i] * m_r[i] / m_diagonal[i];
             rr += m_r[i] * m_r[i];
         }
-        const double beta = next / rz;
-        for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
+        beta = next / rz;
         rz = next;
     }
     // The tool's contact with the displaced points, and the load and its give for the handoff
