@@ -20,11 +20,10 @@ IVec3 lift(const Eigen::Vector3d& p, double ulps)
 
 Motion motion(const std::array<Eigen::Vector3d, 4>& at0, const std::array<Eigen::Vector3d, 4>& at1, double ulps)
 {
-    auto lift = [ulps](const Eigen::Vector3d& p) { return contact::lift(p, ulps); };
     Motion m;
-    for (int i = 0; i < 4; ++i) {
-        m.start[static_cast<std::size_t>(i)] = lift(at0[static_cast<std::size_t>(i)]);
-        m.end[static_cast<std::size_t>(i)] = lift(at1[static_cast<std::size_t>(i)]);
+    for (std::size_t i = 0; i < 4; ++i) {
+        m.start[i] = lift(at0[i], ulps);
+        m.end[i] = lift(at1[i], ulps);
     }
     return m;
 }
