@@ -185,6 +185,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     ViewRequests& requests = channels.requests;
     const auto t0 = std::chrono::steady_clock::now();
     auto now_s = [t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    // The scene tool device d drives now (one device: the active one).
+    auto tool_of = [&](std::size_t d) { return single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]); };
     std::vector<haptics::HapticChannel> served;
     for (std::size_t d = 0; d < driven.size(); ++d) {
         haptics::SafetySettings safety;
@@ -198,7 +200,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                               // (a newer one is taken after this tick's force is sent).
                               const contact::SurfacePoints& surface = hand.snapshots.read_slot();
                               age = now_s() - surface.t_s;
-                              const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
+                              const int k = tool_of(d);
                               haptics::CoupledTool& tool = *coupled[static_cast<std::size_t>(k)];
                               const Eigen::Vector3d f = tool.update(s, surface, 1e-3);
                               hand.proxies.write_slot() = {k, tool.handed_pose(), mouse ? pointer.target() : s.position_mm};
@@ -208,8 +210,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                           },
                           safety,
                           [&, d](const haptics::DeviceState& s) {
-                              const int k = single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]);
-                              coupled[static_cast<std::size_t>(k)]->prepare(s, channels.hand(d).snapshots.latest(), 1e-3);
+                              coupled[static_cast<std::size_t>(tool_of(d))]->prepare(s, channels.hand(d).snapshots.latest(), 1e-3);
                           }});
     }
     haptics::HapticLoop loop(std::move(served));
@@ -266,7 +267,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     loop.stop();
     if (!failure.empty()) throw InputError(scene_path + ": the simulation stopped: " + failure);
     for (std::size_t d = 0; d < driven.size(); ++d) { // where each device left its tool
-        const std::size_t k = single ? static_cast<std::size_t>(requests.active.load()) : driven[d];
+        const auto k = static_cast<std::size_t>(tool_of(d));
         const Eigen::Vector3d at = coupled[k]->proxy().position;
         log::info("tool \"{}\" ({}) ended at ({:.2f}, {:.2f}, {:.2f}) mm", scene.tools[k].name, options.devices[d], at.x(), at.y(), at.z());
     }
