@@ -92,19 +92,6 @@ LocalMesh loop_subdivide(const LocalMesh& m)
     return out;
 }
 
-/// The springs' product: out_i = k_h,i x_i + k_m sum over neighbours (x_i - x_j), x_j = 0 on the border.
-void spring_product(const PatchLayer& p, const Eigen::VectorXd& x, Eigen::VectorXd& out)
-{
-    for (std::size_t i = 0; i < p.free; ++i) {
-        double sum = p.home_n_per_mm[i] * x[static_cast<Eigen::Index>(i)];
-        for (std::uint32_t k = p.neighbour_start[i]; k < p.neighbour_start[i + 1]; ++k) {
-            const std::uint32_t j = p.neighbours[k];
-            sum += p.mesh_n_per_mm * (x[static_cast<Eigen::Index>(i)] - (j < p.free ? x[static_cast<Eigen::Index>(j)] : 0.0));
-        }
-        out[static_cast<Eigen::Index>(i)] = sum;
-    }
-}
-
 /// The springs' displacement under `load` (per free point, N), by conjugate gradients (symmetric,
 /// positive definite: every point has a home spring).
 Eigen::VectorXd spring_give(const PatchLayer& patch, std::span<const double> load)
@@ -114,7 +101,8 @@ Eigen::VectorXd spring_give(const PatchLayer& patch, std::span<const double> loa
     Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r = b, p = r, ap(n);
     double rr = r.squaredNorm();
     for (int k = 0; k < 10 * n && rr > 1e-28 * b.squaredNorm(); ++k) {
-        spring_product(patch, p, ap);
+        for (Eigen::Index i = 0; i < n; ++i)
+            ap[i] = patch.spring_product(static_cast<std::size_t>(i), p, patch.spring_diagonal_n_per_mm[static_cast<std::size_t>(i)]);
         const double alpha = rr / p.dot(ap);
         x += alpha * p;
         r -= alpha * ap;
@@ -236,18 +224,28 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
         normal = normal.squaredNorm() > 0.0 ? normal.normalized() : reference;
         if (normal.dot(reference) < 0.0) normal = -normal;
     }
-    patch.edges = surface_edges(patch.triangles);
-    // Each free point's neighbours.
-    patch.neighbour_start.assign(free + 1, 0);
-    for (const Eigen::Vector2i& e : patch.edges)
+    // The mesh springs: per free point, how many (its diagonal) and which of them reach another
+    // free point, and those edges once.
+    std::vector<std::uint32_t> degree(free, 0);
+    patch.free_edges.clear();
+    patch.free_neighbour_start.assign(free + 1, 0);
+    for (const Eigen::Vector2i& e : surface_edges(patch.triangles)) {
         for (int end : {e[0], e[1]})
-            if (static_cast<std::size_t>(end) < free) ++patch.neighbour_start[static_cast<std::size_t>(end) + 1];
-    for (std::size_t i = 0; i < free; ++i) patch.neighbour_start[i + 1] += patch.neighbour_start[i];
-    patch.neighbours.assign(patch.neighbour_start[free], 0);
-    std::vector<std::uint32_t> fill(patch.neighbour_start.begin(), patch.neighbour_start.end() - 1);
-    for (const Eigen::Vector2i& e : patch.edges)
-        for (int k = 0; k < 2; ++k)
-            if (static_cast<std::size_t>(e[k]) < free) patch.neighbours[fill[static_cast<std::size_t>(e[k])]++] = static_cast<std::uint32_t>(e[1 - k]);
+            if (static_cast<std::size_t>(end) < free) ++degree[static_cast<std::size_t>(end)];
+        if (static_cast<std::size_t>(e[1]) >= free) continue; // e[0] < e[1]: a held end
+        patch.free_edges.push_back(e);
+        ++patch.free_neighbour_start[static_cast<std::size_t>(e[0]) + 1];
+        ++patch.free_neighbour_start[static_cast<std::size_t>(e[1]) + 1];
+    }
+    for (std::size_t i = 0; i < free; ++i) patch.free_neighbour_start[i + 1] += patch.free_neighbour_start[i];
+    patch.free_neighbours.assign(patch.free_neighbour_start[free], 0);
+    std::vector<std::uint32_t> fill(patch.free_neighbour_start.begin(), patch.free_neighbour_start.end() - 1);
+    patch.longest_free_edge_mm = 0.0;
+    for (const Eigen::Vector2i& e : patch.free_edges) {
+        for (int k = 0; k < 2; ++k) patch.free_neighbours[fill[static_cast<std::size_t>(e[k])]++] = static_cast<std::uint32_t>(e[1 - k]);
+        patch.longest_free_edge_mm = std::max(
+            patch.longest_free_edge_mm, (patch.positions_mm[static_cast<std::size_t>(e[1])] - patch.positions_mm[static_cast<std::size_t>(e[0])]).norm());
+    }
 
     // The load the tool presses each free point with now: the preload, and the load the springs
     // are scaled under.
@@ -263,13 +261,13 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
     }
     // Springs at kappa = 1 (see the header), then kappa scaled to the FEM's compliance.
     const double l = settings.decay_mm;
-    patch.home_n_per_mm.assign(free, 0.0);
-    for (std::size_t i = 0; i < free; ++i) patch.home_n_per_mm[i] = patch.areas_mm2[i];
     patch.mesh_n_per_mm = l * l / std::sqrt(3.0);
+    patch.spring_diagonal_n_per_mm.assign(free, 0.0);
+    for (std::size_t i = 0; i < free; ++i) patch.spring_diagonal_n_per_mm[i] = patch.areas_mm2[i] + patch.mesh_n_per_mm * degree[i];
     const Eigen::VectorXd give = spring_give(patch, patch.preload_n); // at kappa = 1
     const double kappa = Eigen::Map<const Eigen::VectorXd>(patch.preload_n.data(), static_cast<Eigen::Index>(free)).dot(give) /
                          (total_preload * total_preload) / compliance_mm_per_n;
-    for (double& k : patch.home_n_per_mm) k *= kappa;
+    for (double& k : patch.spring_diagonal_n_per_mm) k *= kappa;
     patch.mesh_n_per_mm *= kappa;
     patch.compliance_mm_per_n = compliance_mm_per_n;
     patch.preload_give_mm.assign(give.data(), give.data() + free);
@@ -287,9 +285,8 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
 }
 
 ContactPatchState::ContactPatchState(std::size_t capacity)
-    : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_signed(capacity, 0.0), m_contact_k(capacity, 0.0), m_b(capacity, 0.0),
-      m_diagonal(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0), m_carried(capacity, 0.0),
-      m_measured_u(capacity, 0.0), m_free_edge(3 * capacity + 16, Eigen::Vector2i::Zero())
+    : m_displaced(capacity), m_u(capacity, 0.0), m_distance(capacity, 0.0), m_signed(capacity, 0.0), m_diagonal(capacity, 1.0),
+      m_inverse(capacity, 1.0), m_r(capacity, 0.0), m_p(capacity, 0.0), m_ap(capacity, 0.0), m_carried(capacity, 0.0), m_measured_u(capacity, 0.0), m_rim(capacity, 0)
 {
     m_displaced.edges.reserve(3 * capacity + 16); // a triangulated patch has about three edges a point
 }
@@ -329,86 +326,71 @@ void ContactPatchState::take_over(const PatchLayer& p, double k_per_area) noexce
 ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s) noexcept
 {
     const PatchLayer& p = snapshot.patch;
-    if (p.free == 0 || p.free > m_displaced.capacity() || p.edges.size() > m_displaced.edges.capacity()) {
+    if (p.free == 0 || p.free > m_displaced.capacity() || p.free_edges.size() > m_displaced.edges.capacity()) {
         m_displaced.count = 0;
         m_had_patch = false;
         m_load_n = m_give_mm = 0.0;
         return {};
     }
-    // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
-    // normal (the depth falls by what the point gives): the linearised contact of this tick.
+    const std::size_t n = p.free;
     const Eigen::AlignedBox3d reach = tool.world_bounds(contact.margin_mm);
     const double k_per_area = contact.stiffness_n_per_mm / 100.0; // per mm^2
-    const bool fresh = snapshot.t_s != m_patch_t_s || m_displaced.count != p.free;
+    const bool fresh = snapshot.t_s != m_patch_t_s || m_displaced.count != n;
     if (fresh) { // a new patch, on the new snapshot
         m_patch_t_s = snapshot.t_s;
-        m_displaced.count = p.free;
-        std::copy_n(p.normals.begin(), p.free, m_displaced.normals.begin());
-        std::copy_n(p.areas_mm2.begin(), p.free, m_displaced.areas_mm2.begin());
-        m_displaced.edges.assign(p.edges.begin(), p.edges.end()); // within the capacity reserved
-        std::fill_n(m_u.begin(), p.free, 0.0);
-        // The mesh springs between two free points (those to a held one add nothing to the
-        // springs' product beyond the diagonal: it stays at u = 0), so the product below is one
-        // straight loop over them.
-        m_free_edges = 0;
-        for (const Eigen::Vector2i& e : p.edges)
-            if (static_cast<std::size_t>(e[0]) < p.free && static_cast<std::size_t>(e[1]) < p.free) m_free_edge[m_free_edges++] = e;
+        m_displaced.count = n;
+        std::copy_n(p.normals.begin(), n, m_displaced.normals.begin());
+        std::copy_n(p.areas_mm2.begin(), n, m_displaced.areas_mm2.begin());
+        std::fill_n(m_u.begin(), n, 0.0);
     }
-    for (std::size_t i = 0; i < p.free; ++i) {
+    // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
+    // normal (the depth falls by what the point gives): the linearised contact of this tick.
+    auto measure = [&](std::size_t i) {
         const Eigen::Vector3d x = p.positions_mm[i] - m_u[i] * p.normals[i];
         m_distance[i] = reach.contains(x) ? contact.margin_mm - tool.signed_distance(x) + m_u[i] : -INFINITY;
         m_measured_u[i] = m_u[i];
-    }
-    if (fresh) take_over(p, k_per_area);
-    // The carried load fades as the FEM takes it up, over k_handoff_s (in the loop below).
-    const double fade = std::exp(-(dt_s > 0.0 ? dt_s : 1e-3) / k_handoff_s);
+    };
     // The layer under this tick's linearised contact, (K + C) u = C D - preload - carried (C: each
-    // pressed point's contact stiffness; D: its depth at u = 0), by a few conjugate-gradient
+    // pressed point's contact stiffness; D: its depth at u = 0), solved by a few conjugate-gradient
     // iterations from the last tick's u, Jacobi preconditioned: the warm start is close (a tick
     // moves the tool micrometres), and a patch converges in about l / h iterations from rest.
-    const std::size_t n = p.free;
-    for (std::size_t i = 0; i < n; ++i) {
+    // Per point: its diagonal, and its residual at the warm start. The carried load fades as the
+    // FEM takes it up, over k_handoff_s.
+    const double fade = std::exp(-(dt_s > 0.0 ? dt_s : 1e-3) / k_handoff_s);
+    double rz = 0.0, rr = 0.0;
+    auto set_row = [&](std::size_t i) {
         const double k_contact = k_per_area * p.areas_mm2[i];
         const bool pressed = m_distance[i] - m_u[i] > 0.0;
-        m_contact_k[i] = pressed ? k_contact : 0.0;
         m_carried[i] *= fade;
-        m_b[i] = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i] - m_carried[i];
-        m_diagonal[i] = p.home_n_per_mm[i] + p.mesh_n_per_mm * (p.neighbour_start[i + 1] - p.neighbour_start[i]) + m_contact_k[i];
-    }
-    // The mesh springs between free points: out -= k x over each, and the sum of x_a x_b over them
-    // (x . A x = sum diagonal x^2 - 2 k that sum), in the one pass over the edges.
-    const double k_mesh = p.mesh_n_per_mm;
-    auto add_springs = [&](const std::vector<double>& x, std::vector<double>& out) {
-        double pairs = 0.0;
-        for (std::size_t e = 0; e < m_free_edges; ++e) {
-            const auto a = static_cast<std::size_t>(m_free_edge[e][0]), b = static_cast<std::size_t>(m_free_edge[e][1]);
-            out[a] -= k_mesh * x[b];
-            out[b] -= k_mesh * x[a];
-            pairs += x[a] * x[b];
-        }
-        return pairs;
-    };
-    for (std::size_t i = 0; i < n; ++i) m_ap[i] = m_diagonal[i] * m_u[i];
-    add_springs(m_u, m_ap);
-    double rz = 0.0, rr = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-        m_r[i] = m_b[i] - m_ap[i];
+        m_diagonal[i] = p.spring_diagonal_n_per_mm[i] + (pressed ? k_contact : 0.0);
+        m_inverse[i] = 1.0 / m_diagonal[i];
+        const double b = (pressed ? k_contact * m_distance[i] : 0.0) - p.preload_n[i] - m_carried[i];
+        m_r[i] = b - p.spring_product(i, m_u, m_diagonal[i]);
         m_p[i] = 0.0; // the first direction is the preconditioned residual alone (beta = 0 below)
-        rz += m_r[i] * m_r[i] / m_diagonal[i];
+        rz += m_r[i] * m_r[i] * m_inverse[i];
         rr += m_r[i] * m_r[i];
+    };
+    if (fresh) { // the new patch starts where the last left off, from every point's depth
+        for (std::size_t i = 0; i < n; ++i) measure(i);
+        take_over(p, k_per_area);
+        for (std::size_t i = 0; i < n; ++i) set_row(i);
+    } else {
+        for (std::size_t i = 0; i < n; ++i) {
+            measure(i);
+            set_row(i);
+        }
     }
     // Until the points' unbalanced forces are far below what a hand feels (k_residual_n in all).
-    // Each iteration is two passes over the points and one over the springs: the new direction,
-    // its product and p . A p together, then the step.
+    // Each iteration: the new direction; its product (each point gathering its neighbours, so no
+    // point is written twice) and p . A p; the step.
     double beta = 0.0;
     for (int it = 0; it < k_iterations && rr > k_residual_n * k_residual_n; ++it) {
+        for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] * m_inverse[i] + beta * m_p[i];
         double pap = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
-            m_p[i] = m_r[i] / m_diagonal[i] + beta * m_p[i];
-            m_ap[i] = m_diagonal[i] * m_p[i];
+            m_ap[i] = p.spring_product(i, m_p, m_diagonal[i]);
             pap += m_ap[i] * m_p[i];
         }
-        pap -= 2.0 * k_mesh * add_springs(m_p, m_ap);
         if (!(pap > 0.0)) break;
         const double alpha = rz / pap;
         double next = 0.0;
@@ -416,12 +398,20 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         for (std::size_t i = 0; i < n; ++i) {
             m_u[i] += alpha * m_p[i];
             m_r[i] -= alpha * m_ap[i];
-            next += m_r[i] * m_r[i] / m_diagonal[i];
+            next += m_r[i] * m_r[i] * m_inverse[i];
             rr += m_r[i] * m_r[i];
         }
         beta = next / rz;
         rz = next;
     }
+    // The edges the tool can press: both ends outside the pushing shape (else the point contact
+    // has it), and the edge meeting its box, so both ends within the edge's length of that box
+    // and (1-Lipschitz) of the shape. That length is at most the longest at rest plus both ends'
+    // give. Each point says whether it can be such an end (m_rim).
+    double u_max = 0.0;
+    for (std::size_t i = 0; i < n; ++i) u_max = std::max(u_max, std::abs(m_u[i]));
+    const double longest_mm = p.longest_free_edge_mm + 2.0 * u_max;
+    const Eigen::AlignedBox3d edge_reach(reach.min() - Eigen::Vector3d::Constant(longest_mm), reach.max() + Eigen::Vector3d::Constant(longest_mm));
     // The tool's contact with the displaced points, and the load and its give for the handoff
     // (the next patch, the pose the simulation is given). A point that moved less than
     // k_linear_mm in this tick takes its linearised depth, D - u (measuring it again would change
@@ -437,6 +427,7 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         if (m_distance[i] > -INFINITY && std::abs(m_u[i] - m_measured_u[i]) <= k_linear_mm) depth = m_distance[i] - m_u[i];
         else if (reach.contains(x)) depth = contact.margin_mm - tool.signed_distance(x);
         m_signed[i] = depth > -INFINITY ? contact.margin_mm - depth : INFINITY;
+        m_rim[i] = depth > -INFINITY ? depth <= 0.0 && -depth < longest_mm : edge_reach.contains(x);
         if (!(depth > 0.0)) continue;
         const double k = k_per_area * p.areas_mm2[i];
         const Eigen::Vector3d f = k * depth * p.normals[i]; // on the tool, out of the surface
@@ -451,6 +442,11 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     m_had_patch = true;
     m_load_n = load;
     m_give_mm = load > 0.0 ? moment / load : 0.0;
+    // The edges' pass over those alone: the contact's outline, a few of the patch's thousands of
+    // edges (the capacity is reserved).
+    m_displaced.edges.clear();
+    for (const Eigen::Vector2i& e : p.free_edges)
+        if (m_rim[static_cast<std::size_t>(e[0])] && m_rim[static_cast<std::size_t>(e[1])]) m_displaced.edges.push_back(e);
     add_edge_totals(tool, contact, m_displaced, std::span<double>(m_signed.data(), n), out);
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
     // stiffness k becomes k / (1 + k c), c the layer's compliance.

@@ -98,11 +98,10 @@ private:
 
     SurfacePoints m_displaced;
     std::vector<double> m_u, m_distance, m_signed;
-    std::vector<double> m_contact_k, m_b, m_diagonal, m_r, m_p, m_ap; ///< the tick's solve, per free point
+    std::vector<double> m_diagonal, m_inverse, m_r, m_p, m_ap; ///< the tick's solve, per free point
     std::vector<double> m_carried; ///< per free point, the load carried over from the last patch, N
     std::vector<double> m_measured_u; ///< per free point, its u where the tick measured its distance
-    std::vector<Eigen::Vector2i> m_free_edge; ///< the patch's edges between two free points (the first m_free_edges)
-    std::size_t m_free_edges = 0;
+    std::vector<unsigned char> m_rim; ///< per free point, whether it can end an edge the tool presses this tick
     /// A point that moves less than this in a tick keeps its linearised depth (its error is of
     /// the order of the move squared over the tool's radius of curvature), mm.
     static constexpr double k_linear_mm = 0.005;

@@ -64,7 +64,9 @@ struct PointGrid {
 /// snapshot in the simulation thread; the haptic thread displaces its points (ContactPatchState).
 /// Its points are the Loop-subdivided triangles around the contact: the first `free` move along
 /// their inward normal against home springs (to where the snapshot has them) and mesh springs
-/// (along the fine edges); the rest, its border on the snapshot's surface, stay.
+/// (along the fine edges); the rest, its border on the snapshot's surface, stay. Laid out as the
+/// 1 kHz tick reads it: what concerns the free points alone, in their order, so that a tick takes
+/// a new patch without copying or filtering it.
 struct PatchLayer {
     std::size_t count = 0;                    ///< points (0: no patch)
     std::size_t free = 0;                     ///< the first `free` move
@@ -72,10 +74,15 @@ struct PatchLayer {
     std::vector<Eigen::Vector3d> positions_mm, normals;
     std::vector<double> areas_mm2;
     std::vector<Eigen::Vector3i> triangles;
-    std::vector<Eigen::Vector2i> edges;       ///< of the triangles, each once
-    /// Per free point, its mesh neighbours (any point): neighbours[neighbour_start[i] ..].
-    std::vector<std::uint32_t> neighbour_start, neighbours;
-    std::vector<double> home_n_per_mm;        ///< per free point
+    /// The fine edges between two free points, each once (smaller index first, in order): the
+    /// edges the tool's contact presses (one with a held end is the snapshot's border, and stays).
+    std::vector<Eigen::Vector2i> free_edges;
+    double longest_free_edge_mm = 0.0;        ///< where the patch was built
+    /// Per free point, its free neighbours: free_neighbours[free_neighbour_start[i] ..]. A mesh
+    /// spring to a held point (u = 0) adds only to the diagonal.
+    std::vector<std::uint32_t> free_neighbour_start, free_neighbours;
+    /// Per free point, the springs' diagonal: its home spring plus a mesh spring per neighbour.
+    std::vector<double> spring_diagonal_n_per_mm;
     double mesh_n_per_mm = 0.0;               ///< per edge
     /// Per free point, the load (N, inward) the tool pressed it with where the patch was built:
     /// the snapshot holds the deformation under it, so the springs carry only what changes.
@@ -83,13 +90,22 @@ struct PatchLayer {
     /// Per free point that is a snapshot point carried to the fine level: that point, else -1
     /// (what the patch hands back: its displacement at the snapshot's points).
     std::vector<std::int32_t> snapshot_point;
-    /// The FEM's compliance the springs were scaled to: load-weighted displacement per newton,
-    /// and the load's direction, world.
+    /// The FEM's compliance the springs were scaled to: load-weighted displacement per newton.
     double compliance_mm_per_n = 0.0;
     /// Per free point, how far the springs give under the preload alone, mm: the shape the
     /// haptic side starts a new patch displaced along, so the force carries on from the last
     /// patch's instead of jumping to the new snapshot's (ContactPatchState::step).
     std::vector<double> preload_give_mm;
+
+    /// The springs' force on free point i at displacements x (per free point, along the inward
+    /// normal): K x at i. Both sides use it, the build's solve and the tick's (with the contact's
+    /// stiffness added to the diagonal there: `diagonal`).
+    template <class X> [[nodiscard]] double spring_product(std::size_t i, const X& x, double diagonal) const noexcept
+    {
+        double pull = 0.0;
+        for (std::uint32_t k = free_neighbour_start[i]; k < free_neighbour_start[i + 1]; ++k) pull += x[free_neighbours[k]];
+        return diagonal * x[i] - mesh_n_per_mm * pull;
+    }
 };
 
 struct SurfacePoints {
