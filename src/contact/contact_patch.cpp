@@ -98,16 +98,17 @@ Eigen::VectorXd spring_give(const PatchLayer& patch, std::span<const double> loa
 {
     const auto n = static_cast<Eigen::Index>(patch.free);
     const Eigen::Map<const Eigen::VectorXd> b(load.data(), n);
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r = b, p = r, ap(n);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n), r = b, p = Eigen::VectorXd::Zero(n + 1), ap(n); // p[n] = 0: the padding's
+    p.head(n) = r;
     double rr = r.squaredNorm();
     for (int k = 0; k < 10 * n && rr > 1e-28 * b.squaredNorm(); ++k) {
         for (Eigen::Index i = 0; i < n; ++i)
             ap[i] = patch.spring_product(static_cast<std::size_t>(i), p, patch.spring_diagonal_n_per_mm[static_cast<std::size_t>(i)]);
-        const double alpha = rr / p.dot(ap);
-        x += alpha * p;
+        const double alpha = rr / p.head(n).dot(ap);
+        x += alpha * p.head(n);
         r -= alpha * ap;
         const double next = r.squaredNorm();
-        p = r + (next / rr) * p;
+        p.head(n) = r + (next / rr) * p.head(n);
         rr = next;
     }
     return x;
@@ -226,26 +227,27 @@ bool build_patch(SurfacePoints& s, const PlacedShape& tool, const ContactParamet
     }
     // The mesh springs: per free point, how many (its diagonal) and which of them reach another
     // free point, and those edges once.
-    std::vector<std::uint32_t> degree(free, 0);
+    std::vector<std::uint32_t> degree(free, 0), free_degree(free, 0);
     patch.free_edges.clear();
-    patch.free_neighbour_start.assign(free + 1, 0);
+    patch.longest_free_edge_mm = 0.0;
     for (const Eigen::Vector2i& e : surface_edges(patch.triangles)) {
         for (int end : {e[0], e[1]})
             if (static_cast<std::size_t>(end) < free) ++degree[static_cast<std::size_t>(end)];
         if (static_cast<std::size_t>(e[1]) >= free) continue; // e[0] < e[1]: a held end
         patch.free_edges.push_back(e);
-        ++patch.free_neighbour_start[static_cast<std::size_t>(e[0]) + 1];
-        ++patch.free_neighbour_start[static_cast<std::size_t>(e[1]) + 1];
-    }
-    for (std::size_t i = 0; i < free; ++i) patch.free_neighbour_start[i + 1] += patch.free_neighbour_start[i];
-    patch.free_neighbours.assign(patch.free_neighbour_start[free], 0);
-    std::vector<std::uint32_t> fill(patch.free_neighbour_start.begin(), patch.free_neighbour_start.end() - 1);
-    patch.longest_free_edge_mm = 0.0;
-    for (const Eigen::Vector2i& e : patch.free_edges) {
-        for (int k = 0; k < 2; ++k) patch.free_neighbours[fill[static_cast<std::size_t>(e[k])]++] = static_cast<std::uint32_t>(e[1 - k]);
+        ++free_degree[static_cast<std::size_t>(e[0])];
+        ++free_degree[static_cast<std::size_t>(e[1])];
         patch.longest_free_edge_mm = std::max(
             patch.longest_free_edge_mm, (patch.positions_mm[static_cast<std::size_t>(e[1])] - patch.positions_mm[static_cast<std::size_t>(e[0])]).norm());
     }
+    patch.neighbour_slots = free > 0 ? *std::max_element(free_degree.begin(), free_degree.end()) : 0;
+    patch.free_neighbours.assign(free * patch.neighbour_slots, static_cast<std::uint32_t>(free));
+    std::fill(free_degree.begin(), free_degree.end(), 0);
+    for (const Eigen::Vector2i& e : patch.free_edges)
+        for (int k = 0; k < 2; ++k) {
+            const auto i = static_cast<std::size_t>(e[k]);
+            patch.free_neighbours[i * patch.neighbour_slots + free_degree[i]++] = static_cast<std::uint32_t>(e[1 - k]);
+        }
 
     // The load the tool presses each free point with now: the preload, and the load the springs
     // are scaled under.
@@ -326,7 +328,7 @@ void ContactPatchState::take_over(const PatchLayer& p, double k_per_area) noexce
 ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s) noexcept
 {
     const PatchLayer& p = snapshot.patch;
-    if (p.free == 0 || p.free > m_displaced.capacity() || p.free_edges.size() > m_displaced.edges.capacity()) {
+    if (p.free == 0 || p.free >= m_displaced.capacity() || p.free_edges.size() > m_displaced.edges.capacity()) { // one more: the padding's zero
         m_displaced.count = 0;
         m_had_patch = false;
         m_load_n = m_give_mm = 0.0;
@@ -341,7 +343,8 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         m_displaced.count = n;
         std::copy_n(p.normals.begin(), n, m_displaced.normals.begin());
         std::copy_n(p.areas_mm2.begin(), n, m_displaced.areas_mm2.begin());
-        std::fill_n(m_u.begin(), n, 0.0);
+        std::fill_n(m_u.begin(), n + 1, 0.0);
+        m_p[n] = 0.0; // the padding's
     }
     // Each point's depth in the pushing shape where it is now, taken back to u = 0 along its
     // normal (the depth falls by what the point gives): the linearised contact of this tick.
@@ -444,9 +447,14 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     m_give_mm = load > 0.0 ? moment / load : 0.0;
     // The edges' pass over those alone: the contact's outline, a few of the patch's thousands of
     // edges (the capacity is reserved).
-    m_displaced.edges.clear();
-    for (const Eigen::Vector2i& e : p.free_edges)
-        if (m_rim[static_cast<std::size_t>(e[0])] && m_rim[static_cast<std::size_t>(e[1])]) m_displaced.edges.push_back(e);
+    // Written whether kept or not, so that no branch is mispredicted.
+    m_displaced.edges.resize(p.free_edges.size());
+    std::size_t kept = 0;
+    for (const Eigen::Vector2i& e : p.free_edges) {
+        m_displaced.edges[kept] = e;
+        kept += m_rim[static_cast<std::size_t>(e[0])] & m_rim[static_cast<std::size_t>(e[1])];
+    }
+    m_displaced.edges.resize(kept);
     add_edge_totals(tool, contact, m_displaced, std::span<double>(m_signed.data(), n), out);
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
     // stiffness k becomes k / (1 + k c), c the layer's compliance.

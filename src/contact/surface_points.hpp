@@ -78,9 +78,12 @@ struct PatchLayer {
     /// edges the tool's contact presses (one with a held end is the snapshot's border, and stays).
     std::vector<Eigen::Vector2i> free_edges;
     double longest_free_edge_mm = 0.0;        ///< where the patch was built
-    /// Per free point, its free neighbours: free_neighbours[free_neighbour_start[i] ..]. A mesh
-    /// spring to a held point (u = 0) adds only to the diagonal.
-    std::vector<std::uint32_t> free_neighbour_start, free_neighbours;
+    /// Per free point, its free neighbours, `neighbour_slots` of them (one with fewer is padded
+    /// with `free`, the index of a zero the product reads): free_neighbours[i * neighbour_slots ..].
+    /// The same count for every point, so that the tick's loop over them is always predicted. A
+    /// mesh spring to a held point (u = 0) adds only to the diagonal.
+    std::size_t neighbour_slots = 0;
+    std::vector<std::uint32_t> free_neighbours;
     /// Per free point, the springs' diagonal: its home spring plus a mesh spring per neighbour.
     std::vector<double> spring_diagonal_n_per_mm;
     double mesh_n_per_mm = 0.0;               ///< per edge
@@ -97,13 +100,14 @@ struct PatchLayer {
     /// patch's instead of jumping to the new snapshot's (ContactPatchState::step).
     std::vector<double> preload_give_mm;
 
-    /// The springs' force on free point i at displacements x (per free point, along the inward
-    /// normal): K x at i. Both sides use it, the build's solve and the tick's (with the contact's
-    /// stiffness added to the diagonal there: `diagonal`).
+    /// The springs' force on free point i at displacements x (per free point along the inward
+    /// normal, and x[free] = 0): K x at i. Both sides use it, the build's solve and the tick's
+    /// (with the contact's stiffness added to the diagonal there: `diagonal`).
     template <class X> [[nodiscard]] double spring_product(std::size_t i, const X& x, double diagonal) const noexcept
     {
+        const std::uint32_t* neighbour = free_neighbours.data() + i * neighbour_slots;
         double pull = 0.0;
-        for (std::uint32_t k = free_neighbour_start[i]; k < free_neighbour_start[i + 1]; ++k) pull += x[free_neighbours[k]];
+        for (std::size_t k = 0; k < neighbour_slots; ++k) pull += x[neighbour[k]];
         return diagonal * x[i] - mesh_n_per_mm * pull;
     }
 };
