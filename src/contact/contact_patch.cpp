@@ -408,13 +408,13 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         rz = next;
     }
     // The edges the tool can press: both ends outside the pushing shape (else the point contact
-    // has it), and the edge meeting its box, so both ends within the edge's length of that box
-    // and (1-Lipschitz) of the shape. That length is at most the longest at rest plus both ends'
-    // give. Each point says whether it can be such an end (m_rim).
+    // has it) and within the reach band of it (ToolShape::reach_band_mm, for an edge as long as
+    // the longest at rest plus both ends' give), so within that band of its box too. Each point
+    // says whether it can be such an end (m_rim).
     double u_max = 0.0;
     for (std::size_t i = 0; i < n; ++i) u_max = std::max(u_max, std::abs(m_u[i]));
-    const double longest_mm = p.longest_free_edge_mm + 2.0 * u_max;
-    const Eigen::AlignedBox3d edge_reach(reach.min() - Eigen::Vector3d::Constant(longest_mm), reach.max() + Eigen::Vector3d::Constant(longest_mm));
+    const double band_mm = tool.shape->reach_band_mm(contact.margin_mm, p.longest_free_edge_mm + 2.0 * u_max);
+    const Eigen::AlignedBox3d edge_reach(reach.min() - Eigen::Vector3d::Constant(band_mm), reach.max() + Eigen::Vector3d::Constant(band_mm));
     // The tool's contact with the displaced points, and the load and its give for the handoff
     // (the next patch, the pose the simulation is given). A point that moved less than
     // k_linear_mm in this tick takes its linearised depth, D - u (measuring it again would change
@@ -430,7 +430,7 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
         if (m_distance[i] > -INFINITY && std::abs(m_u[i] - m_measured_u[i]) <= k_linear_mm) depth = m_distance[i] - m_u[i];
         else if (reach.contains(x)) depth = contact.margin_mm - tool.signed_distance(x);
         m_signed[i] = depth > -INFINITY ? contact.margin_mm - depth : INFINITY;
-        m_rim[i] = depth > -INFINITY ? depth <= 0.0 && -depth < longest_mm : edge_reach.contains(x);
+        m_rim[i] = depth > -INFINITY ? depth <= 0.0 && -depth < band_mm : edge_reach.contains(x);
         if (!(depth > 0.0)) continue;
         const double k = k_per_area * p.areas_mm2[i];
         const Eigen::Vector3d f = k * depth * p.normals[i]; // on the tool, out of the surface

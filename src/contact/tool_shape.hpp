@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <cmath>
 #include <vector>
 
 namespace vox::contact {
@@ -49,6 +50,18 @@ public:
     /// given, receives the unit direction in which the distance grows fastest (the outward normal
     /// of the nearest surface point).
     [[nodiscard]] double signed_distance(const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const noexcept;
+
+    /// How far outside the shape grown by `margin` each end of a segment `length_mm` long can be
+    /// when the segment reaches into it, mm: sqrt(rho^2 + L^2) - rho, with rho the margin plus the
+    /// radius the shape is itself rounded with (a sphere's; the others' edges are sharp). The
+    /// grown shape is a set grown by rho, and the segment's nearest point to the set's nearest
+    /// point c lies within rho of c, at a right angle: each end is within sqrt(rho^2 + L^2) of c.
+    /// A finer cut than the distance's Lipschitz bound (L) for the segments a contact's rim holds.
+    [[nodiscard]] double reach_band_mm(double margin, double length_mm) const noexcept
+    {
+        const double rho = margin + (m_kind == Kind::sphere ? m_radius : 0.0);
+        return std::sqrt(rho * rho + length_mm * length_mm) - rho;
+    }
 
     /// The area (mm^2) of the shape grown by `margin` as seen along `along` (tool frame): what
     /// the contact across that direction can cover at most. Exact for the analytic shapes (a

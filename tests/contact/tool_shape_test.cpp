@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <random>
@@ -452,4 +453,40 @@ TEST(ToolShape, ShadowAreasAgainstClosedForms)
     // A scalpel seen across its flat sides: its profile (16 x 8 with the front's 8 x 8 corner cut).
     EXPECT_NEAR(ToolShape::scalpel(size).shadow_area(Vector3d(0, 1, 0)), 16.0 * 8.0 - 32.0, 1e-9);
     EXPECT_EQ(box.shadow_area(Vector3d::Zero()), INFINITY);
+}
+
+TEST(ToolShape, ASegmentReachingIntoTheGrownShapeHasBothEndsWithinItsReachBand)
+{
+    // Random segments around a ball, a box and a blade: each one whose ends are both outside the
+    // shape grown by the margin but that dips into it (its distance sampled finely along it) has
+    // both ends within reach_band_mm of the grown shape. The band is the bound the contact patch
+    // leaves its other edges out by, so no edge that can be pressed is left out.
+    const double margin = 0.25;
+    const ToolShape shapes[] = {ToolShape::sphere(2.0), ToolShape::box({6, 6, 4}), ToolShape::scalpel({16, 1, 8})};
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), length(0.1, 2.0);
+    for (const ToolShape& shape : shapes) {
+        const Eigen::AlignedBox3d around = shape.bounds(margin + 2.0);
+        int reaching = 0;
+        double closest_to_band = INFINITY;
+        for (const Vector3d& a : random_points(150000, around, 11)) {
+            const Vector3d direction = Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+            const double l = length(rng);
+            const Vector3d b = a + l * direction;
+            const double e_a = shape.signed_distance(a) - margin, e_b = shape.signed_distance(b) - margin;
+            if (!(e_a >= 0.0 && e_b >= 0.0) || 0.5 * (e_a + e_b - l) >= 0.0) continue; // outside by the Lipschitz bound alone
+            double deepest = INFINITY;
+            for (int k = 1; k < 400; ++k) deepest = std::min(deepest, shape.signed_distance(a + (k / 400.0) * (b - a)) - margin);
+            if (!(deepest < 0.0)) continue;
+            ++reaching;
+            const double band = shape.reach_band_mm(margin, l);
+            EXPECT_LT(std::max(e_a, e_b), band) << "segment " << a.transpose() << " -> " << b.transpose();
+            closest_to_band = std::min(closest_to_band, band - std::max(e_a, e_b));
+        }
+        EXPECT_GT(reaching, 100) << "too few segments reached in to test the band";
+        std::printf("kind %d: %d segments reach in; their farther end is at least %.4f mm inside the band\n", static_cast<int>(shape.kind()), reaching,
+                    closest_to_band);
+    }
+    // For a ball the band is far thinner than the distance's Lipschitz bound (the segment's length).
+    EXPECT_LT(ToolShape::sphere(2.0).reach_band_mm(margin, 1.0), 0.25);
 }
