@@ -4,12 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
-#include <array>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-namespace { struct PhaseDump { std::vector<std::array<double,8>> rows = [] { std::vector<std::array<double,8>> r; r.reserve(200000); return r; }(); ~PhaseDump(){ const char* f=std::getenv("PATCH_PHASES"); if(!f) return; if(FILE* fo=std::fopen(f,"w")){ for(auto&r:rows){ for(double v:r) std::fprintf(fo,"%g ",v); std::fprintf(fo,"\n");} std::fclose(fo);} } } g_phase;
-inline double now_us(){ return std::chrono::duration<double,std::micro>(std::chrono::steady_clock::now().time_since_epoch()).count(); } }
 
 namespace vox::contact {
 namespace {
@@ -333,7 +327,6 @@ void ContactPatchState::take_over(const PatchLayer& p, double k_per_area) noexce
 
 ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s) noexcept
 {
-    const double T0 = now_us();
     const PatchLayer& p = snapshot.patch;
     if (p.free == 0 || p.free >= m_displaced.capacity() || p.free_edges.size() > m_displaced.edges.capacity()) { // one more: the padding's zero
         m_displaced.count = 0;
@@ -396,7 +389,6 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     // Until the points' unbalanced forces are far below what a hand feels (k_residual_n in all).
     // Each iteration: the new direction; its product (each point gathering its neighbours, so no
     // point is written twice) and p . A p; the step.
-    const double T1 = now_us(); int iters = 0;
     double beta = 0.0;
     for (int it = 0; it < k_iterations && rr > k_residual_n * k_residual_n; ++it) {
         for (std::size_t i = 0; i < n; ++i) m_p[i] = m_r[i] * m_inverse[i] + beta * m_p[i];
@@ -416,9 +408,8 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
             rr += m_r[i] * m_r[i];
         }
         beta = next / rz;
-        rz = next; ++iters;
+        rz = next;
     }
-    const double T2 = now_us();
     // The edges the tool can press: both ends outside the pushing shape (else the point contact
     // has it) and within the reach band of it (ToolShape::reach_band_mm, for an edge as long as
     // the longest at rest plus both ends' give), so within that band of its box too. Each point
@@ -459,7 +450,6 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     m_give_mm = load > 0.0 ? moment / load : 0.0;
     // The edges' pass over those alone: the contact's outline, a few of the patch's thousands of
     // edges (the capacity is reserved).
-    const double T3 = now_us();
     // Written whether kept or not, so that no branch is mispredicted.
     m_displaced.edges.resize(p.free_edges.size());
     std::size_t kept = 0;
@@ -469,8 +459,6 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     }
     m_displaced.edges.resize(kept);
     add_edge_totals(tool, contact, m_displaced, std::span<double>(m_signed.data(), n), out);
-    const double T4 = now_us();
-    if (std::getenv("PATCH_PHASES")) g_phase.rows.push_back({double(fresh),double(iters),double(n),T1-T0,T2-T1,T3-T2,T4-T3,T4-T0});
     // The tool feels the contact in series with the layer: for the proxy's step, the contact's
     // stiffness k becomes k / (1 + k c), c the layer's compliance.
     const double k = out.stiffness_n_per_mm.trace();
