@@ -459,10 +459,9 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     }
     m_displaced.edges.resize(kept);
     add_edge_totals(tool, contact, m_displaced, std::span<double>(m_signed.data(), n), out);
-    // The tool feels the contact in series with the layer: for the proxy's step, the contact's
-    // stiffness k becomes k / (1 + k c), c the layer's compliance.
-    const double k = out.stiffness_n_per_mm.trace();
-    if (k > 0.0) out.stiffness_n_per_mm /= 1.0 + k * p.compliance_mm_per_n;
+    // The stiffness is the contact's own, not the contact's in series with the layer: the layer
+    // is that soft only once settled, so a proxy's step taken on it overshoots, and on a stiff
+    // contact with a soft layer rings (tests/haptics/contact_patch_test.cpp).
     return out;
 }
 

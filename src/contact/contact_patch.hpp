@@ -72,8 +72,8 @@ public:
     explicit ContactPatchState(std::size_t capacity = 4096);
     /// One tick with the tool at `tool`: the layer settles (conjugate gradients, warm started)
     /// under the contact, and the contact of the tool with the displaced patch is returned (its
-    /// stiffness the contact's in series with the layer's: what the proxy's step needs). A
-    /// snapshot with no patch, or one too large for the capacity: zero totals.
+    /// stiffness the contact's own: the proxy's step then approaches the layer's equilibrium from
+    /// one side). A snapshot with no patch, or one too large for the capacity: zero totals.
     ContactTotals step(const PlacedShape& tool, const ContactParameters& contact, const SurfacePoints& snapshot, double dt_s = 1e-3) noexcept;
     /// The patch's free points where they are now (count: its free points).
     [[nodiscard]] const SurfacePoints& displaced() const { return m_displaced; }
