@@ -223,6 +223,11 @@ void add_run_command(CLI::App& app)
         if (journal) journal->end_stroke(method, loop.frames(), loop.frames() * dt); // the stroke under way at the end
         record.finish(method);
         if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
+        for (const auto& [tool, touched] : record.tools_given_no_patch())
+            log::warn("tool \"{}\": \"haptic_subdivision\" asked for a contact patch, but none was built in the {} frame(s) it touched: the "
+                      "method measured no give at its contact (only the branched grid measures it, and not where the elements touched hold "
+                      "rigid material), or the contact was wider than a patch holds (docs/haptics.md)",
+                      tool, touched);
         write_surface(dir / "final.obj", method);
         {
             const surface::SurfaceMesh m = method.surface_mesh();

@@ -162,6 +162,8 @@ std::vector<PatchFrame> DeviceRun::patches() const
         const contact::PatchLayer& patch = hand->snapshot.patch;
         PatchFrame p;
         p.tool = m_scene.tools[hand->tool].name;
+        p.asked = m_scene.tools[hand->tool].haptic_subdivision >= 0;
+        p.touching = hand->coupled->contact().area_mm2 > 0.0;
         if (patch.free > 0) {
             p.points = patch.free;
             p.level = patch.level;

@@ -28,6 +28,8 @@ struct PatchFrame {
     double compliance_mm_per_n = 0.0;  ///< the FEM's at the contact, which its springs were scaled to
     double displacement_mm = 0.0;      ///< its largest give at the frame's last tick, handed on with the tool's pose
     double step_us_max = 0.0;          ///< its longest step in the frame's ticks
+    bool asked = false;                ///< the tool asks for one (its haptic_subdivision)
+    bool touching = false;             ///< the tool touched the surface at the frame's last tick
 };
 
 struct FrameStats {

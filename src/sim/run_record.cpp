@@ -113,6 +113,11 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                                   {"max_depth_mm", c.max_depth_mm}};
     }
     for (const PatchFrame& p : f.patches) {
+        if (p.asked) {
+            auto& [touched, patched] = m_patch_use[p.tool];
+            touched += p.touching;
+            patched += p.points > 0;
+        }
         if (p.points == 0) continue;
         ++m_patch_frames;
         frame["haptic_patch"].push_back({{"tool", p.tool}, {"points", p.points}, {"level", p.level}, {"compliance_mm_per_n", p.compliance_mm_per_n},
@@ -120,6 +125,14 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     }
     method.add_frame_figures(frame);
     m_document["frames"].push_back(std::move(frame));
+}
+
+std::vector<std::pair<std::string, std::size_t>> RunRecord::tools_given_no_patch() const
+{
+    std::vector<std::pair<std::string, std::size_t>> out;
+    for (const auto& [tool, use] : m_patch_use)
+        if (use.first > 0 && use.second == 0) out.emplace_back(tool, use.first);
+    return out;
 }
 
 void RunRecord::finish(const Method& method)

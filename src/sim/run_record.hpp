@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,9 @@ public:
     [[nodiscard]] const nlohmann::json& document() const { return m_document; }
     [[nodiscard]] double total_step_ms() const { return m_total_ms; }
     [[nodiscard]] const StepFigures& last_step() const { return m_last; }
+    /// The tools that asked for a contact patch (haptic_subdivision) and touched the surface,
+    /// and how many frames they touched it in, but were given none in any of them.
+    [[nodiscard]] std::vector<std::pair<std::string, std::size_t>> tools_given_no_patch() const;
 
 private:
     nlohmann::json m_document;
@@ -43,6 +47,8 @@ private:
     std::vector<double> m_frame_ms;   ///< whole frames, wall clock
     std::vector<double> m_cutting_ms; ///< frames that cut: collision + propagation + grid update + remesh
     std::size_t m_patch_frames = 0;   ///< device frames with a contact patch (per device)
+    /// Per tool that asks for a patch: the frames it touched in, and those it had a patch in.
+    std::map<std::string, std::pair<std::size_t, std::size_t>> m_patch_use;
     StepFigures m_last;
 };
 

@@ -54,6 +54,34 @@ TEST(FrameLoop, BothMethodsWriteTheSameFiguresUnderTheSameNames)
     EXPECT_TRUE(documents[1]["frames"][7]["isxfem"].contains("cut_tets"));
 }
 
+TEST(FrameLoop, TheRecordNamesAToolThatAskedForAPatchAndNeverGotOne)
+{
+    // A tool asking for a contact patch that touches the surface in frames without one is named
+    // (the run warns, docs/haptics.md), with the frames it touched in; one given a patch in any
+    // frame, or that never touched, is not.
+    const io::Scene scene = bundled("bar_cut_isxfem.json", io::SolverType::dbg);
+    std::unique_ptr<Method> method = open(scene);
+    ToolPolicy tools(scene);
+    FrameLoop loop(scene, *method, tools);
+    RunRecord record(scene.source, *method, scene.solver.dt_s);
+    auto frame_with = [&](std::vector<PatchFrame> patches) {
+        FrameStats f = loop.next();
+        f.patches = std::move(patches);
+        record.add(f, *method);
+    };
+    const PatchFrame denied{.tool = "finger", .asked = true, .touching = true};
+    PatchFrame given = denied;
+    given.tool = "thumb";
+    const PatchFrame not_asked{.tool = "knife", .touching = true}, away{.tool = "palm", .asked = true};
+    frame_with({denied, given, not_asked, away});
+    given.points = 40;
+    frame_with({denied, given, not_asked, away});
+    frame_with({denied});
+    record.finish(*method);
+    const std::vector<std::pair<std::string, std::size_t>> expected{{"finger", 3}};
+    EXPECT_EQ(record.tools_given_no_patch(), expected);
+}
+
 TEST(FrameLoop, OnAnUncutBeamBothMethodsSagAlikeAndStepEveryFrame)
 {
     // The beam of beam_sag.json under gravity, no tool: the linear tetrahedra are stiffer than the
