@@ -448,9 +448,9 @@ ContactTotals ContactPatchState::step(const PlacedShape& tool, const ContactPara
     m_had_patch = true;
     m_load_n = load;
     m_give_mm = load > 0.0 ? moment / load : 0.0;
-    // The edges' pass over those alone: the contact's outline, a few of the patch's thousands of
-    // edges (the capacity is reserved).
-    // Written whether kept or not, so that no branch is mispredicted.
+    // The edges' pass over those alone: the contact's outline, a few of the patch's hundreds of
+    // edges (the capacity is reserved). Each is written whether kept or not, so that no branch is
+    // mispredicted.
     m_displaced.edges.resize(p.free_edges.size());
     std::size_t kept = 0;
     for (const Eigen::Vector2i& e : p.free_edges) {
