@@ -32,6 +32,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <chrono>
@@ -109,14 +110,21 @@ std::vector<haptics::KeyFrame> finger_presses(double seconds)
     return frames;
 }
 
+/// Where the loop put a tool (its proxy) and its device (the driver).
+struct HandPose {
+    contact::PlacedShape proxy;
+    Eigen::Vector3d driver = Eigen::Vector3d::Zero();
+};
+
 /// One device and its tool: the haptic thread's side (device, coupling) and what the threads share.
 struct Hand {
     std::size_t tool = 0;
     haptics::VirtualDevice device;
     haptics::CoupledTool coupled;
     haptics::TripleBuffer<contact::SurfacePoints> snapshots; ///< simulation -> haptics
-    haptics::TripleBuffer<contact::PlacedShape> poses;       ///< haptics -> simulation
-    contact::PlacedShape pose;                               ///< simulation side: the last pose read
+    haptics::TripleBuffer<HandPose> poses;                   ///< haptics -> simulation
+    HandPose pose;                                           ///< simulation side: the last pose read
+    std::atomic<bool> passing{false};                        ///< simulation -> haptics: the tool cuts through
     Hand(std::size_t t, std::vector<haptics::KeyFrame> frames, const contact::ToolShape& shape, const io::ToolSpec& spec, std::size_t capacity)
         : tool(t), device(std::move(frames)),
           coupled(shape, contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, haptics::CouplingSettings{}, capacity),
@@ -181,6 +189,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                                 const contact::SurfacePoints& surface = hand->snapshots.read_slot();
                                 age = now_s() - surface.t_s;
                                 stale_ticks += age > stale_s;
+                                hand->coupled.set_passing(hand->passing.load(std::memory_order_relaxed));
                                 const Eigen::Vector3d f = hand->coupled.update(s, surface, 1e-3);
                                 prepared_ticks += hand->coupled.used_prepared();
                                 // The knife's channel runs first and counts the tick.
@@ -192,7 +201,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                                     }
                                     ++tick;
                                 }
-                                hand->poses.write_slot() = hand->coupled.handed_pose();
+                                hand->poses.write_slot() = {hand->coupled.handed_pose(), s.position_mm};
                                 hand->poses.publish();
                                 return f;
                             },
@@ -208,24 +217,26 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     int frames = 0, cutting_frames = 0;
     std::vector<double> snapshot_points, frame_ms;
     for (const std::unique_ptr<Hand>& hand : hands) { // the devices' first poses, until the loop reports
-        hand->pose = hand->coupled.proxy();
+        hand->pose.proxy = hand->coupled.proxy();
         haptics::DeviceState first;
         hand->device.read(0.0, first);
-        hand->pose.position = first.position_mm;
+        hand->pose.proxy.position = hand->pose.driver = first.position_mm;
     }
     while (lockstep ? frames * scene.solver.dt_s < seconds : now_s() < seconds) {
         const auto frame_start = clock::now();
         for (const std::unique_ptr<Hand>& hand : hands) {
             if (hand->poses.update()) hand->pose = hand->poses.read_slot();
-            tools.drive(hand->tool, hand->pose.position, hand->pose.orientation);
+            tools.drive(hand->tool, hand->pose.proxy.position, hand->pose.proxy.orientation, hand->pose.driver,
+                        hand->coupled.coupling_stiffness_n_per_mm());
         }
         const sim::FrameStats f = frame_loop.next();
+        for (const std::unique_ptr<Hand>& hand : hands) hand->passing.store(tools.passing(hand->tool), std::memory_order_relaxed);
         cutting_frames += f.tools.cut.changed();
         double points = 0.0;
         for (const std::unique_ptr<Hand>& hand : hands) {
             const io::ToolSpec& spec = scene.tools[hand->tool];
             contact::SurfacePoints& out = hand->snapshots.write_slot();
-            sim::take_snapshot(*method, hand->tool, spec, hand->pose, hand->pose.world_bounds(spec.push_margin_mm + sim::k_snapshot_margin_mm), now_s(), out);
+            sim::take_snapshot(*method, hand->tool, spec, hand->pose.proxy, hand->pose.proxy.world_bounds(spec.push_margin_mm + sim::k_snapshot_margin_mm), now_s(), out);
             hand->snapshots.publish();
             points += static_cast<double>(out.count);
         }

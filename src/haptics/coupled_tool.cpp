@@ -7,7 +7,7 @@ namespace vox::haptics {
 
 CoupledTool::CoupledTool(const contact::ToolShape& shape, const contact::ContactParameters& contact, const CouplingSettings& coupling,
                          std::size_t snapshot_capacity)
-    : m_parameters(contact), m_coupling(coupling), m_sweep(shape, contact.margin_mm, snapshot_capacity), m_distance(snapshot_capacity)
+    : m_parameters(contact), m_coupling(coupling), m_mover(shape, contact, snapshot_capacity), m_distance(snapshot_capacity)
 {
     m_proxy.shape = &shape;
 }
@@ -74,24 +74,15 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     m_prepared_on = nullptr;
     const std::span<const double> distance(m_distance.data(), std::min(surface.count, m_distance.size()));
     const double kc = m_coupling.stiffness_n_per_mm;
-    // One Newton step a tick on k_c (x_d - x) + F(x) = 0, F linearised at the proxy: warm started
-    // from the last tick, the proxy converges within a few ticks of any change (a millisecond
-    // moves the device a few micrometres).
-    const Eigen::Matrix3d a = kc * Eigen::Matrix3d::Identity() + m_contact.stiffness_n_per_mm;
-    const Eigen::Vector3d residual = kc * (device.position_mm - m_proxy.position) + m_contact.force_on_tool_n;
-    Eigen::Vector3d step = a.ldlt().solve(residual);
-    // In contact, the linearised contact holds only over the penetration depths it was taken at:
-    // a step longer than the margin could carry a thin tool through the points holding it.
-    const double limit = std::max(m_parameters.margin_mm, 0.05);
-    if (m_contact.area_mm2 > 0.0 && step.norm() > limit) step *= limit / step.norm();
-    if (step.allFinite()) {
-        // Continuous collision: a step that would carry the tool past surface points it touches
-        // at neither end, or through a face or across an edge between them (a thin blade moving
-        // fast), stops where it first touches.
-        contact::PlacedShape moved = m_proxy;
-        moved.position += step;
-        const double t = m_sweep.first_stop(m_proxy, moved, surface, distance);
-        m_proxy.position += t * step;
+    const bool passing = m_passing.load(std::memory_order_relaxed);
+    if (passing) {
+        m_proxy.position = device.position_mm; // the material gives way: the simulation cuts it
+    } else {
+        // One Newton step a tick on k_c (x_d - x) + F(x) = 0, F linearised at the proxy, held
+        // within the depth bound (contact/proxy.hpp): warm started from the last tick, the proxy
+        // converges within a few ticks of any change (a millisecond moves the device a few
+        // micrometres).
+        m_mover.step(m_proxy, device.position_mm, kc, m_contact, surface, distance);
     }
     // The tick a new snapshot arrives, the proxy's move (the surface moved under it) is not felt
     // yet: the felt proxy moves with the device that tick, and the rest of the move is spread
@@ -108,6 +99,10 @@ Eigen::Vector3d CoupledTool::update(const DeviceState& device, const contact::Su
     const Eigen::Vector3d relative_velocity = ((felt - m_previous_felt) - (device.position_mm - m_previous_device)) / dt; // mm/s
     m_previous_felt = felt;
     m_previous_device = device.position_mm;
+    if (passing) { // cutting through: the contact where the tool is, as the simulation presses it
+        m_spread.setZero();
+        return m_contact.force_on_tool_n;
+    }
     return kc * (felt - device.position_mm) + m_coupling.damping_n_s_per_mm * relative_velocity;
 }
 

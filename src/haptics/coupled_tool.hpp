@@ -6,10 +6,13 @@
 // K the contact's stiffness, so stiff contact and a stiff coupling stay stable at 1 kHz (Colgate
 // et al.'s virtual coupling; the adaptive shape matching paper couples the same way). The user
 // feels the spring's force, k_c (x_proxy - x_device) plus damping, which the loop's safety stage
-// then clamps. A step that would carry the tool past points it touches at neither end stops at
-// the first such touch, and the tool's triangle mesh is swept against the snapshot's triangles
-// for features thinner than the gaps between surface points (contact/tool_sweep.hpp), so a fast,
-// thin tool cannot tunnel through the surface between ticks. A new snapshot moves the surface under
+// then clamps. The step is the one every tool's proxy takes (contact/proxy.hpp): no surface point
+// gets deeper into the pushing shape than its bound however hard the device pulls, the step
+// slides along what blocks it, and the tool's triangle mesh is swept against the snapshot's
+// triangles for features thinner than the gaps between surface points (contact/tool_sweep.hpp), so
+// a fast, thin tool cannot tunnel through the surface between ticks. While the simulation says the
+// tool cuts through what it touches (set_passing), the proxy goes where the device is and the user
+// feels the contact there. A new snapshot moves the surface under
 // the proxy at once (the simulation stepped): what the user feels follows the proxy's move over as
 // many ticks as the snapshots come apart, not in one, so the force does not jump once a frame.
 // Where the snapshot carries a subdivided patch at the contact (contact/contact_patch.hpp), the
@@ -25,9 +28,10 @@
 
 #include "contact/contact_patch.hpp"
 #include "contact/penalty_contact.hpp"
-#include "contact/tool_sweep.hpp"
+#include "contact/proxy.hpp"
 #include "haptics/device.hpp"
 
+#include <atomic>
 #include <vector>
 
 namespace vox::haptics {
@@ -63,7 +67,14 @@ public:
     /// Where the user feels it: the proxy, plus what is left of a new snapshot's move to spread.
     [[nodiscard]] Eigen::Vector3d felt_position() const { return m_proxy.position + m_spread; }
     /// The continuous check of the last update (whether it swept the tool's mesh, and stopped on it).
-    [[nodiscard]] const contact::ToolSweep& sweep() const { return m_sweep; }
+    [[nodiscard]] const contact::ToolSweep& sweep() const { return m_mover.sweep(); }
+    /// The simulation cuts through what the tool touches (sim::ToolPolicy::passing): from the next
+    /// tick the proxy is not held by the material. Safe to call from another thread.
+    void set_passing(bool passing) noexcept { m_passing.store(passing, std::memory_order_relaxed); }
+    [[nodiscard]] bool passing() const noexcept { return m_passing.load(std::memory_order_relaxed); }
+    /// The device's position at the last update: the driver, world mm.
+    [[nodiscard]] const Eigen::Vector3d& driver() const { return m_previous_device; }
+    [[nodiscard]] double coupling_stiffness_n_per_mm() const { return m_coupling.stiffness_n_per_mm; }
     /// Whether the last update started from the contact prepare() measured (else it measured it).
     [[nodiscard]] bool used_prepared() const { return m_used_prepared; }
     /// The contact at the proxy before the last update's step (force and stiffness; no pressure).
@@ -80,7 +91,8 @@ private:
     CouplingSettings m_coupling;
     contact::PlacedShape m_proxy;
     contact::ContactTotals m_contact;
-    contact::ToolSweep m_sweep;
+    contact::ProxyMover m_mover;
+    std::atomic<bool> m_passing{false};
     std::vector<double> m_distance; ///< per snapshot point, this tick's distance at the proxy
     contact::ContactPatchState m_patch;
     double m_patch_us = 0.0;

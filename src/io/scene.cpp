@@ -655,6 +655,8 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
     t.push_margin_mm = r.optional("push_margin_mm", t.push_margin_mm, closed_range(0.0, 100.0));
     t.contact_stiffness_n_per_mm =
         r.optional("contact_stiffness_n_per_mm", t.contact_stiffness_n_per_mm, half_open_range(0.0, 1e4));
+    if (r.optional_node("coupling_stiffness_n_per_mm"))
+        t.coupling_stiffness_n_per_mm = r.optional("coupling_stiffness_n_per_mm", 0.0, half_open_range(0.0, 1e6));
     t.cut_pressure_pa = r.optional("cut_pressure_pa", t.cut_pressure_pa, half_open_range(0.0, 1e9));
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
     t.burr_speed_rpm = r.optional("burr_speed_rpm", t.burr_speed_rpm, half_open_range(0.0, 1e6));

@@ -307,6 +307,10 @@ enum class CutMode {
 /// overlaps the object by a depth d it presses with the penalty pressure
 /// contact_stiffness_n_per_mm * d / 1 cm^2. A cut tool cuts only where its inner shape reaches
 /// material and the mean pressure over the outer shape's contact is at or above cut_pressure_pa.
+/// A script-driven tool's coupling spring, N/mm, where the scene gives none: stiff beside the
+/// contact (5 N/mm per cm^2), so the proxy is where the script puts it until the material holds it.
+constexpr double k_script_coupling_n_per_mm = 100.0;
+
 struct ToolSpec {
     /// Unique, non-empty; the script refers to the tool by it.
     std::string name;
@@ -347,6 +351,10 @@ struct ToolSpec {
     /// removes 10 mm^3/s at 1 N and 50,000 rpm, the order of bone-drilling rates reported for
     /// otologic burrs.
     double drill_rate_mm3_per_n_rev = 0.012;
+    /// The spring joining the tool (its proxy, held outside material it does not cut or drill) to
+    /// what drives it (the script, a device), N/mm, in (0, 1e6]. Absent: a script-driven tool's
+    /// is k_script_coupling_n_per_mm, a device's the device's own (contact/proxy.hpp).
+    std::optional<double> coupling_stiffness_n_per_mm;
     /// Haptic subdivision at the contact (contact/contact_patch.hpp): the Loop subdivisions, 0 to
     /// 3, of the surface patch the haptic loop presses, which gives under the tool between
     /// frames as the FEM would; -1 (the default): no patch, the snapshot stays rigid between

@@ -23,6 +23,14 @@ constexpr std::size_t k_snapshot_points = 50000;
 
 } // namespace
 
+haptics::CouplingSettings device_coupling(const io::ToolSpec& tool, const haptics::DeviceLimits& limits)
+{
+    haptics::CouplingSettings coupling;
+    if (tool.coupling_stiffness_n_per_mm) coupling.stiffness_n_per_mm = *tool.coupling_stiffness_n_per_mm;
+    if (limits.max_stiffness_n_per_mm > 0.0) coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, limits.max_stiffness_n_per_mm);
+    return coupling;
+}
+
 std::size_t tool_named(const io::Scene& scene, const std::string& name)
 {
     if (name.empty()) return 0;
@@ -102,10 +110,7 @@ void DeviceRun::add_hand(std::size_t tool, std::unique_ptr<haptics::Device> devi
     hand->device = std::move(device);
     hand->snapshot = contact::SurfacePoints(k_snapshot_points);
     const io::ToolSpec& spec = m_scene.tools[tool];
-    // The device's own limits where it declares them: a coupling it renders stably.
-    haptics::CouplingSettings coupling;
-    const haptics::DeviceLimits& limits = hand->device->limits();
-    if (limits.max_stiffness_n_per_mm > 0.0) coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, limits.max_stiffness_n_per_mm);
+    const haptics::CouplingSettings coupling = device_coupling(spec, hand->device->limits());
     hand->coupled = std::make_unique<haptics::CoupledTool>(tools.shape(tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
                                                            coupling, hand->snapshot.capacity());
     m_hands.push_back(std::move(hand));
@@ -134,7 +139,10 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
             hand->warned_truncated = true;
         }
     }
-    for (const std::unique_ptr<Hand>& hand : m_hands) hand->patch_us_max = 0.0;
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        hand->patch_us_max = 0.0;
+        hand->coupled->set_passing(tools.passing(hand->tool)); // a tool that cut last frame cuts on through
+    }
     const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
     m_tick_s = dt_s / ticks;
     for (int k = 1; k <= ticks; ++k) {
@@ -151,7 +159,7 @@ void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_
     }
     for (const std::unique_ptr<Hand>& hand : m_hands) {
         const contact::PlacedShape pose = hand->coupled->handed_pose();
-        tools.drive(hand->tool, pose.position, pose.orientation);
+        tools.drive(hand->tool, pose.position, pose.orientation, hand->coupled->driver(), hand->coupled->coupling_stiffness_n_per_mm());
     }
 }
 

@@ -98,6 +98,10 @@ private:
     double m_tick_s = 1e-3;
 };
 
+/// The coupling spring of a device driving `tool`: the tool's coupling_stiffness_n_per_mm where
+/// the scene gives it, else the haptic default, at most what the device renders stably.
+[[nodiscard]] haptics::CouplingSettings device_coupling(const io::ToolSpec& tool, const haptics::DeviceLimits& limits);
+
 /// The scene tool named `name` (empty: the first); InputError naming --tool and the scene's tools
 /// when there is none.
 [[nodiscard]] std::size_t tool_named(const io::Scene& scene, const std::string& name);

@@ -23,6 +23,8 @@ nlohmann::json tool_frames_json(const std::vector<ToolFrame>& tools)
             continue;
         }
         out.push_back({{"position_mm", {t.position_mm.x(), t.position_mm.y(), t.position_mm.z()}},
+                       {"driver_mm", {t.driver_mm.x(), t.driver_mm.y(), t.driver_mm.z()}},
+                       {"coupling_force_n", {t.coupling_force_n.x(), t.coupling_force_n.y(), t.coupling_force_n.z()}},
                        {"force_n", {t.force_n.x(), t.force_n.y(), t.force_n.z()}},
                        {"torque_n_mm", {t.torque_n_mm.x(), t.torque_n_mm.y(), t.torque_n_mm.z()}},
                        {"pressure_pa", t.pressure_pa},

@@ -1,7 +1,13 @@
 #pragma once
 // The scene's tools acting on a simulation, frame by frame, the same for every method. Each
-// placed tool (where the script puts it, or where a device drives it) touches the surface by
-// penalty contact, integrated over its move since the last frame. A cutting tool cuts only where
+// placed tool is a proxy joined by a coupling spring to its driver, where the script or a device
+// puts it (contact/proxy.hpp): material the tool does not cut or drill holds the proxy at its
+// surface, and the penalty contact at the proxy, integrated over its move since the last frame, is
+// scaled to carry the spring's pull (a script pulls as hard as it likes: the material deforms or
+// holds, the tool does not pass through). A device's proxy moves in the 1 kHz loop
+// (haptics/coupled_tool.hpp), a script's here, by the same steps. A cutting tool that cut in a
+// frame passes through what it touches in the next (the material gives way where it cuts), as
+// long as it goes on cutting. A cutting tool cuts only where
 // its inner shape reaches the material and the contact pressure is at or above its threshold, and
 // only while that holds: what decides a cut is the contact the user would feel. A two-phase tool
 // (the sculpting paper's) holds the object still from its first touch while it marks its path;
@@ -10,7 +16,9 @@
 // cut goes and what it does to the object is the method's (sim/method.hpp).
 
 #include "sim/method.hpp"
+#include "contact/proxy.hpp"
 
+#include <memory>
 #include <vector>
 
 namespace vox::sim {
@@ -21,7 +29,10 @@ namespace vox::sim {
 /// One tool during one frame.
 struct ToolFrame {
     bool placed = false;
-    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+    Eigen::Vector3d position_mm = Eigen::Vector3d::Zero(); ///< the tool: its proxy
+    Eigen::Vector3d driver_mm = Eigen::Vector3d::Zero();   ///< where the script or device puts it
+    Eigen::Vector3d coupling_force_n = Eigen::Vector3d::Zero(); ///< the spring's pull on the proxy, k_c (driver - proxy)
+    double load_scale = 1.0; ///< the penalty at the proxy scaled by this to carry the pull (contact::load_scale)
     Eigen::Vector3d force_n = Eigen::Vector3d::Zero();     ///< on the tool (the object's reaction)
     Eigen::Vector3d torque_n_mm = Eigen::Vector3d::Zero(); ///< on the tool, about its origin
     double pressure_pa = 0.0;
@@ -51,9 +62,13 @@ public:
     /// them touch, cut and wet `method`, and leaves their contact forces with it for the next step.
     ToolsFrame frame(Method& method, double t_s, double dt_s);
 
-    /// A device moves `tool` from now on (its script entries are ignored): its pose for the next
-    /// frames, world mm.
-    void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation);
+    /// A device moves `tool` from now on (its script entries are ignored): its proxy's pose for
+    /// the next frames, world mm, the device's own position (the driver) and the spring between them.
+    void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation, const Eigen::Vector3d& driver_mm,
+               double coupling_n_per_mm);
+    /// `tool` cut in the last frame: it passes through what it touches (a device's proxy follows
+    /// the device) until it cuts no more.
+    [[nodiscard]] bool passing(std::size_t tool) const { return m_passing[tool]; }
     /// The device lets go of `tool`: the script places it again (nowhere, without entries).
     void release(std::size_t tool);
     /// Forgets every tool's last pose and contact episode (after the object was restored).
@@ -64,12 +79,25 @@ public:
     [[nodiscard]] const contact::PlacedShape& placed(std::size_t tool) const { return m_last_pose[tool]; }
 
 private:
+    contact::ProxyMover& mover(std::size_t tool, const io::ToolSpec& spec);
+    /// Holds `proxy` (the tool where it is, turned as its driver) at the surface of what the tool
+    /// does not cut: a script's proxy settles toward its driver from where it was (`moved_on`);
+    /// a device's stays where the haptic loop put it. Returns the contact's load scale there.
+    double hold(std::size_t tool, Method& method, const io::ToolSpec& spec, contact::PlacedShape& proxy, const Eigen::Vector3d& driver,
+                double coupling_n_per_mm, bool moved_on);
+
     const io::Scene& m_scene;
     std::vector<contact::ToolShape> m_shapes;
     std::vector<contact::PlacedShape> m_last_pose; ///< per tool, at the last frame it was placed (no shape: not placed)
     std::vector<bool> m_episode_cut;               ///< two-phase: this contact has cut its marked path
     std::vector<bool> m_driven;                    ///< a device moves the tool
     std::vector<contact::PlacedShape> m_driven_pose;
+    std::vector<Eigen::Vector3d> m_driven_driver;  ///< the device's position
+    std::vector<double> m_driven_coupling;         ///< its spring, N/mm
+    std::vector<bool> m_passing;                   ///< the tool cut in the last frame
+    /// Per tool: its proxy's steps and the surface near it, sampled each frame.
+    std::vector<std::unique_ptr<contact::ProxyMover>> m_movers;
+    std::vector<contact::SurfacePoints> m_near;
 };
 
 } // namespace vox::sim

@@ -33,7 +33,8 @@ struct RenderState {
 struct ProxyPose {
     int tool = 0;
     contact::PlacedShape pose;
-    Eigen::Vector3d heading = Eigen::Vector3d::Zero();
+    Eigen::Vector3d heading = Eigen::Vector3d::Zero(); ///< the driver: the device, or the pointer's target
+    double coupling_n_per_mm = 0.0;                     ///< the spring between them
 };
 
 /// The window's requests to the simulation thread (the keys), each taken once by it.
@@ -60,6 +61,8 @@ struct HandChannel {
     explicit HandChannel(std::size_t snapshot_capacity) : snapshots(contact::SurfacePoints(snapshot_capacity)) {}
     haptics::TripleBuffer<contact::SurfacePoints> snapshots;
     haptics::TripleBuffer<ProxyPose> proxies;
+    /// The simulation cuts through what this hand's tool touches (sim::ToolPolicy::passing).
+    std::atomic<bool> passing{false};
 };
 
 struct ViewChannels {

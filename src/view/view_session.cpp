@@ -174,10 +174,9 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     // loop serving every device, each with its own coupling and safety stage.
     std::vector<std::unique_ptr<haptics::CoupledTool>> coupled;
     for (std::size_t k = 0; k < scene.tools.size(); ++k) {
-        haptics::CouplingSettings coupling;
+        haptics::CouplingSettings coupling = sim::device_coupling(scene.tools[k], {});
         for (std::size_t d = 0; d < driven.size(); ++d) // a device's own limits where it declares them
-            if (driven[d] == k && devices[d]->limits().max_stiffness_n_per_mm > 0.0)
-                coupling.stiffness_n_per_mm = std::min(coupling.stiffness_n_per_mm, devices[d]->limits().max_stiffness_n_per_mm);
+            if (driven[d] == k) coupling = sim::device_coupling(scene.tools[k], devices[d]->limits());
         coupled.push_back(std::make_unique<haptics::CoupledTool>(
             tools.shape(k), contact::ContactParameters{scene.tools[k].push_margin_mm, scene.tools[k].contact_stiffness_n_per_mm}, coupling,
             snapshot_capacity));
@@ -202,8 +201,10 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                               age = now_s() - surface.t_s;
                               const int k = tool_of(d);
                               haptics::CoupledTool& tool = *coupled[static_cast<std::size_t>(k)];
+                              tool.set_passing(hand.passing.load(std::memory_order_relaxed));
                               const Eigen::Vector3d f = tool.update(s, surface, 1e-3);
-                              hand.proxies.write_slot() = {k, tool.handed_pose(), mouse ? pointer.target() : s.position_mm};
+                              hand.proxies.write_slot() = {k, tool.handed_pose(), mouse ? pointer.target() : s.position_mm,
+                                                           tool.coupling_stiffness_n_per_mm()};
                               hand.proxies.publish();
                               if (d == 0) requests.ticks.fetch_add(1, std::memory_order_relaxed);
                               return f;

@@ -143,14 +143,18 @@ bool ViewSimulation::step(double now_s)
         hand.driven = p.tool;
         hand.pose = p.pose;
         hand.heading = p.heading;
+        hand.coupling_n_per_mm = p.coupling_n_per_mm;
     }
     // A stroke's checkpoint before any of its cuts: the window flags the stroke before it moves
     // the pointer, so a pose read above that belongs to the stroke sees the flag.
     if (r.stroke_started.exchange(false)) m_history.before_stroke(*m_method);
     for (const Hand& hand : m_hands)
-        if (hand.driven >= 0) m_tools.drive(static_cast<std::size_t>(hand.driven), hand.pose.position, hand.pose.orientation);
+        if (hand.driven >= 0)
+            m_tools.drive(static_cast<std::size_t>(hand.driven), hand.pose.position, hand.pose.orientation, hand.heading, hand.coupling_n_per_mm);
     try {
         const sim::FrameStats frame = m_loop.next();
+        for (std::size_t d = 0; d < m_hands.size(); ++d) // a tool that cut goes on cutting through
+            if (m_hands[d].driven >= 0) m_channels.hand(d).passing.store(m_tools.passing(static_cast<std::size_t>(m_hands[d].driven)));
         if (frame.level_change) now_at_level(frame.level_change->reason);
         // A stroke ends when the button goes up, or (a 6-DoF controller) when a cut ends or the tool rests.
         const bool released = r.stroke_ended.exchange(false);

@@ -91,7 +91,8 @@ private:
     struct Hand {
         int driven = -1;
         contact::PlacedShape pose;
-        Eigen::Vector3d heading = Eigen::Vector3d::Zero();
+        Eigen::Vector3d heading = Eigen::Vector3d::Zero(); ///< the driver
+        double coupling_n_per_mm = 0.0;                     ///< the spring between it and the tool
     };
     std::vector<Hand> m_hands;
 };

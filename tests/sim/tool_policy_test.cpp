@@ -103,7 +103,7 @@ TEST_P(EachMethod, ADrivenToolIsWhereTheDeviceSaysAndTheScriptAgainOnceReleased)
     ToolPolicy tools(scene);
     FrameLoop loop(scene, *method, tools);
     const Eigen::Vector3d away(50, 5, 60); // well above the bar
-    tools.drive(0, away, Eigen::Quaterniond::Identity());
+    tools.drive(0, away, Eigen::Quaterniond::Identity(), away, 0.5);
     const FrameStats driven = loop.next();
     EXPECT_TRUE(driven.tools.tools[0].position_mm.isApprox(away));
     EXPECT_EQ(driven.tools.tools[0].force_n.norm(), 0.0);

@@ -1,0 +1,135 @@
+// Contact that holds, on every method that takes the tool: a probe driven 15 mm past the top of a
+// stiff plate thinner than itself, by the script and by a scripted device, stays on the plate with
+// its inner shape at most 1 mm into the surface, and the device feels the coupling spring,
+// clamped; a burr pressed through a bone plate drills its way through it, by the script and by a
+// device, never deeper into undrilled bone than the bound; a fast jab stops at the surface.
+
+#include "io/scene.hpp"
+#include "io/scene_object.hpp"
+#include "sim/device_run.hpp"
+#include "sim/frame_loop.hpp"
+#include "sim/method_factory.hpp"
+#include "sim/tool_policy.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <limits>
+
+namespace vox::sim {
+namespace {
+
+/// A plate of 0.5 mm voxels, 30 x 10 x `thickness` mm, held at both ends (its top z = thickness -
+/// 0.25 mm, voxel centres from 0), and one tool `tool` driven straight down over its middle from
+/// 8 mm above the top to `below` mm below the top in `seconds`, then held there.
+io::Scene plate(const nlohmann::json& tool, double thickness, double below, double seconds, const char* solver, double youngs_pa)
+{
+    const double top = thickness - 0.25;
+    const double lift = tool.value("radius_mm", 0.0);
+    const nlohmann::json doc = {
+        {"object", {{"phantom", {{"shape", "block"}, {"size_mm", {30, 10, thickness}}, {"voxel_mm", 0.5}}}, {"levels", 1}}},
+        {"materials", {{"default", {{"youngs_modulus_pa", youngs_pa}, {"poisson_ratio", 0.3}, {"density_kg_m3", 1900}}}}},
+        {"solver", {{"type", solver}, {"dt_s", 0.01}}},
+        {"gravity_m_s2", {0, 0, 0}},
+        {"constraints",
+         {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {3, 11, thickness + 1}}}}, {{"type", "fixed"}, {"box_mm", {{26.5, -1, -1}, {31, 11, thickness + 1}}}}}},
+        {"tools", {tool}},
+        {"script",
+         {{{"t_s", 0.0}, {"tool", tool["name"]}, {"position_mm", {14.75, 4.75, top + lift + 8}}},
+          {{"t_s", seconds}, {"tool", tool["name"]}, {"position_mm", {14.75, 4.75, top + lift - below}}}}},
+    };
+    return io::parse_scene(doc, ::testing::TempDir(), "plate.json");
+}
+
+/// Per frame: how deep the tool's inner shape reaches into the object's surface (the deepest
+/// surface vertex inside it), and where the tool is.
+struct Pressed {
+    double deepest_mm = 0.0;
+    std::vector<double> z_mm;           ///< the tool's centre per frame
+    int frames_below_surface = 0;       ///< the tool's centre below the surface right under it
+    std::size_t removed_voxels = 0;
+    double max_device_force_n = 0.0;    ///< what the device was given (device runs)
+    double last_device_force_n = 0.0;
+    double max_coupling_n = 0.0;
+};
+
+Pressed press(const io::Scene& scene, int frames, bool device)
+{
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    std::unique_ptr<Method> method = open_method(scene, labels).method;
+    ToolPolicy tools(scene);
+    std::unique_ptr<DeviceRun> run;
+    if (device) run = std::make_unique<DeviceRun>(scene, tools, DeviceOptions{});
+    FrameLoop loop(scene, *method, tools, run.get());
+    Pressed out;
+    for (int f = 0; f < frames; ++f) {
+        const FrameStats s = loop.next();
+        const ToolFrame& t = s.tools.tools[0];
+        out.z_mm.push_back(t.position_mm.z());
+        out.removed_voxels += s.tools.cut.removed_voxels;
+        out.max_coupling_n = std::max(out.max_coupling_n, t.coupling_force_n.norm());
+        const contact::PlacedShape at{&tools.shape(0), t.position_mm, tools.placed(0).orientation};
+        double top = -std::numeric_limits<double>::infinity(); // the surface right under the tool: its highest point there
+        for (const Eigen::Vector3d& v : method->surface_mesh().positions) {
+            out.deepest_mm = std::max(out.deepest_mm, -at.signed_distance(v));
+            if ((v - t.position_mm).head<2>().norm() < 1.0) top = std::max(top, v.z());
+        }
+        out.frames_below_surface += t.position_mm.z() < top;
+    }
+    if (run)
+        for (const ForceSample& f : run->forces()) {
+            out.max_device_force_n = std::max(out.max_device_force_n, f.force_n.norm());
+            out.last_device_force_n = f.force_n.norm();
+        }
+    return out;
+}
+
+class ProxyOnEachMethod : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ProxyOnEachMethod, AProbeDrivenFarPastAStiffPlateThinnerThanItselfStaysOnIt)
+{
+    // A 4 mm probe on a 2 mm plate of 1 GPa, driven 15 mm past its top in 0.5 s and held.
+    const nlohmann::json probe = {{"name", "probe"}, {"shape", "sphere"}, {"radius_mm", 2.0}, {"action", "push"}, {"push_margin_mm", 0.25}};
+    const io::Scene scene = plate(probe, 2.0, 15.0, 0.5, GetParam(), 1e9);
+    for (const bool device : {false, true}) {
+        const Pressed p = press(scene, 70, device);
+        const char* by = device ? "a scripted device" : "the script";
+        EXPECT_LE(p.deepest_mm, 1.0) << "the probe's inner shape reached into the plate, by " << by;
+        EXPECT_EQ(p.frames_below_surface, 0) << "the probe went through the plate, by " << by;
+        if (device) {
+            EXPECT_GT(p.last_device_force_n, 1.0) << "the device feels the plate holding the probe";
+            EXPECT_LE(p.max_device_force_n, 3.0 + 1e-9) << "the coupling force is clamped to the device's maximum";
+        } else {
+            EXPECT_GT(p.max_coupling_n, 100.0) << "the script pulled hard";
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, ProxyOnEachMethod, ::testing::Values("dbg", "isxfem", "shape_matching"));
+
+TEST(ToolProxy, ABurrPressedThroughABonePlateDrillsAHoleByScriptAndByDevice)
+{
+    // A 3 mm burr (radius 1.5) pressed through a 3 mm plate of 15 GPa: it holds the surface, the
+    // bone under it goes, and it comes out below; its inner shape is never more than 1 mm into bone.
+    const nlohmann::json burr = {{"name", "burr"},  {"shape", "sphere"}, {"radius_mm", 1.5}, {"action", "drill"},
+                                 {"burr_speed_rpm", 60000}, {"push_margin_mm", 0.25}};
+    const io::Scene scene = plate(burr, 3.0, 8.0, 1.0, "dbg", 1.5e10);
+    const double top = 2.75, bottom = -0.25;
+    for (const bool device : {false, true}) {
+        const Pressed p = press(scene, 300, device);
+        const char* by = device ? "a scripted device" : "the script";
+        EXPECT_LE(p.deepest_mm, 1.0) << "by " << by;
+        EXPECT_EQ(p.frames_below_surface, 0) << "the burr was below bone it had not drilled, by " << by;
+        EXPECT_GT(p.removed_voxels, 40u) << "by " << by;
+        EXPECT_LT(p.z_mm.back(), bottom) << "the burr came out below the plate, by " << by;
+        // It went down only as fast as it drilled: not at the script's pace.
+        std::size_t frame_in = 0;
+        while (frame_in < p.z_mm.size() && p.z_mm[frame_in] - 1.5 > top) ++frame_in;
+        std::size_t frame_out = frame_in;
+        while (frame_out < p.z_mm.size() && p.z_mm[frame_out] + 1.5 > bottom) ++frame_out;
+        EXPECT_GT(frame_out - frame_in, 5u) << "the burr took time to drill through, by " << by;
+    }
+}
+
+} // namespace
+} // namespace vox::sim
