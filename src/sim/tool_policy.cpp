@@ -85,8 +85,8 @@ contact::ProxyMover& ToolPolicy::mover(std::size_t tool, const io::ToolSpec& spe
     return *m;
 }
 
-double ToolPolicy::hold(std::size_t tool, Method& method, const io::ToolSpec& spec, contact::PlacedShape& proxy, const Eigen::Vector3d& driver,
-                        double coupling_n_per_mm, bool moved_on)
+ToolPolicy::Held ToolPolicy::hold(std::size_t tool, Method& method, const io::ToolSpec& spec, contact::PlacedShape& proxy,
+                                   const Eigen::Vector3d& driver, double coupling_n_per_mm, bool moved_on)
 {
     contact::ProxyMover& m = mover(tool, spec);
     const bool scripted = !m_driven[tool];
@@ -101,11 +101,14 @@ double ToolPolicy::hold(std::size_t tool, Method& method, const io::ToolSpec& sp
     method.sample_surface(box, spec, near); // indexed
     if (near.count == 0) {
         if (scripted) proxy.position = driver; // nothing in the way
-        return 1.0;
+        return {};
     }
-    const contact::ContactTotals c = scripted ? m.settle(proxy, driver, coupling_n_per_mm, near) : contact::penalty_totals(proxy, m.contact(), near, false);
-    return contact::load_scale(coupling_n_per_mm * (driver - proxy.position), c.force_on_tool_n,
-                               contact::deepest_point_mm(proxy, spec.push_margin_mm, near), m.bound_mm());
+    const contact::ContactTotals c = scripted ? m.settle(proxy, driver, coupling_n_per_mm, near) : contact::penalty_totals(proxy, m.contact(), near);
+    Held out;
+    out.load_scale = contact::load_scale(coupling_n_per_mm * (driver - proxy.position), c.force_on_tool_n,
+                                         contact::deepest_point_mm(proxy, spec.push_margin_mm, near), m.bound_mm());
+    out.breaks_in = c.inner_reaches_surface && out.load_scale * c.pressure_pa >= spec.cut_pressure_pa;
+    return out;
 }
 
 ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
@@ -142,7 +145,14 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
         // cutting through passes: it goes where its driver is).
         t.driver_mm = m_driven[k] ? m_driven_driver[k] : to.position_mm;
         const double coupling = m_driven[k] ? m_driven_coupling[k] : spec.coupling_stiffness_n_per_mm.value_or(io::k_script_coupling_n_per_mm);
-        if (!m_passing[k]) t.load_scale = hold(k, method, spec, placed, t.driver_mm, coupling, moved_on);
+        if (!m_passing[k]) {
+            const Held held = hold(k, method, spec, placed, t.driver_mm, coupling, moved_on);
+            t.load_scale = held.load_scale;
+            if (spec.action == io::ToolAction::cut && held.breaks_in) { // the material gives way: the blade cuts on to its driver
+                placed.position = t.driver_mm;
+                t.load_scale = 1.0;
+            }
+        }
         t.position_mm = placed.position;
         t.coupling_force_n = coupling * (t.driver_mm - placed.position);
         // The penalty integrated over the tool's move since the last frame (continuous penalty):
@@ -178,7 +188,9 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
             out.cut += cut;
             out.propagation_ms += clock.lap() - cut.grid_update_ms - cut.remesh_ms - cut.fem_update_ms;
         }
-        m_passing[k] = spec.action == io::ToolAction::cut && t.cut;
+        // A cut episode: from its first cut until the tool leaves the material, the blade goes where
+        // its driver is (in its slit, along its cut) and cuts wherever the pressure breaks in.
+        m_passing[k] = spec.action == io::ToolAction::cut && (t.cut || (m_passing[k] && order.touching));
         if (spec.action == io::ToolAction::wet) method.wet(k, spec.wet_rate_per_s * dt_s);
         if (spec.action == io::ToolAction::drill && order.touching) {
             // Removal rate = rate constant x pressing force x revolutions per second (Agus et

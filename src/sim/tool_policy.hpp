@@ -5,9 +5,9 @@
 // surface, and the penalty contact at the proxy, integrated over its move since the last frame, is
 // scaled to carry the spring's pull (a script pulls as hard as it likes: the material deforms or
 // holds, the tool does not pass through). A device's proxy moves in the 1 kHz loop
-// (haptics/coupled_tool.hpp), a script's here, by the same steps. A cutting tool that cut in a
-// frame passes through what it touches in the next (the material gives way where it cuts), as
-// long as it goes on cutting. A cutting tool cuts only where
+// (haptics/coupled_tool.hpp), a script's here, by the same steps. A cutting tool held at the
+// surface that breaks in goes to its driver and cuts; from then until it leaves the material (a
+// cut episode) it goes where its driver is, cutting wherever its pressure breaks in. A cutting tool cuts only where
 // its inner shape reaches the material and the contact pressure is at or above its threshold, and
 // only while that holds: what decides a cut is the contact the user would feel. A two-phase tool
 // (the sculpting paper's) holds the object still from its first touch while it marks its path;
@@ -66,8 +66,8 @@ public:
     /// the next frames, world mm, the device's own position (the driver) and the spring between them.
     void drive(std::size_t tool, const Eigen::Vector3d& position_mm, const Eigen::Quaterniond& orientation, const Eigen::Vector3d& driver_mm,
                double coupling_n_per_mm);
-    /// `tool` cut in the last frame: it passes through what it touches (a device's proxy follows
-    /// the device) until it cuts no more.
+    /// `tool` is in a cut episode (it has cut since it last touched nothing): it passes through
+    /// what it touches (a device's proxy follows the device) until it leaves the material.
     [[nodiscard]] bool passing(std::size_t tool) const { return m_passing[tool]; }
     /// The device lets go of `tool`: the script places it again (nowhere, without entries).
     void release(std::size_t tool);
@@ -80,10 +80,16 @@ public:
 
 private:
     contact::ProxyMover& mover(std::size_t tool, const io::ToolSpec& spec);
+    /// A tool held at the surface: how much its contact is scaled to carry its driver's pull, and
+    /// whether, so pressed, it breaks in (its inner shape reaches the material at the cut pressure).
+    struct Held {
+        double load_scale = 1.0;
+        bool breaks_in = false;
+    };
     /// Holds `proxy` (the tool where it is, turned as its driver) at the surface of what the tool
     /// does not cut: a script's proxy settles toward its driver from where it was (`moved_on`);
-    /// a device's stays where the haptic loop put it. Returns the contact's load scale there.
-    double hold(std::size_t tool, Method& method, const io::ToolSpec& spec, contact::PlacedShape& proxy, const Eigen::Vector3d& driver,
+    /// a device's stays where the haptic loop put it. Measured on the surface near it, sampled.
+    Held hold(std::size_t tool, Method& method, const io::ToolSpec& spec, contact::PlacedShape& proxy, const Eigen::Vector3d& driver,
                 double coupling_n_per_mm, bool moved_on);
 
     const io::Scene& m_scene;
@@ -94,7 +100,7 @@ private:
     std::vector<contact::PlacedShape> m_driven_pose;
     std::vector<Eigen::Vector3d> m_driven_driver;  ///< the device's position
     std::vector<double> m_driven_coupling;         ///< its spring, N/mm
-    std::vector<bool> m_passing;                   ///< the tool cut in the last frame
+    std::vector<bool> m_passing;                   ///< the tool is in a cut episode
     /// Per tool: its proxy's steps and the surface near it, sampled each frame.
     std::vector<std::unique_ptr<contact::ProxyMover>> m_movers;
     std::vector<contact::SurfacePoints> m_near;

@@ -97,13 +97,16 @@ TEST(CoupledTool, AFastThinToolDoesNotTunnelThroughTheSurface)
     const contact::SurfacePoints surface = wall();
     tool.update(at(3.0), surface, 1e-3);
     tool.update(at(-5.0), surface, 1e-3);
-    // Stopped where its pushing shape (0.25 + 0.25 mm below the centre) first reached z = 0.
-    EXPECT_NEAR(tool.proxy().position.z(), 0.5, 2e-3);
-    // And held there by the contact on the following ticks, pushing the hand back up.
+    // Stopped where its pushing shape (0.25 + 0.25 mm below the centre) reached its depth bound
+    // into the wall (contact/proxy.hpp: 90 % of the pushing shape's half-thickness, 0.45 mm).
+    const double bound = contact::depth_bound_mm(blade, 0.25);
+    EXPECT_NEAR(bound, 0.45, 1e-12);
+    EXPECT_NEAR(tool.proxy().position.z(), 0.5 - bound, 2e-3);
+    // And held there on the following ticks, pushing the hand back up.
     Eigen::Vector3d f;
     for (int tick = 0; tick < 50; ++tick) f = tool.update(at(-5.0), surface, 1e-3);
-    EXPECT_GT(tool.proxy().position.z(), 0.25); // the blade itself stays above the wall
-    EXPECT_GT(f.z(), 2.0);                       // the hand, 5.4 mm below, is pushed back up
+    EXPECT_GT(tool.proxy().position.z(), 0.5 - bound - 1e-3); // the blade's middle stays above the wall
+    EXPECT_GT(f.z(), 2.0);                                    // the hand, 5 mm below, is pushed back up
 }
 
 TEST(CoupledTool, ANeedleIsHeldAtAFaceBetweenDistantPoints)

@@ -675,7 +675,7 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     // A misspelt key is still unknown, and the message lists the new keys among the known ones.
     EXPECT_EQ(with_key("cut_pressure", 1e4),
               "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
-              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, burr_speed_rpm, "
+              "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, coupling_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, burr_speed_rpm, "
               "drill_rate_mm3_per_n_rev, haptic_subdivision, two_phase)");
     EXPECT_EQ(with_key("haptic_subdivision", 4).rfind("s.json: tools[1].haptic_subdivision: must be in [-1, 3]", 0), 0u);
     // (A blade cuts by default.)

@@ -50,8 +50,10 @@ TEST_P(EachMethod, ABladeCutsOnlyWhereAndWhileItsPressureReachesTheThreshold)
     }
     EXPECT_GE(cut_frames, 2) << r.method->name();
 
-    // The same stroke against a threshold it never reaches: the blade only pushes.
+    // The same stroke, pressed through a soft spring (1 N/mm), against a threshold it never
+    // reaches: the blade only pushes, holding the bar up instead of sinking through it.
     scene.tools[0].cut_pressure_pa = 1e9;
+    scene.tools[0].coupling_stiffness_n_per_mm = 1.0;
     const Simulated pushed = simulate(scene, 12);
     for (const FrameStats& f : pushed.frames) {
         EXPECT_FALSE(f.tools.tools[0].cut) << "frame " << f.frame;
@@ -109,7 +111,9 @@ TEST_P(EachMethod, ADrivenToolIsWhereTheDeviceSaysAndTheScriptAgainOnceReleased)
     EXPECT_EQ(driven.tools.tools[0].force_n.norm(), 0.0);
     tools.release(0);
     const FrameStats scripted = loop.next();
-    EXPECT_NEAR(scripted.tools.tools[0].position_mm.x(), 50.3, 1e-9);
+    // Where the script puts it, but for how far the bar it touches holds its proxy back.
+    EXPECT_NEAR(scripted.tools.tools[0].position_mm.x(), 50.3, 1e-3);
+    EXPECT_NEAR(scripted.tools.tools[0].driver_mm.x(), 50.3, 1e-9);
     EXPECT_LT(scripted.tools.tools[0].position_mm.z(), 20.5);
 }
 

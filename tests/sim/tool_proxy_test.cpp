@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <limits>
+#include <map>
 
 namespace vox::sim {
 namespace {
@@ -130,6 +131,93 @@ TEST(ToolProxy, ABurrPressedThroughABonePlateDrillsAHoleByScriptAndByDevice)
         EXPECT_GT(frame_out - frame_in, 5u) << "the burr took time to drill through, by " << by;
     }
 }
+
+/// A soft slab (0.5 MPa) 40 x 10 x 6 mm of 1 mm voxels held at its x < 4 mm end, gravity down, cut across
+/// at about x = 25 mm by a blade turned so that its plane is the y-z plane tilted by 30 degrees
+/// (the freed piece above its face), moved along its own height from above the slab to below it in
+/// 0.2 s, separating; then either left where its stroke ended, or drawn up and away.
+io::Scene slab_cut(const char* solver, bool left_in_place)
+{
+    const nlohmann::json q = {0.6830127, -0.1830127, -0.1830127, 0.6830127}; // tilt -30 deg about y, after a quarter turn about z
+    auto at = [](double s) { return nlohmann::json{25.5 - 0.5 * s, 4.5, 2.5 + 0.8660254 * s}; };
+    nlohmann::json script = {{{"t_s", 0.0}, {"tool", "blade"}, {"position_mm", at(16)}, {"orientation_wxyz", q}},
+                             {{"t_s", 0.2}, {"tool", "blade"}, {"position_mm", at(0)}, {"orientation_wxyz", q}}};
+    if (!left_in_place) {
+        script.push_back({{"t_s", 0.25}, {"tool", "blade"}, {"position_mm", at(40)}, {"orientation_wxyz", q}});
+    }
+    const nlohmann::json doc = {
+        {"object", {{"phantom", {{"shape", "block"}, {"size_mm", {40, 10, 6}}}}, {"levels", 1}}},
+        {"materials", {{"default", {{"youngs_modulus_pa", 5e5}, {"poisson_ratio", 0.45}, {"density_kg_m3", 1000}}}}},
+        {"solver", {{"type", solver}, {"dt_s", 0.01}}},
+        {"gravity_m_s2", {0, 0, -9.81}},
+        {"constraints", {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {3.5, 11, 7}}}}}},
+        {"tools",
+         {{{"name", "blade"}, {"shape", "blade"}, {"size_mm", {30, 0.5, 20}}, {"cut_mode", "separate"}, {"push_margin_mm", 0.25}, {"cut_pressure_pa", 1.2e4}}}},
+        {"script", script},
+    };
+    return io::parse_scene(doc, ::testing::TempDir(), "slab.json");
+}
+
+/// Whether every edge of `mesh` is shared by exactly two of its triangles.
+bool closed(const surface::SurfaceMesh& mesh)
+{
+    std::map<std::pair<int, int>, int> uses;
+    for (const Eigen::Vector3i& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+    for (const auto& [edge, n] : uses)
+        if (n != 2) return false;
+    return true;
+}
+
+struct Cut {
+    std::size_t pieces = 0;
+    double volume_mm3 = 0.0, uncut_volume_mm3 = 0.0;
+    bool closed = false;
+    std::size_t cuts = 0;
+};
+
+Cut cut_slab(const io::Scene& scene, int frames, bool device)
+{
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    std::unique_ptr<Method> method = open_method(scene, labels).method;
+    ToolPolicy tools(scene);
+    std::unique_ptr<DeviceRun> run;
+    if (device) run = std::make_unique<DeviceRun>(scene, tools, DeviceOptions{});
+    FrameLoop loop(scene, *method, tools, run.get());
+    Cut out;
+    out.uncut_volume_mm3 = enclosed_volume_mm3(method->surface_mesh());
+    for (int f = 0; f < frames; ++f) out.cuts += loop.next().tools.tools[0].cut;
+    const surface::SurfaceMesh mesh = method->surface_mesh();
+    out.pieces = method->piece_count();
+    out.volume_mm3 = enclosed_volume_mm3(mesh);
+    out.closed = closed(mesh);
+    return out;
+}
+
+class SlabOnEachMethod : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SlabOnEachMethod, AStrokeCutsTheSameTwoPiecesByScriptAndByDevice)
+{
+    const io::Scene scene = slab_cut(GetParam(), false);
+    const Cut scripted = cut_slab(scene, 40, false), driven = cut_slab(scene, 40, true);
+    for (const bool device : {false, true}) {
+        const Cut& c = device ? driven : scripted;
+        const char* by = device ? "a scripted device" : "the script";
+        EXPECT_EQ(c.pieces, 2u) << "by " << by;
+        EXPECT_TRUE(c.closed) << "by " << by;
+        EXPECT_GT(c.volume_mm3, 0.97 * c.uncut_volume_mm3) << "by " << by;
+    }
+}
+
+TEST_P(SlabOnEachMethod, APieceFreedOntoABladeLeftInPlaceKeepsItsVolume)
+{
+    const Cut c = cut_slab(slab_cut(GetParam(), true), 100, false);
+    EXPECT_EQ(c.pieces, 2u);
+    EXPECT_TRUE(c.closed);
+    EXPECT_GT(c.volume_mm3, 0.97 * c.uncut_volume_mm3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, SlabOnEachMethod, ::testing::Values("dbg", "isxfem", "shape_matching"));
 
 } // namespace
 } // namespace vox::sim
