@@ -5,6 +5,8 @@
 #include "grid/hex8.hpp"
 #include "core/union_find.hpp"
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <numeric>
 
@@ -291,5 +293,18 @@ void HexModel::add_mass_floor(const grid::BranchedGrid& grid)
 }
 
 double HexModel::total_mass() const { return std::accumulate(m_nodal_mass.begin(), m_nodal_mass.end(), 0.0); }
+
+std::size_t inverted_elements(const HexModel& model, const std::vector<Eigen::Vector3d>& positions)
+{
+    // F = frame^T sum_c x_c (dN_c/dX)^T is I at rest; frame is orthogonal (det +-1).
+    const double orientation = model.frame().determinant();
+    std::size_t n = 0;
+    for (const HexElement& el : model.elements()) {
+        Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+        for (int c = 0; c < 8; ++c) f += (positions[el.dof_node[c]] - positions[el.dof_node[0]]) * el.gradient.row(c);
+        n += !(orientation * f.determinant() > 0.0);
+    }
+    return n;
+}
 
 } // namespace vox::fem

@@ -114,4 +114,8 @@ private:
     std::vector<int> m_node_level;
 };
 
+/// Elements of `model` inverted at `positions` (world m, per node): those whose deformation
+/// gradient at their material centroid has a determinant of zero or less (or not finite).
+[[nodiscard]] std::size_t inverted_elements(const HexModel& model, const std::vector<Eigen::Vector3d>& positions);
+
 } // namespace vox::fem

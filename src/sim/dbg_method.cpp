@@ -385,6 +385,7 @@ StepFigures DbgMethod::step()
     out.substeps = s.substeps;
     out.kinetic_energy_j = s.kinetic_energy_j;
     out.elastic_energy_j = s.elastic_energy_j;
+    out.inverted_elements = fem::inverted_elements(m_sim->model(), m_sim->solver().positions());
     out.max_displacement_mm = s.max_displacement_m * 1e3;
     out.energy_projected = s.energy_projected;
     out.asleep_pieces = m_sim->asleep_piece_count();

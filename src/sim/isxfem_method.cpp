@@ -221,6 +221,14 @@ StepFigures IsxfemMethod::step()
     double max_m = 0.0;
     for (std::size_t n = 0; n < rest.size(); ++n) max_m = std::max(max_m, (x[n] - rest[n]).norm());
     out.max_displacement_mm = 1e3 * max_m;
+    // Uncut tetrahedra by their nodes; a cut one's nodes need not bound either side (the
+    // enrichment moves the sides apart), so it is left out.
+    const isxfem::TetMesh& mesh = m_sim->model().mesh();
+    for (std::size_t k = 0; k < mesh.tets.size(); ++k) {
+        if (!m_sim->model().elements()[k].cuts.empty()) continue;
+        const auto& t = mesh.tets[k];
+        out.inverted_elements += !(isxfem::signed_volume({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) > 0.0);
+    }
     return out;
 }
 

@@ -46,6 +46,9 @@ struct StepFigures {
     double kinetic_energy_j = 0.0;
     std::optional<double> elastic_energy_j; ///< empty where the method does not measure it
     double max_displacement_mm = 0.0;       ///< of any node from rest
+    /// Elements inverted after the step (hexahedra: the deformation gradient at the material
+    /// centroid; uncut tetrahedra: the signed volume of their nodes); 0 for a healthy run.
+    std::size_t inverted_elements = 0;
     std::size_t asleep_pieces = 0;          ///< pieces at rest, not stepped (branched grid)
     bool energy_projected = false;          ///< the step created energy even split into 32 substeps, and lost it again
 };

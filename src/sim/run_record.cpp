@@ -65,6 +65,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_max_ms = std::max(m_max_ms, s.step_ms);
     m_converged += s.converged;
     m_projected += s.energy_projected;
+    m_inverted_frames += s.inverted_elements > 0;
     m_removed += t.cut.removed_voxels;
     m_separated_faces += t.cut.separated_faces;
     m_separated_voxels += t.cut.separated_voxels;
@@ -88,6 +89,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"kinetic_energy_j", s.kinetic_energy_j},
                          {"elastic_energy_j", s.elastic_energy_j ? nlohmann::json(*s.elastic_energy_j) : nlohmann::json()},
                          {"max_displacement_mm", s.max_displacement_mm},
+                         {"inverted_elements", s.inverted_elements},
                          {"collision_ms", t.collision_ms},
                          {"propagation_ms", t.propagation_ms},
                          {"grid_update_ms", t.cut.grid_update_ms},
@@ -150,6 +152,7 @@ void RunRecord::finish(const Method& method)
                            {"final_level", method.level()},
                            {"converged_frames", m_converged},
                            {"energy_projected_frames", m_projected},
+                           {"inverted_frames", m_inverted_frames},
                            {"removed_voxels", m_removed},
                            {"separated_faces", m_separated_faces},
                            {"separated_voxels", m_separated_voxels},

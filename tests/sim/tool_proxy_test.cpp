@@ -174,6 +174,7 @@ struct Cut {
     double volume_mm3 = 0.0, uncut_volume_mm3 = 0.0;
     bool closed = false;
     std::size_t cuts = 0;
+    std::size_t inverted_frames = 0; ///< frames ending with an inverted element
 };
 
 Cut cut_slab(const io::Scene& scene, int frames, bool device)
@@ -186,7 +187,11 @@ Cut cut_slab(const io::Scene& scene, int frames, bool device)
     FrameLoop loop(scene, *method, tools, run.get());
     Cut out;
     out.uncut_volume_mm3 = enclosed_volume_mm3(method->surface_mesh());
-    for (int f = 0; f < frames; ++f) out.cuts += loop.next().tools.tools[0].cut;
+    for (int f = 0; f < frames; ++f) {
+        const FrameStats s = loop.next();
+        out.cuts += s.tools.tools[0].cut;
+        out.inverted_frames += s.step.inverted_elements > 0;
+    }
     const surface::SurfaceMesh mesh = method->surface_mesh();
     out.pieces = method->piece_count();
     out.volume_mm3 = enclosed_volume_mm3(mesh);
@@ -206,6 +211,7 @@ TEST_P(SlabOnEachMethod, AStrokeCutsTheSameTwoPiecesByScriptAndByDevice)
         EXPECT_EQ(c.pieces, 2u) << "by " << by;
         EXPECT_TRUE(c.closed) << "by " << by;
         EXPECT_GT(c.volume_mm3, 0.97 * c.uncut_volume_mm3) << "by " << by;
+        EXPECT_EQ(c.inverted_frames, 0u) << "by " << by;
     }
 }
 
@@ -215,6 +221,7 @@ TEST_P(SlabOnEachMethod, APieceFreedOntoABladeLeftInPlaceKeepsItsVolume)
     EXPECT_EQ(c.pieces, 2u);
     EXPECT_TRUE(c.closed);
     EXPECT_GT(c.volume_mm3, 0.97 * c.uncut_volume_mm3);
+    EXPECT_EQ(c.inverted_frames, 0u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, SlabOnEachMethod, ::testing::Values("dbg", "isxfem", "shape_matching"));
