@@ -179,3 +179,24 @@ TEST(CoupledTool, APreparedProxyTakesTheDeviceOrientationOfTheTickBefore)
         EXPECT_TRUE(tool.proxy().orientation.isApprox(before)) << k;
     }
 }
+
+TEST(CoupledTool, AProbePulledFarPastAWallIsHeldAtItsDepthBoundAndPassesOnlyWhileCutting)
+{
+    // A 2 mm ball pulled 20 mm into the wall through a stiff spring (10 N at every millimetre,
+    // far beyond any device's maximum): it stays at the wall, no point deeper than the bound.
+    const contact::ToolShape ball = contact::ToolShape::sphere(2.0);
+    haptics::CoupledTool tool(ball, {0.5, 5.0}, {10.0, 0.0}, 41 * 41);
+    contact::SurfacePoints surface = wall();
+    surface.index();
+    tool.update(at(4.0), surface, 1e-3);
+    Eigen::Vector3d f;
+    for (int tick = 0; tick < 300; ++tick) f = tool.update(at(-20.0), surface, 1e-3);
+    const double bound = contact::depth_bound_mm(ball, 0.5);
+    EXPECT_LE(contact::deepest_point_mm(tool.proxy(), 0.5, surface), bound + 1e-3);
+    EXPECT_GT(tool.proxy().position.z(), 0.0);
+    EXPECT_NEAR(f.z(), 10.0 * (tool.proxy().position.z() + 20.0), 1e-6 * f.z()); // the whole pull, felt
+    // In a cut episode the material gives way: the proxy goes where the device is.
+    tool.set_passing(true);
+    tool.update(at(-20.0), surface, 1e-3);
+    EXPECT_NEAR(tool.proxy().position.z(), -20.0, 1e-12);
+}
