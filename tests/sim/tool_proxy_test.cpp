@@ -42,6 +42,20 @@ io::Scene plate(const nlohmann::json& tool, double thickness, double below, doub
     return io::parse_scene(doc, ::testing::TempDir(), "plate.json");
 }
 
+/// A scene's run, driven by the script alone or, `device`, by one scripted device.
+struct Run {
+    std::unique_ptr<Method> method;
+    ToolPolicy tools;
+    std::unique_ptr<DeviceRun> device;
+    FrameLoop loop;
+    Run(const io::Scene& scene, bool by_device)
+        : method(open_method(scene, std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene))).method), tools(scene),
+          device(by_device ? std::make_unique<DeviceRun>(scene, tools, DeviceOptions{}) : nullptr),
+          loop(scene, *method, tools, device.get())
+    {
+    }
+};
+
 /// Per frame: how deep the tool's inner shape reaches into the object's surface (the deepest
 /// surface vertex inside it), and where the tool is.
 struct Pressed {
@@ -56,29 +70,24 @@ struct Pressed {
 
 Pressed press(const io::Scene& scene, int frames, bool device)
 {
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-    std::unique_ptr<Method> method = open_method(scene, labels).method;
-    ToolPolicy tools(scene);
-    std::unique_ptr<DeviceRun> run;
-    if (device) run = std::make_unique<DeviceRun>(scene, tools, DeviceOptions{});
-    FrameLoop loop(scene, *method, tools, run.get());
+    Run r(scene, device);
     Pressed out;
     for (int f = 0; f < frames; ++f) {
-        const FrameStats s = loop.next();
+        const FrameStats s = r.loop.next();
         const ToolFrame& t = s.tools.tools[0];
         out.z_mm.push_back(t.position_mm.z());
         out.removed_voxels += s.tools.cut.removed_voxels;
         out.max_coupling_n = std::max(out.max_coupling_n, t.coupling_force_n.norm());
-        const contact::PlacedShape at{&tools.shape(0), t.position_mm, tools.placed(0).orientation};
+        const contact::PlacedShape at{&r.tools.shape(0), t.position_mm, r.tools.placed(0).orientation};
         double top = -std::numeric_limits<double>::infinity(); // the surface right under the tool: its highest point there
-        for (const Eigen::Vector3d& v : method->surface_mesh().positions) {
+        for (const Eigen::Vector3d& v : r.method->surface_mesh().positions) {
             out.deepest_mm = std::max(out.deepest_mm, -at.signed_distance(v));
             if ((v - t.position_mm).head<2>().norm() < 1.0) top = std::max(top, v.z());
         }
         out.frames_below_surface += t.position_mm.z() < top;
     }
-    if (run)
-        for (const ForceSample& f : run->forces()) {
+    if (r.device)
+        for (const ForceSample& f : r.device->forces()) {
             out.max_device_force_n = std::max(out.max_device_force_n, f.force_n.norm());
             out.last_device_force_n = f.force_n.norm();
         }
@@ -179,21 +188,16 @@ struct Cut {
 
 Cut cut_slab(const io::Scene& scene, int frames, bool device)
 {
-    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-    std::unique_ptr<Method> method = open_method(scene, labels).method;
-    ToolPolicy tools(scene);
-    std::unique_ptr<DeviceRun> run;
-    if (device) run = std::make_unique<DeviceRun>(scene, tools, DeviceOptions{});
-    FrameLoop loop(scene, *method, tools, run.get());
+    Run r(scene, device);
     Cut out;
-    out.uncut_volume_mm3 = enclosed_volume_mm3(method->surface_mesh());
+    out.uncut_volume_mm3 = enclosed_volume_mm3(r.method->surface_mesh());
     for (int f = 0; f < frames; ++f) {
-        const FrameStats s = loop.next();
+        const FrameStats s = r.loop.next();
         out.cuts += s.tools.tools[0].cut;
         out.inverted_frames += s.step.inverted_elements > 0;
     }
-    const surface::SurfaceMesh mesh = method->surface_mesh();
-    out.pieces = method->piece_count();
+    const surface::SurfaceMesh mesh = r.method->surface_mesh();
+    out.pieces = r.method->piece_count();
     out.volume_mm3 = enclosed_volume_mm3(mesh);
     out.closed = closed(mesh);
     return out;
