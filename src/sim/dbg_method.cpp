@@ -470,6 +470,11 @@ void DbgMethod::sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpe
     cut::sample_surface(m_sim->surface(), goal, box, out, &stiffness);
 }
 
+void DbgMethod::sample_pressed_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec&, contact::SurfacePoints& out) const
+{
+    cut::sample_surface(m_sim->surface(), m_sim->solver().positions(), box, out);
+}
+
 std::optional<double> DbgMethod::contact_compliance_mm_per_n(std::size_t tool)
 {
     constexpr int k_compliance_frames = 10;

@@ -65,6 +65,7 @@ public:
     [[nodiscard]] std::vector<float> surface_wetness() const override;
     [[nodiscard]] std::vector<Eigen::Vector3d> surface_displacements_mm() const override;
     [[nodiscard]] std::vector<std::uint64_t> surface_keys() const override;
+    void sample_pressed_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
     void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const override;
     std::optional<double> contact_compliance_mm_per_n(std::size_t tool) override;
     [[nodiscard]] std::size_t piece_count() const override;

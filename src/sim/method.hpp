@@ -153,6 +153,13 @@ public:
     /// Fills `out` with the surface within `box` (world mm) as the haptic thread touches it with
     /// `tool` (at most out.capacity() points; out.truncated says when more were near).
     virtual void sample_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const = 0;
+    /// The same, as touch() presses it: the deformed surface itself, for the tool policy's proxy
+    /// (sim/tool_policy.hpp). sample_surface's, but where a method hands the haptic loop another
+    /// surface (shape matching: where its clusters' goals put it).
+    virtual void sample_pressed_surface(const Eigen::AlignedBox3d& box, const io::ToolSpec& tool, contact::SurfacePoints& out) const
+    {
+        sample_surface(box, tool, out);
+    }
 
     /// The object's condensed compliance where tool `tool` touched it last frame: under that
     /// contact's own load, spread as it is, the load-weighted displacement per newton one step

@@ -98,7 +98,7 @@ ToolPolicy::Held ToolPolicy::hold(std::size_t tool, Method& method, const io::To
     Eigen::AlignedBox3d box = proxy.world_bounds(reach);
     box.extend(at_driver.world_bounds(reach));
     contact::SurfacePoints& near = m_near[tool];
-    method.sample_surface(box, spec, near); // indexed
+    method.sample_pressed_surface(box, spec, near); // indexed
     if (near.count == 0) {
         if (scripted) proxy.position = driver; // nothing in the way
         return {};
