@@ -47,7 +47,7 @@ ProxyMover::ProxyMover(const ToolShape& shape, const ContactParameters& contact,
 }
 
 double ProxyMover::bounded_share(const PlacedShape& proxy, const Eigen::Vector3d& step, const SurfacePoints& points,
-                                 Eigen::Vector3d& blocking) noexcept
+                                 std::span<const double> distance, Eigen::Vector3d& blocking) noexcept
 {
     blocking.setZero();
     const double length = step.norm();
@@ -63,7 +63,9 @@ double ProxyMover::bounded_share(const PlacedShape& proxy, const Eigen::Vector3d
     std::size_t n = 0;
     points.for_each_point_near(box, [&](std::size_t i) {
         if (points.is_replaced(i) || n >= m_candidates.size()) return;
-        const double depth = margin - proxy.signed_distance(points.positions_mm[i]);
+        // The contact measured most points' distances at the proxy already (+infinity: not).
+        const double measured = i < distance.size() ? distance[i] : INFINITY;
+        const double depth = margin - (measured < INFINITY ? measured : proxy.signed_distance(points.positions_mm[i]));
         const double limit = std::max(m_bound, depth); // a point already deeper (the material came in) may not go deeper
         if (depth + length <= limit) return;            // 1-Lipschitz: it cannot reach its bound over this move
         m_candidates[n] = static_cast<std::uint32_t>(i);
@@ -140,12 +142,13 @@ Eigen::Vector3d ProxyMover::move(PlacedShape& proxy, const Eigen::Vector3d& step
     int plane_count = 0;
     for (int k = 0; k < 6 && rest.squaredNorm() > 1e-18; ++k) {
         Eigen::Vector3d blocking;
-        const double t = bounded_share(proxy, rest, points, blocking);
+        const std::span<const double> measured = k == 0 ? distance : std::span<const double>{}; // at the proxy where it started
+        const double t = bounded_share(proxy, rest, points, measured, blocking);
         PlacedShape to = proxy;
         to.position += t * rest;
         // What passes between points (a thin blade through a face): the tool's mesh against the
         // triangles. Its stop has no normal to slide along: the proxy stays there this step.
-        const double t_mesh = m_sweep.first_stop(proxy, to, points, k == 0 ? distance : std::span<const double>{});
+        const double t_mesh = m_sweep.first_stop(proxy, to, points, measured);
         if (t_mesh < 1.0) {
             proxy.position += t_mesh * t * rest;
             m_blocked = true;

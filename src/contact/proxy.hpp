@@ -80,8 +80,9 @@ public:
 
 private:
     /// The share of `step` the proxy can go before a point passes its depth bound (1: all of it);
-    /// `blocking` receives the direction in which that point's depth grows fastest.
-    double bounded_share(const PlacedShape& proxy, const Eigen::Vector3d& step, const SurfacePoints& points,
+    /// `blocking` receives the direction in which that point's depth grows fastest. `distance`:
+    /// the points' distances at `proxy` where measured (+infinity where not), or empty.
+    double bounded_share(const PlacedShape& proxy, const Eigen::Vector3d& step, const SurfacePoints& points, std::span<const double> distance,
                          Eigen::Vector3d& blocking) noexcept;
 
     ContactParameters m_contact;

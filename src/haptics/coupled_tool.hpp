@@ -71,7 +71,6 @@ public:
     /// The simulation cuts through what the tool touches (sim::ToolPolicy::passing): from the next
     /// tick the proxy is not held by the material. Safe to call from another thread.
     void set_passing(bool passing) noexcept { m_passing.store(passing, std::memory_order_relaxed); }
-    [[nodiscard]] bool passing() const noexcept { return m_passing.load(std::memory_order_relaxed); }
     /// The device's position at the last update: the driver, world mm.
     [[nodiscard]] const Eigen::Vector3d& driver() const { return m_previous_device; }
     [[nodiscard]] double coupling_stiffness_n_per_mm() const { return m_coupling.stiffness_n_per_mm; }

@@ -300,6 +300,10 @@ enum class CutMode {
     return shape == ToolShape::blade || shape == ToolShape::scalpel ? ToolAction::cut : ToolAction::push;
 }
 
+/// A script-driven tool's coupling spring, N/mm, where the scene gives none: stiff beside the
+/// contact (5 N/mm per cm^2), so the proxy is where the script puts it until the material holds it.
+constexpr double k_script_coupling_n_per_mm = 100.0;
+
 /// A tool the script (or a haptic device) moves. Lengths in the tool's own frame, mm.
 ///
 /// Contact model (docs/scene-format.md, "tools"): the shape below is the inner (cutting) shape;
@@ -307,10 +311,6 @@ enum class CutMode {
 /// overlaps the object by a depth d it presses with the penalty pressure
 /// contact_stiffness_n_per_mm * d / 1 cm^2. A cut tool cuts only where its inner shape reaches
 /// material and the mean pressure over the outer shape's contact is at or above cut_pressure_pa.
-/// A script-driven tool's coupling spring, N/mm, where the scene gives none: stiff beside the
-/// contact (5 N/mm per cm^2), so the proxy is where the script puts it until the material holds it.
-constexpr double k_script_coupling_n_per_mm = 100.0;
-
 struct ToolSpec {
     /// Unique, non-empty; the script refers to the tool by it.
     std::string name;

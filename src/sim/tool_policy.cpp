@@ -43,7 +43,7 @@ ToolPolicy::ToolPolicy(const io::Scene& scene)
       m_driven_pose(scene.tools.size()), m_driven_driver(scene.tools.size(), Eigen::Vector3d::Zero()),
       m_driven_coupling(scene.tools.size(), 0.0), m_passing(scene.tools.size(), false), m_movers(scene.tools.size())
 {
-    m_shapes.reserve(scene.tools.size()); // the movers refer to the shapes
+    m_shapes.reserve(scene.tools.size()); // placed shapes point at them
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_tool_shape(t));
     for (std::size_t k = 0; k < scene.tools.size(); ++k) m_near.emplace_back(k_near_points);
 }
