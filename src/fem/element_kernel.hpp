@@ -139,6 +139,20 @@ inline void scatter_add(const CornerVectors& w, double* x, const std::array<std:
     return out;
 }
 
+/// m g_c for every corner c, g_c the corner's row of `gradient` (the derivative of a function of
+/// the deformation gradient F with respect to the corners, m the derivative with respect to F).
+[[nodiscard]] inline CornerVectors gradient_times(const Eigen::Matrix3d& m, const Eigen::Matrix<double, 8, 3>& gradient)
+{
+    CornerVectors out;
+    for (int i = 0; i < 3; ++i)
+        for (int h = 0; h < 2; ++h)
+            for (int k = 0; k < 4; ++k) {
+                const int c = 4 * h + k;
+                out.v[2 * i + h][k] = m(i, 0) * gradient(c, 0) + m(i, 1) * gradient(c, 1) + m(i, 2) * gradient(c, 2);
+            }
+    return out;
+}
+
 /// k u for a component-major stiffness: column j of k times u's entry j, summed into six
 /// independent registers.
 [[nodiscard]] inline CornerVectors stiffness_times(const Matrix24d& k, const CornerVectors& u)

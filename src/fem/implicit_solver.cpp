@@ -47,6 +47,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_stiffness_scale.assign(model.elements().size(), 1.0);
     m_behaviour.resize(model.materials().size());
     m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
+    m_volume_hessian.assign(model.elements().size(), VolumeHessian{});
     m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
     if (same_mesh && same_mesh->m_options.matrix_free == m_options.matrix_free && same_connectivity(same_mesh->m_model, model)) {
         // A cut that changed element matrices only (a drill taking a voxel a frame): the
@@ -301,6 +302,7 @@ void ImplicitSolver::update_active()
             }
         if (m_active[e]) continue;
         m_element_energy[e] = 0.0;
+        m_volume_hessian[e] = {};
     }
     m_active_current = true;
     m_element_pass_current = false; // the internal forces it left hold the elements now left out
@@ -356,6 +358,25 @@ double ImplicitSolver::plastic_correction(std::size_t e, const Vector24d& u, Vec
     return el.volume_m3 * (-(strain.cwiseProduct(sigma_p)).sum() + 0.5 * plastic.cwiseProduct(sigma_p).sum());
 }
 
+double ImplicitSolver::add_volume_correction(std::size_t e, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation, double* forces)
+{
+    // fem/volume_correction.hpp at the material centroid, in the index-aligned frame of f; the
+    // world gradient of a function of F_world = frame f is frame times its gradient in f.
+    const HexElement& el = m_model.elements()[e];
+    const grid::Lame& lame = m_model.materials()[static_cast<std::size_t>(el.material)].lame;
+    const double lambda_v = m_stiffness_scale[e] * lame.lambda * el.volume_m3;
+    double plastic_volume = 1.0, plastic_trace = 0.0; // the plastic strain's own volume change is its rest
+    if (!m_plastic.empty() && m_behaviour[static_cast<std::size_t>(el.material)].plastic()) {
+        plastic_volume = (Eigen::Matrix3d::Identity() + m_plastic[e]).determinant();
+        plastic_trace = m_plastic[e].trace();
+    }
+    const VolumeCorrection c = volume_correction(f, rotation, lambda_v, plastic_volume, plastic_trace);
+    const Eigen::Matrix3d& frame = m_model.frame();
+    scatter_add(gradient_times(frame * c.gradient, el.gradient), forces, el.dof_node);
+    m_volume_hessian[e] = c.hessian.turned(frame);
+    return c.energy;
+}
+
 double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
 {
     const Eigen::Matrix3d& frame = m_model.frame();
@@ -397,6 +418,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                     fl = from_corner_major(force);
                 }
                 scatter_add(turn(r, fl, false), m_internal.data(), el.dof_node);
+                m_element_energy[e] += add_volume_correction(e, f[i], m_rotation[e].toRotationMatrix(), m_internal.data());
             }
         });
     }
@@ -419,6 +441,10 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                 const Eigen::Matrix3d rk = r * corner_block(*el.stiffness, c, c);
                 Eigen::Vector3d d = ks * rk.cwiseProduct(r).rowwise().sum();
                 if (!lumped) d.array() += m_scale * el.mass(c, c);
+                if (const VolumeHessian& v = m_volume_hessian[e]; v.active()) {
+                    const Eigen::Vector3d g = el.gradient.row(c).transpose();
+                    d += k_scale * v.block(g, g).diagonal();
+                }
                 m_diagonal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += d;
             }
         }));
@@ -446,9 +472,11 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                     const Eigen::Matrix3d& r = m_element_rotation[e];
                     const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
                     const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
+                    const VolumeHessian& v = m_volume_hessian[e];
                     for (int d = 0; d < 8; ++d) {
                         Eigen::Matrix3d block = rk * corner_block(*el.stiffness, static_cast<int>(c), d) * r.transpose();
                         if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
+                        if (v.active()) block += k_scale * v.block(el.gradient.row(c).transpose(), el.gradient.row(d).transpose());
                         double* at = values + outer[3 * n] + 3 * ranks[d];
                         for (int i = 0; i < 3; ++i)
                             for (int j = 0; j < 3; ++j) at[i * row_length + j] += block(i, j);
@@ -628,6 +656,9 @@ void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::Vect
         const Eigen::Matrix3d& r = m_element_rotation[e];
         const CornerVectors local = turn(r, gather(p.data(), el.dof_node), true);
         scatter_add(turn(r, m_stiffness_scale[e] * stiffness_times(*el.stiffness, local), false), m_stiffness_product.data(), el.dof_node);
+        if (const VolumeHessian& v = m_volume_hessian[e]; v.active())
+            scatter_add(gradient_times(v.times(outer_sum(gather(p.data(), el.dof_node), el.gradient)), el.gradient), m_stiffness_product.data(),
+                        el.dof_node);
     }));
     out.resize(p.size());
     const bool lumped = m_options.lumped_mass;

@@ -9,9 +9,11 @@
 #include "fem/hex_model.hpp"
 #include "fem/pair_contact.hpp"
 #include "fem/preconditioner.hpp"
+#include "fem/volume_correction.hpp"
 
 #include <Eigen/Sparse>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -36,7 +38,7 @@ struct SolverOptions {
     /// preconditioner. (With the warped factor the solver already multiplies element by element
     /// and assembles only when the factor is taken again.)
     bool matrix_free = false;
-    int newton_max_iterations = 20;   ///< quasi-static mode
+    int newton_max_iterations = 30;   ///< quasi-static mode, and dynamic steps solved fully (newton_step)
     /// Throws InputError naming the offending option.
     void validate() const;
 };
@@ -232,6 +234,10 @@ private:
     /// Adds the plastic forces of element e to `force` (local frame), letting its plastic strain
     /// creep first when a step starts; returns the energy correction, J.
     double plastic_correction(std::size_t e, const Vector24d& u, Vector24d& force);
+    /// The volume correction of element e at deformation gradient `f` and corotational rotation
+    /// `rotation` (index-aligned frame; fem/volume_correction.hpp): adds its forces into `forces`
+    /// (per dof), keeps its Hessian's positive part for the system, returns its energy, J.
+    double add_volume_correction(std::size_t e, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation, double* forces);
     /// out = M v (lumped or consistent, with the added mass floor).
     void mass_times(const std::vector<Eigen::Vector3d>& v, Eigen::VectorXd& out) const;
     /// Adds sign times the step's stiffness of the pair contacts `which` (all when null) to the
@@ -308,6 +314,7 @@ private:
     std::vector<Eigen::Quaterniond> m_rotation;       ///< per element, index-aligned frame (warm start)
     std::vector<Eigen::Quaterniond> m_node_rotation;  ///< per node, mean of its elements'
     std::vector<double> m_element_energy;
+    std::vector<VolumeHessian> m_volume_hessian; ///< per element: of its volume correction, world frame
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
     std::unique_ptr<Preconditioner> m_preconditioner;
     std::unique_ptr<NodeIntegrator> m_integrator;

@@ -171,7 +171,7 @@ struct SolverSettings {
     /// Rayleigh damping, stiffness part: beta in C = alpha M + beta K, s (>= 0).
     double rayleigh_stiffness_s = 0.002;
     /// Static mode: Newton iteration cap per frame (>= 1).
-    int newton_max_iterations = 20;
+    int newton_max_iterations = 30;
     /// Key "preconditioner": "auto" (default), "jacobi", "cholesky", "multigrid".
     PreconditionerChoice preconditioner = PreconditionerChoice::automatic;
     /// Key "mass": "lumped" (default: row sums, diagonal) or "consistent".

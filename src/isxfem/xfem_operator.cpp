@@ -69,6 +69,7 @@ std::vector<std::uint32_t> XfemOperator::model_changed()
     m_rotation.resize(elements.size(), {q, q, q, q});
     m_r.resize(elements.size(), {i3, i3, i3, i3});
     m_turned_gradient.resize(elements.size());
+    m_volume_hessian.resize(elements.size());
     m_cut_count.resize(elements.size(), 0);
     m_slot_start.assign(elements.size() + 1, 0);
     std::vector<std::uint32_t> count(blocks + 1, 0);
@@ -180,7 +181,10 @@ void XfemOperator::update(const std::vector<Eigen::Vector3d>& x, const std::vect
             const Eigen::Matrix3d f = Eigen::Matrix3d::Identity() + gradient_of(displacement, el.geometry);
             fem::extract_rotation(f, m_rotation[e][0]);
             const Eigen::Matrix3d r = m_r[e][0] = m_rotation[e][0].toRotationMatrix();
-            const Eigen::Matrix3d s = r * stress(r.transpose() * f - Eigen::Matrix3d::Identity(), m_lame_volume[e]);
+            // With the volume correction of a squeezed element (fem/volume_correction.hpp).
+            const fem::VolumeCorrection volume = fem::volume_correction(f, r, m_lame_volume[e][0]);
+            m_volume_hessian[e] = volume.hessian;
+            const Eigen::Matrix3d s = r * stress(r.transpose() * f - Eigen::Matrix3d::Identity(), m_lame_volume[e]) + volume.gradient;
             for (Eigen::Index c = 0; c < 4; ++c) Eigen::Map<Eigen::Vector3d>(force + 3 * c) = s * el.geometry.gradient.row(c).transpose();
             m_turned_gradient[e].noalias() = r * el.geometry.gradient.transpose();
             return;
@@ -261,6 +265,8 @@ void XfemOperator::fill_row(std::size_t block, double scale_m, double scale_k)
                 const Eigen::Vector3d gb = turned.col(b);
                 Eigen::Matrix3d m = lambda * ga * gb.transpose() + mu * gb * ga.transpose();
                 m.diagonal().array() += mu * ga.dot(gb);
+                if (const fem::VolumeHessian& v = m_volume_hessian[e]; v.active())
+                    m += scale_k * v.block(el.geometry.gradient.row(a).transpose(), el.geometry.gradient.row(b).transpose());
                 add(ranks[b], m);
             }
             continue;

@@ -22,6 +22,7 @@
 
 #include "fem/pair_contact.hpp"
 #include "fem/preconditioner.hpp"
+#include "fem/volume_correction.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -85,6 +86,7 @@ private:
     std::vector<std::array<Eigen::Quaterniond, 1u << k_max_cuts>> m_rotation; ///< per element, per region
     std::vector<std::array<Eigen::Matrix3d, 1u << k_max_cuts>> m_r;           ///< the same as matrices
     std::vector<Eigen::Matrix<double, 3, 4>> m_turned_gradient; ///< per whole element: R g_c by corner
+    std::vector<fem::VolumeHessian> m_volume_hessian;           ///< per whole element: of its volume correction
     std::vector<unsigned char> m_cut_count; ///< per element: the cuts its rotations know of
     std::vector<std::array<double, 2>> m_lame_volume; ///< per element: V lambda, V mu
     std::vector<std::uint32_t> m_slot_start;          ///< per element: first of its 3 per dof block force values in m_slots

@@ -62,8 +62,9 @@ TEST(ImplicitSolver, RigidMotionsStoreNoEnergy)
 
 TEST(ImplicitSolver, UniaxialCompressionMatchesFLOverEAAndPatchTest)
 {
-    // A 12 x 4 x 4 mm bar, symmetry planes held by slide constraints, a force F on its far end.
-    const double h = 1e-3, length = 12e-3, side = 4e-3, force = -0.5;
+    // A 12 x 4 x 4 mm bar, symmetry planes held by slide constraints, a force F on its far end: a
+    // 1.25 % strain, where the linear model holds (fem/volume_correction.hpp leaves it alone).
+    const double h = 1e-3, length = 12e-3, side = 4e-3, force = -0.02;
     const auto grid = block_grid({12, 4, 4}, 1);
     for (int level : {0, 1}) {
     SCOPED_TRACE(testing::Message() << "level " << level);

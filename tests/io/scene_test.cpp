@@ -199,7 +199,7 @@ TEST(SceneDefaults, AbsentKeysTakeTheDocumentedDefaults)
     EXPECT_EQ(s.solver.mode, SolverMode::dynamic);
     EXPECT_EQ(s.solver.rayleigh_mass_per_s, 0.5);
     EXPECT_EQ(s.solver.rayleigh_stiffness_s, 0.002);
-    EXPECT_EQ(s.solver.newton_max_iterations, 20);
+    EXPECT_EQ(s.solver.newton_max_iterations, 30);
     EXPECT_EQ(s.gravity_m_s2, Eigen::Vector3d(0, 0, -9.81));
     EXPECT_TRUE(s.constraints.empty());
     EXPECT_TRUE(s.loads.empty());
@@ -223,7 +223,7 @@ TEST(SceneDefaults, EmptySectionsTakeTheDefaultsToo)
     EXPECT_EQ(s.solver.mode, SolverMode::dynamic);
     EXPECT_EQ(s.solver.rayleigh_mass_per_s, 0.5);
     EXPECT_EQ(s.solver.rayleigh_stiffness_s, 0.002);
-    EXPECT_EQ(s.solver.newton_max_iterations, 20);
+    EXPECT_EQ(s.solver.newton_max_iterations, 30);
     EXPECT_TRUE(s.loads.empty());
     EXPECT_EQ(s.output.dir, fs::path("/tmp/scenes/out"));
 }
@@ -327,7 +327,7 @@ TEST(SceneDefaults, StructDefaultsMatchTheReader)
     EXPECT_EQ(solver.mode, SolverMode::dynamic);
     EXPECT_EQ(solver.rayleigh_mass_per_s, 0.5);
     EXPECT_EQ(solver.rayleigh_stiffness_s, 0.002);
-    EXPECT_EQ(solver.newton_max_iterations, 20);
+    EXPECT_EQ(solver.newton_max_iterations, 30);
     const Constraint constraint; // type fixed: holds every axis
     EXPECT_EQ(constraint.type, ConstraintType::fixed);
     EXPECT_EQ(constraint.held_axes, (std::array<bool, 3>{true, true, true}));

@@ -6,7 +6,10 @@
 
 #include "isxfem/xfem_operator.hpp"
 
+#include "fem/volume_correction.hpp"
+
 #include <Eigen/SVD>
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -77,7 +80,7 @@ TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
         const auto n = static_cast<Eigen::Index>(3 * model.block_count());
         Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n), mass = Eigen::MatrixXd::Zero(n, n);
         Eigen::VectorXd force = Eigen::VectorXd::Zero(n);
-        int whole = 0;
+        int whole = 0, squeezed = 0;
         for (std::size_t e = 0; e < model.elements().size(); ++e) {
             const XfemElement& el = model.elements()[e];
             const auto blocks = static_cast<Eigen::Index>(el.block_count());
@@ -102,6 +105,24 @@ TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
                     }
                 }
             }
+            if (!el.is_cut()) { // and the volume correction of a squeezed whole element (fem/volume_correction.hpp)
+                const Eigen::Matrix3d r = op.rotation(e)[0].toRotationMatrix();
+                Eigen::Matrix3d dx, dX;
+                for (int c = 0; c < 3; ++c) {
+                    dx.col(c) = d.x[el.node[static_cast<std::size_t>(c + 1)]] - d.x[el.node[0]];
+                    dX.col(c) = model.mesh().nodes[el.node[static_cast<std::size_t>(c + 1)]] - model.mesh().nodes[el.node[0]];
+                }
+                const double lambda_v = el.geometry.volume * model.materials()[el.material].lame.lambda;
+                const fem::VolumeCorrection v = fem::volume_correction(dx * dX.inverse(), r, lambda_v);
+                squeezed += v.hessian.active();
+                for (Eigen::Index i = 0; i < 4; ++i) {
+                    const auto bi = 3 * static_cast<Eigen::Index>(el.node[static_cast<std::size_t>(i)]);
+                    force.segment<3>(bi) += v.gradient * el.geometry.gradient.row(i).transpose();
+                    for (Eigen::Index j = 0; j < 4; ++j)
+                        a.block<3, 3>(bi, 3 * static_cast<Eigen::Index>(el.node[static_cast<std::size_t>(j)])) +=
+                            scale_k * v.hessian.block(el.geometry.gradient.row(i).transpose(), el.geometry.gradient.row(j).transpose());
+                }
+            }
             if (!el.is_cut() && whole++ < 20) { // the rotation is the polar factor of F
                 Eigen::Matrix3d dx, dX;
                 for (int c = 0; c < 3; ++c) {
@@ -112,6 +133,7 @@ TEST(XfemOperator, MatchesADenseAssemblyOfTheElementMatrices)
                 EXPECT_LT((op.rotation(e)[0].toRotationMatrix() - svd.matrixU() * svd.matrixV().transpose()).norm(), 1e-11);
             }
         }
+        EXPECT_GT(squeezed, 0) << "the bar is deformed enough to squeeze some tetrahedra";
         a += scale_m * mass;
         for (Eigen::Index i = 0; i < n; ++i)
             if (d.fixed[static_cast<std::size_t>(i)]) {

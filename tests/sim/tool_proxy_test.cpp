@@ -228,7 +228,38 @@ TEST_P(SlabOnEachMethod, APieceFreedOntoABladeLeftInPlaceKeepsItsVolume)
     EXPECT_EQ(c.inverted_frames, 0u);
 }
 
+/// A soft block (30 kPa, Poisson 0.45) 20 x 20 x 10 mm of 1 mm voxels resting on its held base,
+/// pinched by a 6 mm probe pressed from above to 1 mm over the base in 1 s and held there.
+io::Scene pinched_block(const char* solver)
+{
+    const nlohmann::json doc = {
+        {"object", {{"phantom", {{"shape", "block"}, {"size_mm", {20, 20, 10}}}}, {"levels", 1}}},
+        {"materials", {{"default", {{"youngs_modulus_pa", 3e4}, {"poisson_ratio", 0.45}, {"density_kg_m3", 1000}}}}},
+        {"solver", {{"type", solver}, {"dt_s", 0.01}}},
+        {"gravity_m_s2", {0, 0, 0}},
+        {"constraints", {{{"type", "fixed"}, {"box_mm", {{-1, -1, -1}, {21, 21, 0.2}}}}}},
+        {"tools", {{{"name", "probe"}, {"shape", "sphere"}, {"radius_mm", 3.0}, {"action", "push"}, {"push_margin_mm", 0.25}}}},
+        {"script",
+         {{{"t_s", 0.0}, {"tool", "probe"}, {"position_mm", {9.5, 9.5, 14.5}}}, {{"t_s", 1.0}, {"tool", "probe"}, {"position_mm", {9.5, 9.5, 3.5}}}}},
+    };
+    return io::parse_scene(doc, ::testing::TempDir(), "pinched.json");
+}
+
+class PinchOnEachMethod : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(PinchOnEachMethod, ABlockPinchedByAProbeKeepsItsVolume)
+{
+    const Cut c = cut_slab(pinched_block(GetParam()), 150, false);
+    EXPECT_EQ(c.pieces, 1u);
+    EXPECT_TRUE(c.closed);
+    EXPECT_GT(c.volume_mm3, 0.97 * c.uncut_volume_mm3) << c.volume_mm3 / c.uncut_volume_mm3;
+    EXPECT_EQ(c.inverted_frames, 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Methods, SlabOnEachMethod, ::testing::Values("dbg", "isxfem", "shape_matching"));
+// Is-XFEM's linear tetrahedra lock under the volume correction (94 % here) and shape matching has
+// none yet (86 %): issue 50 goes on with them.
+INSTANTIATE_TEST_SUITE_P(Methods, PinchOnEachMethod, ::testing::Values("dbg"));
 
 } // namespace
 } // namespace vox::sim
