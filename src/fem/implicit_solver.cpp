@@ -371,6 +371,10 @@ double ImplicitSolver::add_volume_correction(std::size_t e, const Eigen::Matrix3
         plastic_trace = m_plastic[e].trace();
     }
     const VolumeCorrection c = volume_correction(f, rotation, lambda_v, plastic_volume, plastic_trace);
+    if (c.gradient.isZero(0.0)) { // not squeezed (most elements): nothing to add
+        m_volume_hessian[e] = {};
+        return c.energy;
+    }
     const Eigen::Matrix3d& frame = m_model.frame();
     scatter_add(gradient_times(frame * c.gradient, el.gradient), forces, el.dof_node);
     m_volume_hessian[e] = c.hessian.turned(frame);
@@ -406,7 +410,8 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
             for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
                 const std::size_t e = batch[i];
                 const HexElement& el = elements[e];
-                const Eigen::Matrix3d r = frame * m_rotation[e].toRotationMatrix();
+                const Eigen::Matrix3d local_rotation = m_rotation[e].toRotationMatrix();
+                const Eigen::Matrix3d r = frame * local_rotation;
                 m_element_rotation[e] = r;
                 const CornerVectors rest = from_corner_major(el.rest);
                 const CornerVectors u = turn(r, moved[i], true) - minus(rest, Eigen::Vector3d(rest.at(0, 0), rest.at(0, 1), rest.at(0, 2)));
@@ -418,7 +423,7 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                     fl = from_corner_major(force);
                 }
                 scatter_add(turn(r, fl, false), m_internal.data(), el.dof_node);
-                m_element_energy[e] += add_volume_correction(e, f[i], m_rotation[e].toRotationMatrix(), m_internal.data());
+                m_element_energy[e] += add_volume_correction(e, f[i], local_rotation, m_internal.data());
             }
         });
     }
