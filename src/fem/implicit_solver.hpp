@@ -261,7 +261,8 @@ private:
     /// skipped by every element loop.
     void update_active();
     /// `same_system`: the matrix and preconditioner of the previous solve, another right-hand side.
-    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system = false);
+    /// `tolerance`: CG's relative tolerance when not the scene's (a Newton iteration's own).
+    int solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& residual, bool same_system = false, double tolerance = 0.0);
     [[nodiscard]] double kinetic_energy() const;
     /// One linearised implicit Euler step of `dt`; returns the external forces' work over it and
     /// sets `energy_before` to the kinetic plus elastic energy at its start.
