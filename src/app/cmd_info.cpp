@@ -125,15 +125,22 @@ json dicom_info(const std::string& path, const std::string& pick)
 {
     const std::vector<io::DicomSeries> all = io::list_dicom_series(path);
     json list = json::array();
-    for (const io::DicomSeries& s : all)
+    for (const io::DicomSeries& s : all) {
         list.push_back({{"number", s.number},
                         {"uid", s.uid},
                         {"description", s.description},
                         {"modality", s.modality},
                         {"size", {s.size[0], s.size[1], s.size[2]}}});
+        // A series that cannot be read is still listed, with why: info describes, it does not refuse.
+        if (!s.problem.empty()) list.back()["cannot_import"] = s.problem;
+    }
     json j{{"file", path}, {"kind", "DICOM"}, {"series", list}};
-    if (!pick.empty() || all.size() == 1) {
-        j["volume"] = volume_info(io::read_dicom(path, pick), path);
+    const io::DicomSeries* picked = all.size() == 1 && pick.empty() ? &all.front() : nullptr;
+    for (const io::DicomSeries& s : all)
+        if (!pick.empty() && (s.uid == pick || std::to_string(s.number) == pick)) picked = &s;
+    if (!pick.empty() && picked == nullptr) (void)io::read_dicom(path, pick); // names the series that is not there
+    if (picked != nullptr && picked->problem.empty()) {
+        j["volume"] = volume_info(io::read_dicom(path, std::to_string(picked->number)), path);
         j["volume"].erase("file");
     }
     return j;
@@ -212,11 +219,14 @@ void print_text(const json& j)
             for (const auto& [label, n] : value.items()) std::printf("  %s: %s\n", label.c_str(), n.dump().c_str());
         } else if (key == "series") {
             std::printf("series (number: modality columns x rows x slices, description, UID):\n");
-            for (const json& one : value)
+            for (const json& one : value) {
                 std::printf("  %s: %s %sx%sx%s \"%s\" %s\n", one["number"].dump().c_str(),
                             one["modality"].get<std::string>().c_str(), one["size"][0].dump().c_str(),
                             one["size"][1].dump().c_str(), one["size"][2].dump().c_str(),
                             one["description"].get<std::string>().c_str(), one["uid"].get<std::string>().c_str());
+                if (one.contains("cannot_import"))
+                    std::printf("     cannot import: %s\n", one["cannot_import"].get<std::string>().c_str());
+            }
         } else if (key == "segments") {
             std::printf("segments (name, ID, layer, label value, voxels, colour):\n");
             for (const json& one : value)

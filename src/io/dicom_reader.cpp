@@ -7,9 +7,11 @@
 //   slice along n = r x c, ordered by n . position: file names and InstanceNumber say nothing
 //   reliable about where a slice is.
 // - The series must be a regular grid: one orientation, one size, one pixel spacing, slices at
-//   even steps along n (a missing slice shows as a double step) and stacked straight along n (a
-//   gantry-tilted CT is sheared). Anything else is refused with what was found, rather than
-//   resampled silently.
+//   even steps along n and stacked straight along n (a gantry-tilted CT is sheared). The steps
+//   are those of the even grid fitted to the positions (least squares), which every slice must
+//   lie within 10 % of a step from: scanners round the positions they write, while a missing
+//   slice leaves one at least half a step off. Anything else is refused with what was found,
+//   rather than resampled silently.
 // - Values: stored values with one rescale slope and intercept for the series (CT: Hounsfield
 //   units), or, when slices carry different ones, rescaled per slice into float.
 // - Pixel data: whatever GDCM decodes (native, RLE, JPEG lossless and lossy, JPEG-LS through
@@ -277,10 +279,56 @@ ScalarType scalar_type(const gdcm::PixelFormat& pf, const std::string& file)
     }
 }
 
+/// How far a slice may lie from the even grid fitted to the series, as a fraction of the slice
+/// spacing: header rounding (0.1 mm on 0.5 - 7 mm slices) passes; a missing slice, which leaves
+/// some slice at least half a spacing off any even grid, does not.
+constexpr double k_slice_tolerance = 0.1;
+
+/// The least-squares even grid through slices sorted along their normal: position k = first +
+/// k step (step a vector: its part across the normal is a gantry tilt).
+struct SliceGrid {
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    double first_along = 0.0;  ///< the grid's first slice along the normal
+    double worst_offset = 0.0; ///< the furthest slice's distance from the grid along the normal, mm
+    std::string worst_file;
+};
+
+SliceGrid fit_slice_grid(const std::vector<Slice>& v)
+{
+    const auto count = static_cast<double>(v.size());
+    const double mean_k = 0.5 * (count - 1.0);
+    Eigen::Vector3d mean_p = Eigen::Vector3d::Zero();
+    double mean_a = 0.0;
+    for (const Slice& slice : v) {
+        mean_p += slice.position / count;
+        mean_a += slice.along / count;
+    }
+    double kk = 0.0, ka = 0.0;
+    Eigen::Vector3d kp = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < v.size(); ++k) {
+        const double dk = static_cast<double>(k) - mean_k;
+        kk += dk * dk;
+        ka += dk * (v[k].along - mean_a);
+        kp += dk * (v[k].position - mean_p);
+    }
+    SliceGrid grid;
+    grid.step = kp / kk;
+    const double step_along = ka / kk;
+    grid.first_along = mean_a - step_along * mean_k;
+    for (std::size_t k = 0; k < v.size(); ++k)
+        if (const double off = std::abs(v[k].along - grid.first_along - step_along * static_cast<double>(k)); off > grid.worst_offset) {
+            grid.worst_offset = off;
+            grid.worst_file = v[k].file;
+        }
+    return grid;
+}
+
 /// The slices of `s` ordered along their normal, with the volume's geometry checked and built.
 struct Stack {
     std::vector<Slice> slices;
     Eigen::Matrix4d index_to_world;
+    double moved_mm = 0.0;  ///< how far the furthest slice was moved onto the even grid
+    std::string moved_file; ///< that slice's file
 };
 
 Stack stack(const Scan& scan, const DicomSeries& s, const std::string& path)
@@ -328,6 +376,7 @@ Stack stack(const Scan& scan, const DicomSeries& s, const std::string& path)
     const std::vector<Slice>& v = out.slices;
     const std::size_t count = v.size();
     double step = 0.0;
+    Eigen::Vector3d origin = v.front().position;
     if (count == 1) {
         const std::vector<double> thickness = numbers(scan.value(first, k_slice_thickness), 1);
         step = !thickness.empty() && thickness[0] > 0.0 ? thickness[0] : std::min(spacing[0], spacing[1]);
@@ -338,40 +387,51 @@ Stack stack(const Scan& scan, const DicomSeries& s, const std::string& path)
                 throw file_error(path, "series " + std::to_string(s.number) + " has two slices at " +
                                            text3(v[k].position) + " mm (" + v[k].file + " and " + v[k + 1].file +
                                            "): several phases, echoes or acquisitions in one series are not read");
-        step = (v.back().along - v.front().along) / static_cast<double>(count - 1);
-        // The gap furthest from the median names the defect (a missing slice shows as a double gap).
-        std::vector<double> gaps;
-        for (std::size_t k = 0; k + 1 < count; ++k) gaps.push_back(v[k + 1].along - v[k].along);
-        std::vector<double> sorted = gaps;
-        std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-        const double median = sorted[sorted.size() / 2];
-        const double tolerance = std::max(1e-3, 0.01 * median);
-        const auto worst = std::max_element(gaps.begin(), gaps.end(), [&](double a, double b) {
-            return std::abs(a - median) < std::abs(b - median);
-        });
-        if (std::abs(*worst - median) > tolerance) {
-            const std::size_t k = static_cast<std::size_t>(worst - gaps.begin());
+        // The even grid that fits the positions best (least squares over the slice index), as
+        // ITK and 3D Slicer place a series: scanners round the positions they write (to 0.1 mm,
+        // even 1 mm), so the gaps between neighbours vary by far more than the grid does.
+        const SliceGrid grid = fit_slice_grid(v);
+        step = grid.step.dot(n);
+        const double tolerance = k_slice_tolerance * step;
+        if (grid.worst_offset > tolerance) {
+            // The gap furthest from the median names the defect (a missing slice shows as a
+            // double gap).
+            std::vector<double> gaps;
+            for (std::size_t k = 0; k + 1 < count; ++k) gaps.push_back(v[k + 1].along - v[k].along);
+            std::vector<double> sorted = gaps;
+            std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+            const double median = sorted[sorted.size() / 2];
+            const auto worst = std::max_element(gaps.begin(), gaps.end(), [&](double a, double b) {
+                return std::abs(a - median) < std::abs(b - median);
+            });
+            const auto k = static_cast<std::size_t>(worst - gaps.begin());
             std::ostringstream msg;
-            msg << "series " << s.number << " has uneven slice spacing: " << *worst << " mm between " << v[k].file
-                << " and " << v[k + 1].file << " where the slices are " << median
-                << " mm apart elsewhere (a missing slice?); resample it to even spacing first";
+            msg << "series " << s.number << " has uneven slice spacing: " << *worst << " mm between " << v[k].file << " and "
+                << v[k + 1].file << " where the slices are " << median << " mm apart elsewhere (a missing slice?: "
+                << grid.worst_file << " lies " << grid.worst_offset << " mm off the even grid, more than "
+                << 100.0 * k_slice_tolerance << " % of the spacing); resample it to even spacing first";
             throw file_error(path, msg.str());
         }
-        // Gantry tilt: the slices are stacked along a direction other than their normal.
-        const Eigen::Vector3d offset = v.back().position - v.front().position;
-        const double sideways = (offset - offset.dot(n) * n).norm();
-        const double degrees = std::atan2(sideways, offset.dot(n)) * 180.0 / M_PI;
-        if (sideways > tolerance && degrees > 0.01) {
+        // Gantry tilt: the slices are stacked along a direction other than their normal. Read
+        // untilted, the last slice would sit this far sideways of where it was scanned.
+        const Eigen::Vector3d along = grid.step * static_cast<double>(count - 1);
+        const double sideways = (along - along.dot(n) * n).norm();
+        const double degrees = std::atan2(sideways, along.dot(n)) * 180.0 / M_PI;
+        if (sideways > std::max(tolerance, 0.5 * in_plane) && degrees > 0.01) {
             std::ostringstream msg;
             msg.precision(3);
             msg << "series " << s.number << " is tilted: its slices are stacked " << degrees
                 << " degrees off their normal (gantry tilt), which is not read; resample it to an untilted volume first";
             throw file_error(path, msg.str());
         }
+        // The first slice moved along the normal onto the grid; the others follow from the step.
+        origin += (grid.first_along - v.front().along) * n;
+        out.moved_mm = grid.worst_offset;
+        out.moved_file = grid.worst_file;
     }
     Eigen::Matrix3d direction;
     direction << r.normalized(), c.normalized(), n;
-    out.index_to_world = make_index_to_world(Eigen::Vector3d(spacing[1], spacing[0], step), direction, v.front().position);
+    out.index_to_world = make_index_to_world(Eigen::Vector3d(spacing[1], spacing[0], step), direction, origin);
     return out;
 }
 
@@ -394,7 +454,16 @@ namespace {
 std::vector<DicomSeries> list_series(const std::string& path, const std::set<std::string>& skip, Note* note)
 {
     const Scan scan(path, skip, note);
-    return series_of(scan, path);
+    std::vector<DicomSeries> all = series_of(scan, path);
+    for (DicomSeries& s : all) {
+        try {
+            (void)stack(scan, s, path);
+        } catch (const InputError& e) {
+            s.problem = e.what();
+            if (s.problem.starts_with(path + ": ")) s.problem.erase(0, path.size() + 2); // the listing names the path
+        }
+    }
+    return all;
 }
 
 Volume read_series(const std::string& path, const std::string& series, const std::set<std::string>& skip, Note* note)
@@ -404,8 +473,13 @@ Volume read_series(const std::string& path, const std::string& series, const std
     const DicomSeries& s = pick(all, series, path);
     const Stack geometry = stack(scan, s, path);
     const std::int64_t slice_voxels = s.size[0] * s.size[1];
-    if (note == nullptr)
+    if (note == nullptr) {
         log::info("{}: reading series {} ({} {} slices of {}x{})", path, s.number, s.size[2], s.modality, s.size[0], s.size[1]);
+        if (geometry.moved_mm > 1e-4)
+            log::info("{}: series {}: slices placed on an even grid of {:.4f} mm; the furthest, {}, moved {:.3f} mm "
+                      "(rounded header positions)",
+                      path, s.number, geometry.index_to_world.col(2).head<3>().norm(), geometry.moved_file, geometry.moved_mm);
+    }
 
     Volume v;
     v.source = path;

@@ -276,3 +276,33 @@ TEST(Cli, ADicomFolderIsListedReadInASceneAndNoPatientIdentifierIsWritten)
     EXPECT_EQ(wrong.exit_code, 2);
     EXPECT_NE(wrong.err.find("has no series 2"), std::string::npos) << wrong.err;
 }
+
+TEST(Cli, InfoListsASeriesThatCannotBeImportedWithWhyAndExitsZero)
+{
+    // A folder with a good series and one missing a slice: info describes both (the second with
+    // the reason on its line) and succeeds; import refuses the second with the same reason.
+    const fs::path d = fresh_dir("cli_dicom_missing");
+    const std::string dir = (d / "export").string();
+    ASSERT_EQ(vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py",
+                                    {VOX_SOURCE_DIR "/data/liver.inr.gz", dir + "/a", "--slices", "10", "--series-number", "1"}),
+              0);
+    ASSERT_EQ(vox::test::run_python(VOX_SOURCE_DIR "/tests/io/write_dicom_series.py",
+                                    {VOX_SOURCE_DIR "/data/liver.inr.gz", dir + "/b", "--slices", "20", "--drop-slice", "8",
+                                     "--series-number", "2"}),
+              0);
+    const auto info = run_voxsculpt("info " + quote(dir));
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("  1: CT 438x353x10"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("  2: CT 438x353x19"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("     cannot import: series 2 has uneven slice spacing: 2.66666 mm between"), std::string::npos) << info.out;
+    const auto picked_run = run_voxsculpt("info --json --series 2 " + quote(dir));
+    ASSERT_EQ(picked_run.exit_code, 0) << picked_run.err;
+    const auto picked = nlohmann::json::parse(picked_run.out);
+    EXPECT_FALSE(picked.contains("volume"));
+    EXPECT_FALSE(picked["series"][0].contains("cannot_import"));
+    EXPECT_EQ(picked["series"][1]["cannot_import"].get<std::string>().rfind("series 2 has uneven slice spacing", 0), 0u);
+    const auto import = run_voxsculpt("import " + quote(dir) + " --series 2 -o " + quote((d / "b.vdb").string()));
+    EXPECT_EQ(import.exit_code, 2);
+    EXPECT_NE(import.err.find("series 2 has uneven slice spacing"), std::string::npos) << import.err;
+    EXPECT_FALSE(fs::exists(d / "b.vdb"));
+}

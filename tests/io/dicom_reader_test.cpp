@@ -187,6 +187,31 @@ TEST(DicomReader, AFolderOfSeveralSeriesIsListedAndOneIsPickedByNumberOrUid)
     expect_refused([&] { (void)import_object(k_liver, pick); }, k_liver, "--series picks a series of a DICOM folder");
 }
 
+TEST(DicomReader, PositionsRoundedByTheScannerAreReadOnTheirEvenGrid)
+{
+    // Oblique slices 1.3333 mm apart whose positions are written rounded to 0.1 mm, as scanners
+    // write them: neighbours' gaps vary from about 1.2 to 1.5 mm (more than 10 %), yet every slice
+    // lies within 0.09 mm of an even grid. The volume is the INR's, voxel for voxel, on that grid.
+    const ScratchDir scratch;
+    const std::string dir = scratch.path("rounded");
+    write_series(dir, "--rotate-deg 30 --shuffle --slices 24 --round-mm 0.1");
+    const Volume inr = read_volume(k_liver);
+    const Volume dicom = read_dicom(dir);
+    ASSERT_EQ(dicom.dims, (std::array<std::int64_t, 3>{inr.dims[0], inr.dims[1], 24}));
+    expect_same_values(inr, dicom, 24);
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(30.0 * M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+    const Eigen::Vector3d slice_step = dicom.index_to_world.block<3, 1>(0, 2);
+    EXPECT_NEAR(slice_step.norm(), inr.index_to_world(2, 2), 0.02); // the positions' mean gap is 4/3 mm
+    EXPECT_LT((slice_step.normalized() - r.col(2)).norm(), 1e-4) << slice_step.transpose();
+    // The grid's first voxel within the rounding of where the writer put it.
+    EXPECT_LT((dicom.index_to_world.block<3, 1>(0, 3) - inr.index_to_world.block<3, 1>(0, 3)).norm(), 0.09);
+
+    // Gaps of 1.33 mm with one position 0.2 mm off (15 %): a defect, not rounding.
+    const std::string off = scratch.path("off");
+    write_series(off, "--slices 12 --round-mm 0.4");
+    expect_refused([&] { (void)read_dicom(off); }, off, "off the even grid, more than 10 % of the spacing");
+}
+
 TEST(DicomReader, IrregularSeriesAreRefusedWithWhatWasFound)
 {
     const ScratchDir scratch;

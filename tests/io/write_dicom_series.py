@@ -6,11 +6,12 @@ One file per slice, CT modality, 16-bit signed stored values: the INR's values t
 map), or with --rescale stored as 2 v + 1000 with slope 0.5 and intercept -500, so that only the
 rescale gives the INR's value back (as Hounsfield units come from a CT's stored values). Options make the series awkward the way real exports are:
 file names shuffled, instance numbers reversed, an oblique orientation, and the defects the reader
-must refuse (a missing slice, two slices at one position, gantry tilt).
+must refuse (a missing slice, two slices at one position, gantry tilt), and the rounding a scanner
+applies to the positions it writes (--round-mm, which the reader must accept).
 
 Usage: write_dicom_series.py IN.inr[.gz] OUT_DIR [--shuffle] [--rotate-deg A] [--tilt-deg T]
          [--drop-slice K] [--duplicate-slice K] [--slices N] [--rle] [--rescale] [--series-number S]
-         [--description TEXT]
+         [--description TEXT] [--round-mm R]
 """
 import argparse
 import gzip
@@ -69,6 +70,8 @@ def main():
     p.add_argument("--rescale", action="store_true", help="stored 2 v + 1000, slope 0.5, intercept -500")
     p.add_argument("--series-number", type=int, default=3)
     p.add_argument("--description", default="liver labels")
+    p.add_argument("--round-mm", type=float, default=0.0,
+                   help="write ImagePositionPatient rounded to multiples of R mm, as scanners do")
     a = p.parse_args()
 
     voxels, spacing, origin = read_inr(a.inr)
@@ -102,6 +105,8 @@ def main():
         ds.SeriesDescription = a.description
         ds.InstanceNumber = len(slices) - n if a.shuffle else n + 1
         position = np.array(origin) + k * spacing[2] * (normal + shear * col_dir)
+        if a.round_mm > 0:
+            position = np.round(position / a.round_mm) * a.round_mm
         ds.ImagePositionPatient = ds_text(position)
         ds.ImageOrientationPatient = ds_text(list(row_dir) + list(col_dir))
         ds.PixelSpacing = ds_text([spacing[1], spacing[0]])  # between rows, then between columns
