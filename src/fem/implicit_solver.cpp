@@ -48,6 +48,7 @@ ImplicitSolver::ImplicitSolver(const HexModel& model, const SolverOptions& optio
     m_behaviour.resize(model.materials().size());
     m_element_rotation.assign(model.elements().size(), Eigen::Matrix3d::Identity());
     m_volume_hessian.assign(model.elements().size(), VolumeHessian{});
+    m_squeezed.assign(model.elements().size(), 0);
     m_internal = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * n));
     if (same_mesh && same_mesh->m_options.matrix_free == m_options.matrix_free && same_connectivity(same_mesh->m_model, model)) {
         // A cut that changed element matrices only (a drill taking a voxel a frame): the
@@ -302,7 +303,7 @@ void ImplicitSolver::update_active()
             }
         if (m_active[e]) continue;
         m_element_energy[e] = 0.0;
-        m_volume_hessian[e] = {};
+        m_squeezed[e] = 0;
     }
     m_active_current = true;
     m_element_pass_current = false; // the internal forces it left hold the elements now left out
@@ -371,13 +372,13 @@ double ImplicitSolver::add_volume_correction(std::size_t e, const Eigen::Matrix3
         plastic_trace = m_plastic[e].trace();
     }
     const VolumeCorrection c = volume_correction(f, rotation, lambda_v, plastic_volume, plastic_trace);
-    if (c.gradient.isZero(0.0)) { // not squeezed (most elements): nothing to add
-        m_volume_hessian[e] = {};
-        return c.energy;
-    }
+    m_squeezed[e] = 0;
+    if (c.gradient.isZero(0.0)) return c.energy; // not squeezed (most elements): nothing to add
     const Eigen::Matrix3d& frame = m_model.frame();
     scatter_add(gradient_times(frame * c.gradient, el.gradient), forces, el.dof_node);
+    if (!c.hessian.active()) return c.energy;
     m_volume_hessian[e] = c.hessian.turned(frame);
+    m_squeezed[e] = 1;
     return c.energy;
 }
 
@@ -446,9 +447,9 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                 const Eigen::Matrix3d rk = r * corner_block(*el.stiffness, c, c);
                 Eigen::Vector3d d = ks * rk.cwiseProduct(r).rowwise().sum();
                 if (!lumped) d.array() += m_scale * el.mass(c, c);
-                if (const VolumeHessian& v = m_volume_hessian[e]; v.active()) {
+                if (m_squeezed[e]) {
                     const Eigen::Vector3d g = el.gradient.row(c).transpose();
-                    d += k_scale * v.block(g, g).diagonal();
+                    d += k_scale * m_volume_hessian[e].block(g, g).diagonal();
                 }
                 m_diagonal.segment<3>(3 * static_cast<Eigen::Index>(el.dof_node[c])) += d;
             }
@@ -477,11 +478,12 @@ double ImplicitSolver::assemble(double m_scale, double k_scale, Output output)
                     const Eigen::Matrix3d& r = m_element_rotation[e];
                     const Eigen::Matrix3d rk = (k_scale * m_stiffness_scale[e]) * r;
                     const std::uint16_t* ranks = &m_rank[64 * std::size_t{e} + 8 * c];
-                    const VolumeHessian& v = m_volume_hessian[e];
+                    const bool squeezed = m_squeezed[e] != 0;
+                    const VolumeHessian& v = m_volume_hessian[e]; // read only where squeezed
                     for (int d = 0; d < 8; ++d) {
                         Eigen::Matrix3d block = rk * corner_block(*el.stiffness, static_cast<int>(c), d) * r.transpose();
                         if (!lumped) block.diagonal().array() += m_scale * el.mass(c, d);
-                        if (v.active()) block += k_scale * v.block(el.gradient.row(c).transpose(), el.gradient.row(d).transpose());
+                        if (squeezed) block += k_scale * v.block(el.gradient.row(c).transpose(), el.gradient.row(d).transpose());
                         double* at = values + outer[3 * n] + 3 * ranks[d];
                         for (int i = 0; i < 3; ++i)
                             for (int j = 0; j < 3; ++j) at[i * row_length + j] += block(i, j);
@@ -661,8 +663,8 @@ void ImplicitSolver::multiply_element_wise(const Eigen::VectorXd& p, Eigen::Vect
         const Eigen::Matrix3d& r = m_element_rotation[e];
         const CornerVectors local = turn(r, gather(p.data(), el.dof_node), true);
         scatter_add(turn(r, m_stiffness_scale[e] * stiffness_times(*el.stiffness, local), false), m_stiffness_product.data(), el.dof_node);
-        if (const VolumeHessian& v = m_volume_hessian[e]; v.active())
-            scatter_add(gradient_times(v.times(outer_sum(gather(p.data(), el.dof_node), el.gradient)), el.gradient), m_stiffness_product.data(),
+        if (m_squeezed[e]) // a byte a element: the 176-byte Hessian is read only where it is not zero
+            scatter_add(gradient_times(m_volume_hessian[e].times(outer_sum(gather(p.data(), el.dof_node), el.gradient)), el.gradient), m_stiffness_product.data(),
                         el.dof_node);
     }));
     out.resize(p.size());

@@ -315,7 +315,8 @@ private:
     std::vector<Eigen::Quaterniond> m_rotation;       ///< per element, index-aligned frame (warm start)
     std::vector<Eigen::Quaterniond> m_node_rotation;  ///< per node, mean of its elements'
     std::vector<double> m_element_energy;
-    std::vector<VolumeHessian> m_volume_hessian; ///< per element: of its volume correction, world frame
+    std::vector<VolumeHessian> m_volume_hessian; ///< per element: of its volume correction, world frame (where m_squeezed)
+    std::vector<unsigned char> m_squeezed;       ///< per element: 1 where its volume correction has a Hessian
     Eigen::VectorXd m_internal;         ///< internal forces, N, per dof
     std::unique_ptr<Preconditioner> m_preconditioner;
     std::unique_ptr<NodeIntegrator> m_integrator;
