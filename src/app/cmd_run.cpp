@@ -175,7 +175,6 @@ void add_run_command(CLI::App& app)
         log::info("{}: {}, {} frames of {} s ({}; {})", args->scene, method.description(), frames, dt,
                   scene.solver.mode == io::SolverMode::static_equilibrium ? "quasi-static" : "implicit Euler", method.linear_solver());
 
-        const std::string linear_solver = method.linear_solver();
         sim::RunRecord record(args->scene, method, dt);
         if (opened.choice) record.document()["level_choice"] = level_choice_json(*opened.choice);
         if (!args->resume.empty())
@@ -222,7 +221,6 @@ void add_run_command(CLI::App& app)
         progress.finish();
         if (journal) journal->end_stroke(method, loop.frames(), loop.frames() * dt); // the stroke under way at the end
         record.finish(method);
-        if (method.linear_solver() != linear_solver) log::warn("{}", method.linear_solver()); // a fallback took over
         for (const auto& [tool, touched] : record.tools_given_no_patch())
             log::warn("tool \"{}\": \"haptic_subdivision\" asked for a contact patch, but none was built in the {} frame(s) it touched: the "
                       "method measured no give at its contact (only the branched grid measures it, and not where the elements touched hold "

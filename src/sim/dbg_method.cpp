@@ -388,6 +388,8 @@ StepFigures DbgMethod::step()
     out.inverted_elements = fem::inverted_elements(m_sim->model(), m_sim->solver().positions());
     out.max_displacement_mm = s.max_displacement_m * 1e3;
     out.energy_projected = s.energy_projected;
+    out.recovered = s.converged && (s.newton_iterations > 0 || s.substeps > 0);
+    out.preconditioner_fallback = newly_failed(m_sim->solver().fallback_note(), m_fallback_reported);
     out.asleep_pieces = m_sim->asleep_piece_count();
     return out;
 }

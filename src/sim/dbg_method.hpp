@@ -162,6 +162,7 @@ private:
     std::vector<StrokeCarry> m_stroke;
     static constexpr double k_stroke_turn_cos = 0.98480775301220802; // cos 10 degrees
     static constexpr double k_stroke_gap_s = 0.2;
+    std::string m_fallback_reported; ///< the solver's preconditioner failure already reported (sim::newly_failed)
 };
 
 } // namespace vox::sim

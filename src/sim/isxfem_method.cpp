@@ -215,6 +215,7 @@ StepFigures IsxfemMethod::step()
     out.newton_iterations = 1;
     out.residual = s.residual;
     out.converged = s.converged;
+    out.preconditioner_fallback = newly_failed(m_sim->solver().fallback_note(), m_fallback_reported);
     out.kinetic_energy_j = s.kinetic_energy_j;
     const auto& rest = m_sim->model().mesh().nodes;
     const auto& x = m_sim->solver().state();

@@ -98,6 +98,7 @@ private:
     // The run so far.
     std::size_t m_cut_tets = 0, m_recut = 0, m_crossed = 0, m_beside = 0, m_frames_left_whole = 0;
     std::size_t m_frame = 0;
+    std::string m_fallback_reported; ///< the solver's preconditioner failure already reported (sim::newly_failed)
 };
 
 } // namespace vox::sim

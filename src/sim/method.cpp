@@ -1,6 +1,7 @@
 #include "sim/method.hpp"
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 
 #include <cmath>
 
@@ -24,6 +25,14 @@ void check_motion(const std::vector<double>& numbers, std::size_t expected)
         throw InputError("the state holds " + std::to_string(numbers.size()) + " numbers, this object's has " + std::to_string(expected));
     for (const double x : numbers)
         if (!std::isfinite(x)) throw InputError("the state holds a number that is not finite");
+}
+
+std::string newly_failed(const std::string& note, std::string& reported)
+{
+    if (note == reported) return {};
+    reported = note; // "" again once a rebuilt solver has a working preconditioner
+    if (!note.empty()) log::warn("{}", note);
+    return note;
 }
 
 double enclosed_volume_mm3(const surface::SurfaceMesh& mesh)

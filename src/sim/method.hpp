@@ -51,6 +51,10 @@ struct StepFigures {
     std::size_t inverted_elements = 0;
     std::size_t asleep_pieces = 0;          ///< pieces at rest, not stepped (branched grid)
     bool energy_projected = false;          ///< the step created energy even split into 32 substeps, and lost it again
+    /// The first solve created energy and was refused; the fuller one (Newton, substeps) converged.
+    bool recovered = false;
+    /// Why the preconditioner failed in this step and what took over ("" when it did not).
+    std::string preconditioner_fallback;
 };
 
 /// What one tool's cut did in one frame (added over a frame's tools). Phases as the branched-grid
@@ -228,5 +232,10 @@ public:
 
 /// Throws InputError unless `numbers` holds `expected` finite numbers (Method::set_motion).
 void check_motion(const std::vector<double>& numbers, std::size_t expected);
+
+/// A method's solver's fallback note (`note`, "" while its preconditioner works) when it is new
+/// since the last call (`reported` keeps what was said): the step in which it failed says it once,
+/// and the log warns. "" otherwise.
+[[nodiscard]] std::string newly_failed(const std::string& note, std::string& reported);
 
 } // namespace vox::sim

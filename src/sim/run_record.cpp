@@ -64,7 +64,9 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_total_ms += s.step_ms;
     m_max_ms = std::max(m_max_ms, s.step_ms);
     m_converged += s.converged;
+    m_recovered += s.recovered;
     m_projected += s.energy_projected;
+    m_fallbacks += !s.preconditioner_fallback.empty();
     m_inverted_frames += s.inverted_elements > 0;
     m_removed += t.cut.removed_voxels;
     m_separated_faces += t.cut.separated_faces;
@@ -83,6 +85,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"newton_iterations", s.newton_iterations},
                          {"residual", s.residual},
                          {"converged", s.converged},
+                         {"recovered", s.recovered},
                          {"substeps", s.substeps},
                          {"energy_projected", s.energy_projected},
                          {"asleep_pieces", s.asleep_pieces},
@@ -127,6 +130,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
         frame["haptic_patch"].push_back({{"tool", p.tool}, {"points", p.points}, {"level", p.level}, {"compliance_mm_per_n", p.compliance_mm_per_n},
                                          {"displacement_mm", p.displacement_mm}, {"step_us_max", p.step_us_max}});
     }
+    if (!s.preconditioner_fallback.empty()) frame["preconditioner_fallback"] = s.preconditioner_fallback;
     method.add_frame_figures(frame);
     m_document["frames"].push_back(std::move(frame));
 }
@@ -151,6 +155,9 @@ void RunRecord::finish(const Method& method)
                            {"level_changes", m_document["level_changes"].size()},
                            {"final_level", method.level()},
                            {"converged_frames", m_converged},
+                           {"nonconverged_steps", m_frames - m_converged},
+                           {"recovered_steps", m_recovered},
+                           {"preconditioner_fallbacks", m_fallbacks},
                            {"energy_projected_frames", m_projected},
                            {"inverted_frames", m_inverted_frames},
                            {"removed_voxels", m_removed},

@@ -44,6 +44,8 @@ private:
     double m_total_ms = 0.0, m_max_ms = 0.0;
     std::size_t m_removed = 0, m_separated_faces = 0, m_separated_voxels = 0;
     std::size_t m_projected = 0;      ///< frames whose step lost the energy it created (StepFigures::energy_projected)
+    std::size_t m_recovered = 0;      ///< frames whose refused first solve a fuller one replaced (StepFigures::recovered)
+    std::size_t m_fallbacks = 0;      ///< frames in which a preconditioner failed
     std::size_t m_inverted_frames = 0; ///< frames ending with an inverted element (StepFigures::inverted_elements)
     std::vector<double> m_frame_ms;   ///< whole frames, wall clock
     std::vector<double> m_cutting_ms; ///< frames that cut: collision + propagation + grid update + remesh

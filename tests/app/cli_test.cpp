@@ -147,6 +147,27 @@ nlohmann::json run_scene(const fs::path& dir, const std::string& name, const std
 }
 } // namespace
 
+TEST(Cli, APreconditionerThatFailsIsNamedInItsFrameOnceAndCounted)
+{
+    // Quasi-static with nothing held: K is singular, the warped Cholesky factor fails and Jacobi
+    // takes over. The frame it failed in says why, the log warns once, the summary counts it.
+    const fs::path d = fresh_dir("cli_preconditioner_fallback");
+    std::ofstream(d / "s.json") << R"({"object": {"phantom": {"shape": "beam", "size_mm": [40, 10, 10]}, "levels": 1, "unheld_pieces": "fall"},
+        "solver": {"mode": "static", "preconditioner": "cholesky"}})";
+    const auto r = run_voxsculpt("run " + quote((d / "s.json").string()) + " --frames 3 --out " + quote((d / "out").string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string why = "warped Cholesky preconditioner failed (singular matrix: is the object held?); using Jacobi";
+    const auto first = r.err.find(why);
+    EXPECT_NE(first, std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find(why, first + 1), std::string::npos) << "warned once: " << r.err;
+    std::ifstream in(d / "out" / "stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(in);
+    EXPECT_EQ(stats["frames"][0]["preconditioner_fallback"], why);
+    EXPECT_FALSE(stats["frames"][1].contains("preconditioner_fallback"));
+    EXPECT_EQ(stats["summary"]["preconditioner_fallbacks"], 1);
+    EXPECT_EQ(stats["linear_solver"], why);
+}
+
 TEST(Cli, RunAtLevelZeroAndWithAutomaticLevels)
 {
     const fs::path d = fresh_dir("cli_run_levels");

@@ -93,12 +93,17 @@ TEST(FrameLoop, OnAnUncutBeamBothMethodsSagAlikeAndStepEveryFrame)
         ToolPolicy tools(scene);
         FrameLoop loop(scene, *method, tools);
         FrameStats last;
+        int recovered = 0;
         for (int f = 0; f < 20; ++f) {
             last = loop.next();
             EXPECT_TRUE(last.step.converged) << method->name() << ", frame " << last.frame;
+            recovered += last.step.recovered;
             EXPECT_GT(last.step.step_ms, 0.0);
         }
         EXPECT_EQ(loop.frames(), 20);
+        // The branched grid's linearised step creates energy once the beam swings (frames 7 to
+        // 17): the Newton step takes over and converges, and the frame says it recovered.
+        if (type == io::SolverType::dbg) EXPECT_GT(recovered, 5);
         sag.push_back(last.step.max_displacement_mm);
     }
     EXPECT_GT(sag[0], 1.0);

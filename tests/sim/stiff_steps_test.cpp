@@ -6,6 +6,7 @@
 #include "io/scene.hpp"
 #include "io/scene_object.hpp"
 #include "sim/frame_loop.hpp"
+#include "sim/run_record.hpp"
 #include "sim/method_factory.hpp"
 #include "sim/tool_policy.hpp"
 
@@ -76,6 +77,20 @@ TEST(StiffSteps, AHundredNewtonKickIsSolvedByTheNonlinearStep)
     EXPECT_GT(kick.step.newton_iterations, 0) << "the linearised step created energy: the nonlinear step took over";
     EXPECT_FALSE(kick.step.energy_projected);
     EXPECT_TRUE(std::isfinite(kick.step.max_displacement_mm));
+    // Said as it is: a flung beam's Newton step stops at its cap far from converged (its energy
+    // is physical, so it is kept); that is a step that did not converge, not one that recovered.
+    EXPECT_EQ(kick.step.recovered, kick.step.converged);
+    EXPECT_TRUE(kick.step.preconditioner_fallback.empty());
+    RunRecord record(scene.source, *method, scene.solver.dt_s);
+    record.add(kick, *method);
+    const FrameStats next = loop.next();
+    record.add(next, *method);
+    record.finish(*method);
+    const nlohmann::json& summary = record.document()["summary"];
+    EXPECT_EQ(summary["nonconverged_steps"], int(!kick.step.converged) + int(!next.step.converged));
+    EXPECT_EQ(summary["recovered_steps"], int(kick.step.recovered) + int(next.step.recovered));
+    EXPECT_EQ(summary["preconditioner_fallbacks"], 0);
+    EXPECT_EQ(record.document()["frames"][0]["recovered"], kick.step.recovered);
 }
 
 } // namespace
