@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <sstream>
+#include <unordered_set>
 
 namespace vox::io {
 namespace {
@@ -20,20 +22,42 @@ std::string format_number(double v)
     return os.str();
 }
 
-/// A short list of the values present, for "nothing selected" messages.
-std::string describe_values(const std::map<double, std::uint64_t>& counts)
-{
-    std::ostringstream os;
-    int shown = 0;
-    for (const auto& [value, n] : counts) {
-        if (shown++ == 12) {
-            os << ", ... (" << counts.size() << " distinct values)";
-            break;
-        }
-        os << (shown > 1 ? ", " : "") << value;
+/// The values a file holds, for "nothing selected" messages: the smallest ones with their voxel
+/// counts, how many distinct values there are (up to a cap) and how many voxels.
+class ValueCensus {
+public:
+    void add(double value, std::uint64_t voxels = 1)
+    {
+        m_voxels += voxels;
+        if (m_distinct.size() < k_distinct_cap) m_distinct.insert(value);
+        // The smallest k_shown values, counted exactly: one pushed out has k_shown smaller values
+        // that stay, so it never comes back with a partial count.
+        if (m_smallest.size() == k_shown && value > m_smallest.rbegin()->first) return;
+        m_smallest[value] += voxels;
+        if (m_smallest.size() > k_shown) m_smallest.erase(std::prev(m_smallest.end()));
     }
-    return os.str();
-}
+    [[nodiscard]] std::string describe(const std::string& what) const
+    {
+        std::ostringstream os;
+        const bool capped = m_distinct.size() >= k_distinct_cap;
+        os << what << " present (" << (capped ? "more than " : "") << m_distinct.size() << " distinct, in " << m_voxels
+           << " voxels; " << (m_distinct.size() > k_shown ? "the smallest" : "smallest first") << ", with their voxels): ";
+        bool first = true;
+        for (const auto& [value, n] : m_smallest) {
+            os << (first ? "" : ", ") << format_number(value) << " (" << n << ")";
+            first = false;
+        }
+        if (m_distinct.size() > k_shown) os << ", ...";
+        return os.str();
+    }
+
+private:
+    static constexpr std::size_t k_shown = 12;
+    static constexpr std::size_t k_distinct_cap = 1000000;
+    std::map<double, std::uint64_t> m_smallest;
+    std::unordered_set<double> m_distinct;
+    std::uint64_t m_voxels = 0;
+};
 
 /// The label a voxel gets under `s`, or 0 when it is not selected. `stored`/`scaled` are its values.
 struct Selector {
@@ -142,12 +166,10 @@ grid::LabelGrid select_voxels(const Volume& v, const Selection& s)
         progress.update(static_cast<std::uint64_t>(k + 1));
     }
     if (out.active_voxel_count() == 0) {
-        std::map<double, std::uint64_t> counts;
+        ValueCensus census;
         const bool scaled = s.threshold_min.has_value() || !s.bands.empty();
-        for (std::int64_t m = 0; m < v.voxel_count() && counts.size() <= 13; ++m)
-            ++counts[scaled ? v.scaled(m) : v.stored(m)];
-        throw file_error(v.source, "the selection (" + s.describe() + ") holds no voxel; " +
-                                       (scaled ? "values" : "stored values") + " present: " + describe_values(counts));
+        for (std::int64_t m = 0; m < v.voxel_count(); ++m) census.add(scaled ? v.scaled(m) : v.stored(m));
+        throw file_error(v.source, "the selection (" + s.describe() + ") holds no voxel; " + census.describe(scaled ? "values" : "stored values"));
     }
     return s.pieces.empty() ? std::move(out) : select_pieces(out, s.pieces, v.source);
 }
@@ -166,10 +188,9 @@ grid::LabelGrid select_labels(const grid::LabelGrid& labels, const Selection& s,
         if (l != 0) out.set(c, l);
     });
     if (out.active_voxel_count() == 0) {
-        std::map<double, std::uint64_t> counts;
-        for (const auto& [l, n] : labels.label_histogram()) counts[l] = n;
-        throw file_error(source, "the selection (" + s.describe() + ") holds no voxel; labels present: " +
-                                     describe_values(counts));
+        ValueCensus census;
+        for (const auto& [l, n] : labels.label_histogram()) census.add(l, n);
+        throw file_error(source, "the selection (" + s.describe() + ") holds no voxel; " + census.describe("labels"));
     }
     return s.pieces.empty() ? std::move(out) : select_pieces(out, s.pieces, source);
 }

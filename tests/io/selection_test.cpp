@@ -62,7 +62,27 @@ TEST(Selection, EmptySelectionNamesTheFileAndTheValuesPresent)
         (void)select_voxels(make_volume({0, 3, 5}), s);
         FAIL();
     } catch (const vox::InputError& e) {
-        EXPECT_STREQ(e.what(), "test.nii: the selection (label 42) holds no voxel; stored values present: 0, 3, 5");
+        EXPECT_STREQ(e.what(), "test.nii: the selection (label 42) holds no voxel; stored values present (3 distinct, in 3 voxels; "
+                               "smallest first, with their voxels): 0 (1), 3 (1), 5 (1)");
+    }
+}
+
+TEST(Selection, AnEmptySelectionOfAScanOfManyValuesCountsTheSmallestAndAllOfThem)
+{
+    // 40 voxels of 20 values, each twice, the larger ones first in the file: the 12 smallest are
+    // listed in order with their exact counts, and the 20 and 40 are totals, not a prefix.
+    std::vector<std::int16_t> values;
+    for (int k = 19; k >= 0; --k) values.push_back(static_cast<std::int16_t>(10 * k));
+    for (int k = 0; k < 20; ++k) values.push_back(static_cast<std::int16_t>(10 * k));
+    Selection s;
+    s.labels = {7};
+    try {
+        (void)select_voxels(make_volume(values), s);
+        FAIL();
+    } catch (const vox::InputError& e) {
+        EXPECT_STREQ(e.what(), "test.nii: the selection (label 7) holds no voxel; stored values present (20 distinct, in 40 voxels; "
+                               "the smallest, with their voxels): 0 (2), 10 (2), 20 (2), 30 (2), 40 (2), 50 (2), 60 (2), 70 (2), "
+                               "80 (2), 90 (2), 100 (2), 110 (2), ...");
     }
 }
 
