@@ -1,5 +1,6 @@
 // NIfTI-1/NIfTI-2 reader through libnifti2. The transform follows ITK (5.2 and later) and 3D Slicer:
-// the sform when its code is set, else the qform when its code is set, else the voxel sizes alone;
+// the sform when its code is set, else the qform when its code is set, else the voxel sizes alone
+// (a set sform that is not finite gives way to a set qform, with a warning, or is refused);
 // NIfTI's RAS world is converted to LPS by negating x and y. Unlike ITK we keep any shear of the
 // sform instead of dropping it, so voxel centres land exactly where the file says.
 //
@@ -8,6 +9,7 @@
 // mends others (a NaN or zero pixdim becomes 1 mm), while a bad file must give one line of ours.
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/memory_limit.hpp"
 #include "io/file_bytes.hpp"
 #include "io/text_parsing.hpp"
@@ -238,10 +240,23 @@ Eigen::Matrix4d to_eigen(const nifti_dmat44& m)
     return t;
 }
 
-Eigen::Matrix4d ras_index_to_world(const nifti_image& nim, const RawHeader& raw)
+Eigen::Matrix4d ras_index_to_world(const nifti_image& nim, const RawHeader& raw, const std::string& path)
 {
-    if (nim.sform_code > 0) return to_eigen(nim.sto_xyz);
-    if (nim.qform_code > 0) return to_eigen(nim.qto_xyz);
+    // A transform with a NaN or an infinity places nothing; the other one, when the file has it,
+    // is what a reader that ignored the broken one would use (said, since it may differ).
+    const Eigen::Matrix4d sform = to_eigen(nim.sto_xyz), qform = to_eigen(nim.qto_xyz);
+    const bool sform_ok = sform.allFinite(), qform_ok = qform.allFinite();
+    if (nim.sform_code > 0 && sform_ok) return sform;
+    if (nim.sform_code > 0 && !(nim.qform_code > 0 && qform_ok))
+        throw file_error(path, "its sform (the transform that places its voxels) is not finite (a NaN or an infinity), and it has no "
+                               "usable qform to fall back on");
+    if (nim.sform_code > 0) {
+        log::warn("{}: its sform is not finite (a NaN or an infinity); placed by its qform instead", path);
+        return qform;
+    }
+    if (nim.qform_code > 0 && !qform_ok)
+        throw file_error(path, "its qform (the transform that places its voxels) is not finite (a NaN or an infinity), and it has no sform");
+    if (nim.qform_code > 0) return qform;
     // The voxel sizes of the header (checked positive along the image's axes); an axis the image
     // does not have (a 2-D image's third) gets 1 mm when its pixdim is unset.
     Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
@@ -278,7 +293,7 @@ Volume read_nifti(const std::string& path)
     if (nim->byteorder != nifti_short_order()) swap_bytes(v);
 
     const Eigen::Matrix4d lps_from_ras = Eigen::Vector4d(-1.0, -1.0, 1.0, 1.0).asDiagonal();
-    v.index_to_world = lps_from_ras * ras_index_to_world(*nim, raw);
+    v.index_to_world = lps_from_ras * ras_index_to_world(*nim, raw, path);
     // NIfTI: a zero slope means "no scaling".
     if (nim->scl_slope != 0.0) {
         v.scale_slope = nim->scl_slope;

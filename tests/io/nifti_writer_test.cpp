@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 #include <nifti2_io.h>
 
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <limits>
 
 namespace fs = std::filesystem;
 using namespace vox::io;
@@ -83,4 +86,32 @@ TEST(NiftiWriter, RefusesOtherNamesAndLeavesNothing)
     const fs::path path = fs::path(::testing::TempDir()) / "written.mha";
     EXPECT_THROW(write_nifti(sample_volume(), path), vox::InputError);
     EXPECT_FALSE(fs::exists(path));
+}
+
+TEST(NiftiWriter, ASformThatIsNotFiniteFallsBackToTheQformOrIsRefused)
+{
+    // The written file with a NaN put into its sform: the qform (which matches) places it, with a
+    // warning; with the qform's code cleared too, nothing can place it and it is refused.
+    const Volume v = sample_volume();
+    const fs::path path = fs::path(::testing::TempDir()) / "nan_sform.nii";
+    write_nifti(v, path);
+    auto patch = [&](std::size_t offset, const void* bytes, std::size_t n) {
+        std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(static_cast<std::streamoff>(offset));
+        f.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(n));
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    patch(offsetof(nifti_1_header, srow_x), &nan, sizeof nan);
+    const Volume back = read_volume(path.string());
+    EXPECT_LT((back.index_to_world - v.index_to_world).cwiseAbs().maxCoeff(), 1e-4);
+    const std::int16_t unset = 0;
+    patch(offsetof(nifti_1_header, qform_code), &unset, sizeof unset);
+    try {
+        (void)read_volume(path.string());
+        FAIL() << "a file nothing can place was read";
+    } catch (const vox::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("nan_sform.nii: its sform (the transform that places its voxels) is not finite"),
+                  std::string::npos)
+            << e.what();
+    }
 }
