@@ -16,6 +16,8 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -54,18 +56,25 @@ json world_bbox(const Eigen::Matrix4d& t, const Eigen::Vector3d& lo, const Eigen
 
 json volume_info(const io::Volume& v, const std::string& path)
 {
+    // A label map (whole numbers, at most k_label_values of them) lists its labels; anything else
+    // (a CT's Hounsfield units, an MR's intensities) its values' spread: a list of thousands of
+    // "labels" describes nothing.
+    constexpr std::size_t k_label_values = 256;
     std::map<double, std::uint64_t> counts;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     std::uint64_t nonzero = 0;
     bool integral = true;
+    // Every voxel up to a million, else an even sample of a million: the percentiles' resolution.
+    const std::int64_t stride = std::max<std::int64_t>(1, v.voxel_count() / 1000000);
+    std::vector<double> sample;
     for (std::int64_t n = 0; n < v.voxel_count(); ++n) {
         const double s = v.stored(n);
         lo = std::min(lo, s);
         hi = std::max(hi, s);
         if (s != 0.0) ++nonzero;
-        // A histogram is useful for label maps; stop counting when the values are a continuum.
-        if (integral && counts.size() <= 1024) ++counts[s];
+        if (integral && counts.size() <= k_label_values) ++counts[s];
         if (s != static_cast<double>(static_cast<std::int64_t>(s))) integral = false;
+        if (n % stride == 0) sample.push_back(v.scaled(n));
     }
     json j{{"file", path},
            {"kind", "volume"},
@@ -78,11 +87,20 @@ json volume_info(const io::Volume& v, const std::string& path)
            {"active_voxels", nonzero},
            {"stored_range", {lo, hi}},
            {"scaling", {{"slope", v.scale_slope}, {"intercept", v.scale_intercept}}}};
-    if (integral && counts.size() <= 1024) {
+    if (integral && counts.size() <= k_label_values) {
         json hist = json::object();
         for (const auto& [value, n] : counts)
             if (value != 0.0) hist[std::to_string(static_cast<std::int64_t>(value))] = n;
         j["labels"] = hist;
+    } else if (!sample.empty()) {
+        std::sort(sample.begin(), sample.end());
+        json percentiles = json::object();
+        for (const int p : {1, 5, 25, 50, 75, 95, 99})
+            percentiles[std::to_string(p)] = sample[static_cast<std::size_t>(std::llround(0.01 * p * static_cast<double>(sample.size() - 1)))];
+        const double a = v.scale_slope * lo + v.scale_intercept, b = v.scale_slope * hi + v.scale_intercept;
+        j["values"] = {{"range", {std::min(a, b), std::max(a, b)}}, // scaled: Hounsfield units for a CT
+                       {"percentiles", percentiles},
+                       {"sampled_voxels", sample.size()}};
     }
     return j;
 }
@@ -217,6 +235,14 @@ void print_text(const json& j)
         if (key == "labels") {
             std::printf("labels (label: voxels):\n");
             for (const auto& [label, n] : value.items()) std::printf("  %s: %s\n", label.c_str(), n.dump().c_str());
+        } else if (key == "values") {
+            std::printf("values (scaled; not labels): range %s, percentiles 1 / 5 / 25 / 50 / 75 / 95 / 99: ", human(value["range"]).c_str());
+            const char* between = "";
+            for (const char* p : {"1", "5", "25", "50", "75", "95", "99"}) {
+                std::printf("%s%s", between, human(value["percentiles"][p]).c_str());
+                between = " / ";
+            }
+            std::printf(" (of %s voxels)\n", value["sampled_voxels"].dump().c_str());
         } else if (key == "series") {
             std::printf("series (number: modality columns x rows x slices, description, UID):\n");
             for (const json& one : value) {
@@ -244,7 +270,7 @@ void print_text(const json& j)
         }
     }
     if (j.contains("kind") && j["kind"] == "volume" && !j.contains("labels"))
-        std::printf("labels: not listed (more than 1024 distinct values, or values that are not integers)\n");
+        std::printf("labels: not listed (more than 256 distinct values, or values that are not integers: the values above)\n");
 }
 
 } // namespace

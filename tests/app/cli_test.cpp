@@ -6,10 +6,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <filesystem>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <vector>
 
 namespace fs = std::filesystem;
 using vox::test::fresh_dir;
@@ -296,6 +300,30 @@ TEST(Cli, ADicomFolderIsListedReadInASceneAndNoPatientIdentifierIsWritten)
     const auto wrong = run_voxsculpt("check " + quote((d / "wrong.json").string()));
     EXPECT_EQ(wrong.exit_code, 2);
     EXPECT_NE(wrong.err.find("has no series 2"), std::string::npos) << wrong.err;
+}
+
+TEST(Cli, InfoOnAScanOfValuesShowsTheirSpreadNotLabels)
+{
+    // 40^3 int16 voxels cycling through -1000..1000 (2001 values, as a CT's are): info lists no
+    // labels but the range and percentiles, which a sort of the same values gives.
+    const fs::path d = fresh_dir("cli_info_values");
+    std::vector<std::int16_t> values(40 * 40 * 40);
+    for (std::size_t n = 0; n < values.size(); ++n) values[n] = static_cast<std::int16_t>(static_cast<int>(n % 2001) - 1000);
+    std::ofstream(d / "ct.mhd") << "ObjectType = Image\nNDims = 3\nDimSize = 40 40 40\nElementSpacing = 1 1 1\n"
+                                   "ElementType = MET_SHORT\nElementDataFile = ct.raw\n";
+    std::ofstream(d / "ct.raw", std::ios::binary)
+        .write(reinterpret_cast<const char*>(values.data()), static_cast<std::streamsize>(2 * values.size()));
+    const auto j = info_json(d / "ct.mhd");
+    EXPECT_FALSE(j.contains("labels"));
+    std::vector<double> sorted(values.begin(), values.end());
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(j["values"]["range"], nlohmann::json({-1000.0, 1000.0}));
+    for (const int p : {1, 5, 25, 50, 75, 95, 99})
+        EXPECT_EQ(j["values"]["percentiles"][std::to_string(p)], sorted[static_cast<std::size_t>(std::llround(0.01 * p * (sorted.size() - 1)))]) << p;
+    EXPECT_EQ(j["values"]["sampled_voxels"], 64000);
+    const auto text = run_voxsculpt("info " + quote((d / "ct.mhd").string()));
+    EXPECT_NE(text.out.find("values (scaled; not labels): range [-1000, 1000], percentiles 1 / 5 / 25 / 50 / 75 / 95 / 99: "), std::string::npos)
+        << text.out;
 }
 
 TEST(Cli, InfoListsASeriesThatCannotBeImportedWithWhyAndExitsZero)
