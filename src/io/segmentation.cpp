@@ -1,6 +1,7 @@
 #include "io/segmentation.hpp"
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "io/nrrd_image.hpp"
 #include "io/text_parsing.hpp"
 
@@ -66,6 +67,8 @@ std::vector<Segment> read_segments(const std::string& path)
         }
         if (const std::string* value = find(pairs, prefix + "LabelValue"))
             s.label_value = static_cast<std::int32_t>(whole(path, prefix + "LabelValue", *value, 1, 2147483647));
+        else // Slicer before 4.11 wrote none (a layer per segment, its voxels 1); a newer file should
+            log::warn("{}: segment '{}' has no {}LabelValue: its voxels are read as those of value 1 in its layer", path, s.name, prefix);
         s.layer = n; // Slicer before 4.11 kept each segment in a layer of its own
         if (const std::string* layer = find(pairs, prefix + "Layer"))
             s.layer = static_cast<int>(whole(path, prefix + "Layer", *layer, 0, 100000));

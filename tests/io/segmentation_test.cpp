@@ -97,6 +97,35 @@ TEST(Segmentation, SegmentsAreReadWithNamesColoursLayersAndLabelValues)
     EXPECT_EQ(all[0].tags, "Segmentation.Status:inprogress|");
 }
 
+TEST(Segmentation, ASegmentWithoutALabelValueIsReadAsValueOneAndNamedInAWarning)
+{
+    // The tumor (alone in its layer, value 1) with its LabelValue key taken out, as Slicer before
+    // 4.11 wrote it: the same voxels, and a warning that names it.
+    const ScratchDir dir;
+    const std::string seg = write_segmentation(dir);
+    std::string bytes;
+    {
+        std::ifstream in(seg, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const std::string key = "Segment2_LabelValue:=1\n";
+    const auto at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    bytes.erase(at, key.size());
+    const std::string old = dir.path("old.seg.nrrd");
+    std::ofstream(old, std::ios::binary) << bytes;
+    ::testing::internal::CaptureStderr();
+    const std::vector<Segment> all = read_segments(old);
+    const std::string warned = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(warned.find("old.seg.nrrd: segment 'tumor' has no Segment2_LabelValue: its voxels are read as those of value 1 in its layer"),
+              std::string::npos)
+        << warned;
+    EXPECT_EQ(warned.find("'liver'"), std::string::npos) << warned;
+    ASSERT_EQ(all.size(), 3u);
+    EXPECT_EQ(all[2].label_value, 1);
+    EXPECT_EQ(read_segmentation(old, {"tumor"}).active_voxel_count(), counts_of(seg)["tumor"].get<std::uint64_t>());
+}
+
 TEST(Segmentation, SegmentsPickedByNameTakeLabelsInOrderAndTheLaterWinsWhereTheyOverlap)
 {
     const ScratchDir dir;
