@@ -11,6 +11,7 @@
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -169,6 +170,10 @@ void write_label_map(const grid::LabelGrid& labels, const std::filesystem::path&
     Eigen::Matrix4d shift = Eigen::Matrix4d::Identity();
     shift.block<3, 1>(0, 3) = box.min.cast<double>();
     v.index_to_world = labels.index_to_world() * shift;
+    if (std::optional<NiftiTransforms> nifti = NiftiTransforms::parse(labels.metadata("nifti_transforms"))) {
+        nifti->qform_ras = nifti->qform_ras * shift; // the scan's own codes and qform, on this box
+        v.nifti = nifti;
+    }
     const std::size_t size = scalar_size(v.type);
     v.data.assign(static_cast<std::size_t>(v.voxel_count()) * size, std::byte{0});
     labels.for_each_active([&](const grid::Coord& c, std::int32_t label) {

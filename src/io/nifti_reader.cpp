@@ -294,6 +294,14 @@ Volume read_nifti(const std::string& path)
 
     const Eigen::Matrix4d lps_from_ras = Eigen::Vector4d(-1.0, -1.0, 1.0, 1.0).asDiagonal();
     v.index_to_world = lps_from_ras * ras_index_to_world(*nim, raw, path);
+    // Its own codes and qform, for a label map written back on its grid (a qform that is not
+    // finite is not kept).
+    NiftiTransforms kept;
+    kept.sform_code = nim->sform_code;
+    kept.qform_ras = to_eigen(nim->qto_xyz);
+    kept.qform_code = kept.qform_ras.allFinite() ? nim->qform_code : 0;
+    if (kept.qform_code == 0) kept.qform_ras.setIdentity();
+    v.nifti = kept;
     // NIfTI: a zero slope means "no scaling".
     if (nim->scl_slope != 0.0) {
         v.scale_slope = nim->scl_slope;

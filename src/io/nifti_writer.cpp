@@ -55,22 +55,36 @@ nifti_1_header make_header(const Volume& v, const std::string& name)
     const Eigen::Vector3d spacing = v.spacing();
     h.pixdim[0] = 1.0f;
     for (int a = 0; a < 3; ++a) h.pixdim[a + 1] = static_cast<float>(spacing[a]);
-    h.sform_code = NIFTI_XFORM_SCANNER_ANAT;
-    for (int c = 0; c < 4; ++c) {
-        h.srow_x[c] = static_cast<float>(ras(0, c));
-        h.srow_y[c] = static_cast<float>(ras(1, c));
-        h.srow_z[c] = static_cast<float>(ras(2, c));
+    // A volume read from NIfTI keeps its own codes and qform (a label map written back on a scan's
+    // grid says what the scan said); any other gets the sform, and a qform where it can hold the
+    // axes.
+    const int sform_code = v.nifti ? v.nifti->sform_code : NIFTI_XFORM_SCANNER_ANAT;
+    if (sform_code > 0) {
+        h.sform_code = static_cast<short>(sform_code);
+        for (int c = 0; c < 4; ++c) {
+            h.srow_x[c] = static_cast<float>(ras(0, c));
+            h.srow_y[c] = static_cast<float>(ras(1, c));
+            h.srow_z[c] = static_cast<float>(ras(2, c));
+        }
     }
-    // The qform holds rotations only: write it when the axes are orthogonal, as readers that
-    // ignore the sform then still place the voxels right.
-    const Eigen::Matrix3d axes = ras.topLeftCorner<3, 3>() * spacing.cwiseInverse().asDiagonal();
-    if ((axes.transpose() * axes - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6) {
+    Eigen::Matrix4d qform = ras;
+    int qform_code = 0;
+    if (v.nifti) {
+        qform = v.nifti->qform_ras;
+        qform_code = v.nifti->qform_code;
+    } else {
+        // The qform holds rotations only: written when the axes are orthogonal, as readers that
+        // ignore the sform then still place the voxels right.
+        const Eigen::Matrix3d axes = ras.topLeftCorner<3, 3>() * spacing.cwiseInverse().asDiagonal();
+        if ((axes.transpose() * axes - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6) qform_code = NIFTI_XFORM_SCANNER_ANAT;
+    }
+    if (qform_code > 0) {
         nifti_dmat44 m;
         for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) m.m[r][c] = ras(r, c);
+            for (int c = 0; c < 4; ++c) m.m[r][c] = qform(r, c);
         double qb, qc, qd, qx, qy, qz, dx, dy, dz, qfac;
         nifti_dmat44_to_quatern(m, &qb, &qc, &qd, &qx, &qy, &qz, &dx, &dy, &dz, &qfac);
-        h.qform_code = NIFTI_XFORM_SCANNER_ANAT;
+        h.qform_code = static_cast<short>(qform_code);
         h.quatern_b = static_cast<float>(qb);
         h.quatern_c = static_cast<float>(qc);
         h.quatern_d = static_cast<float>(qd);
@@ -78,6 +92,9 @@ nifti_1_header make_header(const Volume& v, const std::string& name)
         h.qoffset_y = static_cast<float>(qy);
         h.qoffset_z = static_cast<float>(qz);
         h.pixdim[0] = static_cast<float>(qfac);
+        h.pixdim[1] = static_cast<float>(dx); // the qform's voxel sizes (the spacing, unless a kept qform says otherwise)
+        h.pixdim[2] = static_cast<float>(dy);
+        h.pixdim[3] = static_cast<float>(dz);
     }
     return h;
 }

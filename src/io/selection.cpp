@@ -151,6 +151,7 @@ grid::LabelGrid select_voxels(const Volume& v, const Selection& s)
     out.set_metadata("source", v.source);
     // The scan's size: what is written back covers the scan's whole grid (io/label_map_writer.hpp).
     out.set_metadata("scan_dims", std::to_string(v.dims[0]) + " " + std::to_string(v.dims[1]) + " " + std::to_string(v.dims[2]));
+    if (v.nifti) out.set_metadata("nifti_transforms", v.nifti->text()); // for label maps written back (label_map_writer)
     const Selector select{s};
     const bool keep_values = s.empty();
     Progress progress("selecting voxels", static_cast<std::uint64_t>(v.dims[2]));

@@ -7,8 +7,31 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 namespace vox::io {
+
+std::string NiftiTransforms::text() const
+{
+    std::ostringstream out;
+    out.precision(17);
+    out << sform_code << ' ' << qform_code;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out << ' ' << qform_ras(r, c);
+    return out.str();
+}
+
+std::optional<NiftiTransforms> NiftiTransforms::parse(const std::string& text)
+{
+    std::istringstream in(text);
+    NiftiTransforms t;
+    if (!(in >> t.sform_code >> t.qform_code)) return std::nullopt;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c)
+            if (!(in >> t.qform_ras(r, c))) return std::nullopt;
+    if (!(in >> std::ws).eof() || !t.qform_ras.allFinite()) return std::nullopt;
+    return t;
+}
 
 std::size_t scalar_size(ScalarType t)
 {

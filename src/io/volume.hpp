@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,21 @@ enum class ScalarType { u8, i8, u16, i16, u32, i32, f32, f64 };
 /// A dense volume: voxel (i, j, k) is stored at i + dims[0] * (j + dims[1] * k), in native byte
 /// order, and has its centre at world point index_to_world * (i, j, k, 1), in millimetres in the
 /// LPS frame (x towards the patient's left, y posterior, z superior), as ITK and 3D Slicer use.
+/// A NIfTI file's own placement as read: its sform and qform codes and the qform's matrix (index
+/// to RAS mm), so that a label map written back on its grid says what the scan said. The sform's
+/// matrix is the volume's index_to_world (or the qform's, when the sform is not set).
+struct NiftiTransforms {
+    int sform_code = 0;
+    int qform_code = 0;
+    Eigen::Matrix4d qform_ras = Eigen::Matrix4d::Identity();
+
+    /// As a label grid keeps it in its metadata ("nifti_transforms"): the codes, then the qform's
+    /// 16 numbers row by row.
+    [[nodiscard]] std::string text() const;
+    /// From text(); nullopt for "" or text that is not that.
+    [[nodiscard]] static std::optional<NiftiTransforms> parse(const std::string& text);
+};
+
 struct Volume {
     std::array<std::int64_t, 3> dims{0, 0, 0};
     Eigen::Matrix4d index_to_world = Eigen::Matrix4d::Identity(); ///< affine, last row (0 0 0 1)
@@ -30,6 +46,7 @@ struct Volume {
     double scale_intercept = 0.0;
     std::vector<std::byte> data; ///< dims product * scalar_size(type) bytes
     std::string source;          ///< the file it came from, for messages
+    std::optional<NiftiTransforms> nifti; ///< a NIfTI file's codes and qform; empty for other formats
 
     [[nodiscard]] std::int64_t voxel_count() const { return dims[0] * dims[1] * dims[2]; }
     /// The stored value of voxel number `n` (linear index), converted to double.

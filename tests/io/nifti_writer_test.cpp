@@ -1,6 +1,9 @@
 #include "io/nifti_writer.hpp"
 
 #include "core/error.hpp"
+#include "grid/label_grid.hpp"
+#include "io/label_map_writer.hpp"
+#include "io/selection.hpp"
 #include "io/volume_reader.hpp"
 
 #include <Eigen/Geometry>
@@ -114,4 +117,42 @@ TEST(NiftiWriter, ASformThatIsNotFiniteFallsBackToTheQformOrIsRefused)
                   std::string::npos)
             << e.what();
     }
+}
+
+TEST(NiftiWriter, ALabelMapWrittenBackKeepsTheScansCodesAndQform)
+{
+    // A scan whose sform says MNI (code 4) and whose qform, aligned (code 2), sits 1.5 mm off it:
+    // selected, then written back as a label map, the file says the same: both codes, the sform
+    // and the qform as they were (ITK and Slicer pick one of them by its code).
+    Volume scan = sample_volume();
+    NiftiTransforms own;
+    own.sform_code = NIFTI_XFORM_MNI_152;
+    own.qform_code = NIFTI_XFORM_ALIGNED_ANAT;
+    own.qform_ras = Eigen::Vector4d(-1.0, -1.0, 1.0, 1.0).asDiagonal() * scan.index_to_world;
+    own.qform_ras(0, 3) += 1.5;
+    scan.nifti = own;
+    const fs::path in = fs::path(::testing::TempDir()) / "coded_scan.nii";
+    write_nifti(scan, in);
+    const Volume read = read_volume(in.string());
+    ASSERT_TRUE(read.nifti.has_value());
+    EXPECT_EQ(read.nifti->sform_code, NIFTI_XFORM_MNI_152);
+    EXPECT_EQ(read.nifti->qform_code, NIFTI_XFORM_ALIGNED_ANAT);
+    EXPECT_LT((read.nifti->qform_ras - own.qform_ras).cwiseAbs().maxCoeff(), 1e-4);
+
+    Selection every;
+    every.threshold_min = -1e9;
+    const vox::grid::LabelGrid labels = select_voxels(read, every);
+    const fs::path out = fs::path(::testing::TempDir()) / "coded_labels.nii";
+    write_label_map(labels, out);
+    nifti_image* back = nifti_image_read(out.c_str(), 0);
+    ASSERT_NE(back, nullptr);
+    EXPECT_EQ(back->sform_code, NIFTI_XFORM_MNI_152);
+    EXPECT_EQ(back->qform_code, NIFTI_XFORM_ALIGNED_ANAT);
+    const Eigen::Matrix4d sform_ras = Eigen::Vector4d(-1.0, -1.0, 1.0, 1.0).asDiagonal() * scan.index_to_world;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) {
+            EXPECT_NEAR(back->sto_xyz.m[r][c], sform_ras(r, c), 1e-4) << r << ", " << c;
+            EXPECT_NEAR(back->qto_xyz.m[r][c], own.qform_ras(r, c), 1e-4) << r << ", " << c;
+        }
+    nifti_image_free(back);
 }
