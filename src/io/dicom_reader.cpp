@@ -293,28 +293,23 @@ struct SliceGrid {
     std::string worst_file;
 };
 
-SliceGrid fit_slice_grid(const std::vector<Slice>& v)
+SliceGrid fit_slice_grid(const std::vector<Slice>& v, const Eigen::Vector3d& n)
 {
     const auto count = static_cast<double>(v.size());
     const double mean_k = 0.5 * (count - 1.0);
     Eigen::Vector3d mean_p = Eigen::Vector3d::Zero();
-    double mean_a = 0.0;
-    for (const Slice& slice : v) {
-        mean_p += slice.position / count;
-        mean_a += slice.along / count;
-    }
-    double kk = 0.0, ka = 0.0;
+    for (const Slice& slice : v) mean_p += slice.position / count;
+    double kk = 0.0;
     Eigen::Vector3d kp = Eigen::Vector3d::Zero();
     for (std::size_t k = 0; k < v.size(); ++k) {
         const double dk = static_cast<double>(k) - mean_k;
         kk += dk * dk;
-        ka += dk * (v[k].along - mean_a);
         kp += dk * (v[k].position - mean_p);
     }
     SliceGrid grid;
     grid.step = kp / kk;
-    const double step_along = ka / kk;
-    grid.first_along = mean_a - step_along * mean_k;
+    const double step_along = grid.step.dot(n); // along = n . position: the fit of the positions, seen along n
+    grid.first_along = n.dot(mean_p) - step_along * mean_k;
     for (std::size_t k = 0; k < v.size(); ++k)
         if (const double off = std::abs(v[k].along - grid.first_along - step_along * static_cast<double>(k)); off > grid.worst_offset) {
             grid.worst_offset = off;
@@ -390,7 +385,7 @@ Stack stack(const Scan& scan, const DicomSeries& s, const std::string& path)
         // The even grid that fits the positions best (least squares over the slice index), as
         // ITK and 3D Slicer place a series: scanners round the positions they write (to 0.1 mm,
         // even 1 mm), so the gaps between neighbours vary by far more than the grid does.
-        const SliceGrid grid = fit_slice_grid(v);
+        const SliceGrid grid = fit_slice_grid(v, n);
         step = grid.step.dot(n);
         const double tolerance = k_slice_tolerance * step;
         if (grid.worst_offset > tolerance) {
