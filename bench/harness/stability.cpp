@@ -94,6 +94,7 @@ StabilityResult run_case(const Object& object, const Case& c, int steps)
             r.final_kinetic_j = s.kinetic_energy_j;
             r.final_elastic_j = s.elastic_energy_j.value_or(0.0);
             r.peak_kinetic_j = std::max(r.peak_kinetic_j, s.kinetic_energy_j);
+            r.max_stretch = std::max(r.max_stretch, s.max_stretch);
             double worst = 0.0;
             bool finite = std::isfinite(s.kinetic_energy_j) && std::isfinite(s.elastic_energy_j.value_or(0.0));
             for (std::size_t n = 0; n < rest.size(); ++n) {
@@ -260,17 +261,17 @@ void write_stability(const std::filesystem::path& dir, const std::vector<Stabili
           "the work of gravity and loads by more than 5 %; *refused* when the solver stops it with a "
           "message (a step that still creates energy at 1/32 of dt); *diverged* otherwise. Large "
           "displacements of soft objects under gravity are physical, noted, and not failures.\n\n";
-    md << "| object | case | outcome | steps | max displacement (mm) | peak / final kinetic energy (J) | final elastic energy (J) | note |\n"
-          "|---|---|---|---|---|---|---|---|\n";
+    md << "| object | case | outcome | steps | max displacement (mm) | max stretch | peak / final kinetic energy (J) | final elastic energy (J) | note |\n"
+          "|---|---|---|---|---|---|---|---|---|\n";
     nlohmann::json j = nlohmann::json::array();
     for (const StabilityResult& r : results) {
         char line[512];
-        std::snprintf(line, sizeof line, "| %s | %s | %s | %d | %.3g | %.3g / %.3g | %.3g | %s |\n", r.object.c_str(), r.variation.c_str(),
-                      r.outcome.c_str(), r.steps, r.max_displacement_mm, r.peak_kinetic_j, r.final_kinetic_j, r.final_elastic_j,
+        std::snprintf(line, sizeof line, "| %s | %s | %s | %d | %.3g | %.3g | %.3g / %.3g | %.3g | %s |\n", r.object.c_str(), r.variation.c_str(),
+                      r.outcome.c_str(), r.steps, r.max_displacement_mm, r.max_stretch, r.peak_kinetic_j, r.final_kinetic_j, r.final_elastic_j,
                       r.detail.c_str());
         md << line;
         j.push_back({{"object", r.object}, {"case", r.variation}, {"outcome", r.outcome}, {"detail", r.detail}, {"steps", r.steps},
-                     {"max_displacement_mm", r.max_displacement_mm}, {"peak_kinetic_j", r.peak_kinetic_j},
+                     {"max_displacement_mm", r.max_displacement_mm}, {"max_stretch", r.max_stretch}, {"peak_kinetic_j", r.peak_kinetic_j},
                      {"final_kinetic_j", r.final_kinetic_j}, {"final_elastic_j", r.final_elastic_j},
                      {"unconverged_steps", r.unconverged_steps}, {"projected_steps", r.projected_steps}});
     }

@@ -13,7 +13,7 @@ namespace vox::bench {
 struct StabilityResult {
     std::string object, variation, outcome, detail;
     int steps = 0;
-    double max_displacement_mm = 0.0, final_kinetic_j = 0.0, peak_kinetic_j = 0.0, final_elastic_j = 0.0;
+    double max_displacement_mm = 0.0, max_stretch = 1.0, final_kinetic_j = 0.0, peak_kinetic_j = 0.0, final_elastic_j = 0.0;
     int unconverged_steps = 0;
     int projected_steps = 0; ///< steps whose created energy was taken out again (fem::StepStats::energy_projected)
 };

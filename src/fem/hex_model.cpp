@@ -294,17 +294,22 @@ void HexModel::add_mass_floor(const grid::BranchedGrid& grid)
 
 double HexModel::total_mass() const { return std::accumulate(m_nodal_mass.begin(), m_nodal_mass.end(), 0.0); }
 
-std::size_t inverted_elements(const HexModel& model, const std::vector<Eigen::Vector3d>& positions)
+ElementShapes element_shapes(const HexModel& model, const std::vector<Eigen::Vector3d>& positions)
 {
-    // F = frame^T sum_c x_c (dN_c/dX)^T is I at rest; frame is orthogonal (det +-1).
+    // F = frame^T sum_c x_c (dN_c/dX)^T is I at rest; frame is orthogonal (det +-1), and leaves
+    // the Frobenius norm as it is.
     const double orientation = model.frame().determinant();
-    std::size_t n = 0;
+    ElementShapes out;
     for (const HexElement& el : model.elements()) {
         Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-        for (int c = 0; c < 8; ++c) f += (positions[el.dof_node[c]] - positions[el.dof_node[0]]) * el.gradient.row(c);
-        n += !(orientation * f.determinant() > 0.0);
+        Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+        for (int c = 0; c < 8; ++c) {
+            f += (positions[el.dof_node[c]] - positions[el.dof_node[0]]) * el.gradient.row(c);
+            middle += positions[el.dof_node[c]] / 8.0;
+        }
+        out.add(f, orientation, middle);
     }
-    return n;
+    return out;
 }
 
 } // namespace vox::fem

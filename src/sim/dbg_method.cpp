@@ -385,7 +385,10 @@ StepFigures DbgMethod::step()
     out.substeps = s.substeps;
     out.kinetic_energy_j = s.kinetic_energy_j;
     out.elastic_energy_j = s.elastic_energy_j;
-    out.inverted_elements = fem::inverted_elements(m_sim->model(), m_sim->solver().positions());
+    const fem::ElementShapes shapes = fem::element_shapes(m_sim->model(), m_sim->solver().positions());
+    out.inverted_elements = shapes.inverted;
+    out.max_stretch = shapes.max_stretch;
+    out.most_stretched_mm = {1e3 * shapes.most_stretched_m.x(), 1e3 * shapes.most_stretched_m.y(), 1e3 * shapes.most_stretched_m.z()};
     out.max_displacement_mm = s.max_displacement_m * 1e3;
     out.energy_projected = s.energy_projected;
     out.recovered = s.converged && (s.newton_iterations > 0 || s.substeps > 0);

@@ -5,6 +5,8 @@
 #include "core/stopwatch.hpp"
 #include "sim/device_run.hpp"
 
+#include <spdlog/fmt/fmt.h>
+
 #include <cmath>
 
 namespace vox::sim {
@@ -37,9 +39,19 @@ FrameStats FrameLoop::next()
     out.tools = m_tools.frame(*m_method, out.t_s, dt);
     if (!out.tools.hold_object) out.step = m_method->step(); // held: a two-phase cut is being marked
     const StepFigures& s = out.step;
-    if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)))
+    if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)) || !std::isfinite(s.max_stretch))
         throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +
-                         " (non-finite energy); reduce solver.dt_s or check the materials");
+                         " (non-finite state); reduce solver.dt_s or check the materials");
+    m_growing = s.max_stretch > k_runaway_stretch && s.max_stretch >= k_runaway_growth * m_last_stretch ? m_growing + 1 : 0;
+    m_last_stretch = s.max_stretch;
+    if (m_growing >= k_runaway_frames) {
+        const auto& at = s.most_stretched_mm;
+        throw Diverged(fmt::format("{}: the simulation diverged at frame {}: the element at ({:.1f}, {:.1f}, {:.1f}) mm is stretched "
+                                   "{:.3g} times its size, more each frame{}; reduce solver.dt_s, choose another level or check the materials and "
+                                   "what holds the object",
+                                   m_scene.source, m_frame, at[0], at[1], at[2], s.max_stretch,
+                                   s.converged ? "" : fmt::format(" (the step did not converge: residual {:.2g})", s.residual)));
+    }
     out.frame_ms = clock.lap();
     if (m_governor && !(m_device && m_device->replaying())) m_pending = m_governor->after_frame(out.level, out.frame_ms);
     return out;

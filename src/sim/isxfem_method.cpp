@@ -7,6 +7,7 @@
 #include "core/stopwatch.hpp"
 #include "core/union_find.hpp"
 #include "sim/dbg_simulation.hpp"
+#include "fem/hex_model.hpp"
 
 #include <cstdint>
 #include <cstdio>
@@ -224,12 +225,20 @@ StepFigures IsxfemMethod::step()
     out.max_displacement_mm = 1e3 * max_m;
     // Uncut tetrahedra by their nodes; a cut one's nodes need not bound either side (the
     // enrichment moves the sides apart), so it is left out.
-    const isxfem::TetMesh& mesh = m_sim->model().mesh();
-    for (std::size_t k = 0; k < mesh.tets.size(); ++k) {
-        if (!m_sim->model().elements()[k].cuts.empty()) continue;
-        const auto& t = mesh.tets[k];
-        out.inverted_elements += !(isxfem::signed_volume({x[t[0]], x[t[1]], x[t[2]], x[t[3]]}) > 0.0);
+    fem::ElementShapes shapes;
+    for (const isxfem::XfemElement& el : m_sim->model().elements()) {
+        if (el.is_cut()) continue;
+        Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+        for (std::size_t c = 0; c < 4; ++c) {
+            f += x[el.node[c]] * el.geometry.gradient.row(static_cast<Eigen::Index>(c));
+            middle += x[el.node[c]] / 4.0;
+        }
+        shapes.add(f, 1.0, middle);
     }
+    out.inverted_elements = shapes.inverted;
+    out.max_stretch = shapes.max_stretch;
+    out.most_stretched_mm = {1e3 * shapes.most_stretched_m.x(), 1e3 * shapes.most_stretched_m.y(), 1e3 * shapes.most_stretched_m.z()};
     return out;
 }
 

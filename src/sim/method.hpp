@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -49,6 +50,10 @@ struct StepFigures {
     /// Elements inverted after the step (hexahedra: the deformation gradient at the material
     /// centroid; uncut tetrahedra: the signed volume of their nodes); 0 for a healthy run.
     std::size_t inverted_elements = 0;
+    /// The largest stretch of any element (fem::ElementShapes::max_stretch: 1 at rest) and where
+    /// that element is, mm: what tells a run that diverges (sim::k_runaway_stretch).
+    double max_stretch = 1.0;
+    std::array<double, 3> most_stretched_mm{};
     std::size_t asleep_pieces = 0;          ///< pieces at rest, not stepped (branched grid)
     bool energy_projected = false;          ///< the step created energy even split into 32 substeps, and lost it again
     /// The first solve created energy and was refused; the fuller one (Newton, substeps) converged.

@@ -68,6 +68,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
     m_projected += s.energy_projected;
     m_fallbacks += !s.preconditioner_fallback.empty();
     m_inverted_frames += s.inverted_elements > 0;
+    m_max_stretch = std::max(m_max_stretch, s.max_stretch);
     m_removed += t.cut.removed_voxels;
     m_separated_faces += t.cut.separated_faces;
     m_separated_voxels += t.cut.separated_voxels;
@@ -93,6 +94,7 @@ void RunRecord::add(const FrameStats& f, const Method& method)
                          {"elastic_energy_j", s.elastic_energy_j ? nlohmann::json(*s.elastic_energy_j) : nlohmann::json()},
                          {"max_displacement_mm", s.max_displacement_mm},
                          {"inverted_elements", s.inverted_elements},
+                         {"max_stretch", s.max_stretch},
                          {"collision_ms", t.collision_ms},
                          {"propagation_ms", t.propagation_ms},
                          {"grid_update_ms", t.cut.grid_update_ms},
@@ -160,6 +162,7 @@ void RunRecord::finish(const Method& method)
                            {"preconditioner_fallbacks", m_fallbacks},
                            {"energy_projected_frames", m_projected},
                            {"inverted_frames", m_inverted_frames},
+                           {"max_stretch", m_max_stretch},
                            {"removed_voxels", m_removed},
                            {"separated_faces", m_separated_faces},
                            {"separated_voxels", m_separated_voxels},

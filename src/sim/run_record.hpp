@@ -47,6 +47,7 @@ private:
     std::size_t m_recovered = 0;      ///< frames whose refused first solve a fuller one replaced (StepFigures::recovered)
     std::size_t m_fallbacks = 0;      ///< frames in which a preconditioner failed
     std::size_t m_inverted_frames = 0; ///< frames ending with an inverted element (StepFigures::inverted_elements)
+    double m_max_stretch = 1.0;        ///< the largest StepFigures::max_stretch of any frame
     std::vector<double> m_frame_ms;   ///< whole frames, wall clock
     std::vector<double> m_cutting_ms; ///< frames that cut: collision + propagation + grid update + remesh
     std::size_t m_patch_frames = 0;   ///< device frames with a contact patch (per device)

@@ -355,3 +355,23 @@ TEST(Cli, InfoListsASeriesThatCannotBeImportedWithWhyAndExitsZero)
     EXPECT_NE(import.err.find("series 2 has uneven slice spacing"), std::string::npos) << import.err;
     EXPECT_FALSE(fs::exists(d / "b.vdb"));
 }
+
+TEST(Cli, ARunThatRunsAwayStopsWithExit2NamingWhereAndWritesNothing)
+{
+    // Is-XFEM steps solved with two CG iterations (what a far too loose solver does) while a probe
+    // presses into a held block: the state runs away geometrically. The run stops with one line
+    // naming the frame, the element's place and its stretch, exit 2, and no output folder; it
+    // used to go on to 1e39 mm and end with exit 0.
+    const fs::path d = fresh_dir("cli_runaway");
+    std::ofstream(d / "runaway.json") << R"({"object": {"phantom": {"shape": "block", "size_mm": [12, 12, 8]}, "levels": 1},
+        "materials": {"default": {"youngs_modulus_pa": 3e4, "poisson_ratio": 0.45, "density_kg_m3": 1000}},
+        "solver": {"type": "isxfem", "dt_s": 0.01, "cg_max_iterations": 2, "preconditioner": "jacobi"}, "gravity_m_s2": [0, 0, 0],
+        "constraints": [{"type": "fixed", "box_mm": [[-1, -1, -1], [13, 13, 0.2]]}],
+        "tools": [{"name": "probe", "shape": "sphere", "radius_mm": 3.0, "action": "push", "push_margin_mm": 0.25}],
+        "script": [{"t_s": 0, "tool": "probe", "position_mm": [5.5, 5.5, 10.5]}, {"t_s": 0.5, "tool": "probe", "position_mm": [5.5, 5.5, 3.5]}]})";
+    const auto r = run_voxsculpt("run " + quote((d / "runaway.json").string()) + " --frames 100 --out " + quote((d / "out").string()));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("runaway.json: the simulation diverged at frame "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" times its size, more each frame (the step did not converge: residual "), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(d / "out"));
+}
