@@ -11,6 +11,7 @@
 #include "io/label_map_writer.hpp"
 #include "io/segmentation.hpp"
 #include "render/draw_mesh.hpp"
+#include "core/label_palette.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/object_import.hpp"
 #include "io/scene_object.hpp"
@@ -66,7 +67,7 @@ void add_export_command(CLI::App& app)
             for (auto& [label, segment] : io::segments_of(labels)) segments[label] = segment;
             io::write_glb(
                 args->output, m.positions, m.triangles, m.labels,
-                [&](std::int32_t l) { return segments.count(l) ? segments[l].color : Eigen::Vector3d(render::label_color(l).cast<double>()); },
+                [&](std::int32_t l) { return segments.count(l) ? segments[l].color : label_color(l); },
                 [&](std::int32_t l) { return segments.count(l) ? segments[l].name : "label " + std::to_string(l); });
         } else {
             io::write_mesh(args->output, m.positions, m.triangles, m.labels);

@@ -8,6 +8,7 @@
 
 #include "app/commands.hpp"
 #include "render/draw_mesh.hpp"
+#include "core/label_palette.hpp"
 #include "view/scene_pictures.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -231,7 +232,7 @@ void add_run_command(CLI::App& app)
             const surface::SurfaceMesh m = method.surface_mesh();
             const auto color_of = [&](std::int32_t label) {
                 const auto own = scene.object.label_colors.find(label);
-                return own != scene.object.label_colors.end() ? own->second : Eigen::Vector3d(render::label_color(label).cast<double>());
+                return own != scene.object.label_colors.end() ? own->second : label_color(label);
             };
             const auto name_of = [&](std::int32_t label) {
                 const auto own = scene.object.label_names.find(label);

@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/label_palette.hpp"
 #include "io/nifti_writer.hpp"
 #include "io/segmentation.hpp"
 #include "io/text_parsing.hpp"
@@ -22,15 +23,6 @@ namespace {
 bool ends_with(const std::string& s, const std::string& suffix)
 {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-/// Colours for labels no segment names, so that Slicer tells them apart.
-Eigen::Vector3d fallback_color(std::int32_t label)
-{
-    static const std::array<Eigen::Vector3d, 6> colors{
-        Eigen::Vector3d(0.50, 0.68, 0.50), Eigen::Vector3d(0.85, 0.40, 0.30), Eigen::Vector3d(0.40, 0.55, 0.85),
-        Eigen::Vector3d(0.90, 0.80, 0.45), Eigen::Vector3d(0.70, 0.45, 0.75), Eigen::Vector3d(0.45, 0.80, 0.80)};
-    return colors[static_cast<std::size_t>(label) % colors.size()];
 }
 
 std::string gzip(const std::vector<std::byte>& data, const std::string& path)
@@ -103,7 +95,7 @@ std::vector<std::pair<std::string, std::string>> segmentation_pairs(const grid::
         Segment s;
         s.id = "Segment_" + std::to_string(label);
         s.name = "label " + std::to_string(label);
-        s.color = fallback_color(label);
+        s.color = label_color(label);
         by_label[label] = s;
     }
     std::vector<std::pair<std::string, std::string>> pairs{

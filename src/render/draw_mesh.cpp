@@ -2,7 +2,6 @@
 
 #include <Eigen/Geometry>
 
-#include <array>
 
 namespace vox::render {
 
@@ -51,26 +50,6 @@ void smooth_for_display(DrawMesh& mesh, int iterations)
         }
         mesh.positions.swap(next);
     }
-}
-
-Eigen::Vector3f label_color(std::int32_t label)
-{
-    // Ordered so that the hash below gives the bundled liver (255) its red-brown and the lesion
-    // label beside it (127) a pale yellow.
-    static const std::array<Eigen::Vector3f, 8> palette{
-        Eigen::Vector3f(0.45f, 0.65f, 0.40f), // green
-        Eigen::Vector3f(0.65f, 0.50f, 0.75f), // violet
-        Eigen::Vector3f(0.90f, 0.60f, 0.30f), // orange
-        Eigen::Vector3f(0.88f, 0.80f, 0.52f), // pale yellow (lesion, fat)
-        Eigen::Vector3f(0.62f, 0.22f, 0.18f), // red-brown (liver)
-        Eigen::Vector3f(0.30f, 0.45f, 0.75f), // blue (vessels)
-        Eigen::Vector3f(0.75f, 0.35f, 0.40f), // pink (muscle)
-        Eigen::Vector3f(0.50f, 0.70f, 0.75f), // teal
-    };
-    if (label <= 1) return {0.76f, 0.60f, 0.48f}; // clay: unlabelled objects and the phantoms (label 1)
-    // Multiplicative hashing spreads neighbouring labels (1, 2, 3 or 127, 255) over the palette.
-    const auto h = static_cast<std::uint32_t>(label) * 2654435761u;
-    return palette[(h >> 29) % palette.size()];
 }
 
 } // namespace vox::render

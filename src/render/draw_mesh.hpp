@@ -27,8 +27,4 @@ void compute_normals(DrawMesh& mesh);
 /// (3D Slicer smooths its segmentation models the same way). Shrinks the shape very little.
 void smooth_for_display(DrawMesh& mesh, int iterations);
 
-/// A colour for a material label, the same every time: a palette of tissue and clay tones
-/// (label 0, unlabelled objects and the phantoms' label 1 get clay).
-[[nodiscard]] Eigen::Vector3f label_color(std::int32_t label);
-
 } // namespace vox::render

@@ -1,6 +1,7 @@
 #include "view/scene_pictures.hpp"
 
 #include "core/error.hpp"
+#include "core/label_palette.hpp"
 #include "sim/dbg_method.hpp"
 #include "sim/obstacles.hpp"
 
@@ -40,7 +41,7 @@ render::DrawMesh surface_drawing(const surface::SurfaceMesh& mesh, int smooth, c
     for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
         const std::int32_t label = v < mesh.labels.size() ? mesh.labels[v] : 0;
         const auto own = colors.find(label);
-        d.colors.push_back(own != colors.end() ? Eigen::Vector3f(own->second.cast<float>()) : render::label_color(label));
+        d.colors.push_back(own != colors.end() ? Eigen::Vector3f(own->second.cast<float>()) : Eigen::Vector3f(label_color(label).cast<float>()));
     }
     d.indices.reserve(3 * mesh.triangles.size());
     for (const Eigen::Vector3i& t : mesh.triangles)
@@ -144,7 +145,7 @@ render::DrawMesh voxel_boxes(const sim::DbgSimulation& sim)
         const std::uint32_t e = surface.voxel_element(v, local);
         const double half = half_voxel(e);
         // A checkerboard of two shades, so that each voxel shows.
-        const Eigen::Vector3f color = ((c.x() + c.y() + c.z()) % 2 == 0 ? 0.92f : 0.78f) * render::label_color(voxels.label(v));
+        const Eigen::Vector3f color = ((c.x() + c.y() + c.z()) % 2 == 0 ? 0.92f : 0.78f) * label_color(voxels.label(v)).cast<float>();
         for (int axis = 0; axis < 3; ++axis)
             for (const int side : {-1, 1}) {
                 const std::uint32_t n = voxels.find(c + side * grid::Coord::Unit(axis));

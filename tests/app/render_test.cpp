@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <stb/stb_image.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -40,8 +41,8 @@ Picture read_png(const fs::path& path)
 
 /// Pixels unlike the plain background (236, 238, 242).
 bool foreground(const unsigned char* c) { return std::abs(c[0] - 236) + std::abs(c[1] - 238) + std::abs(c[2] - 242) > 24; }
-/// Pixels of the object (its warm material colour), not of the grey-blue tool.
-bool object(const unsigned char* c) { return foreground(c) && c[0] > c[2] + 30; }
+/// Pixels of the object (its label's colour, warm or green: Slicer's tissue), not of the grey-blue tool.
+bool object(const unsigned char* c) { return foreground(c) && std::max(c[0], c[1]) > c[2] + 20; }
 /// Pixels of the orange an Is-XFEM picture marks pieces left coupled with.
 bool coupled(const unsigned char* c) { return c[0] > 200 && c[2] < 90 && c[0] > c[1] + 60; }
 

@@ -10,13 +10,16 @@
 #include "io/segmentation.hpp"
 
 #include "core/error.hpp"
+#include "core/label_palette.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <zlib.h>
 
+#include <array>
 #include <fstream>
+#include <set>
 #include <iterator>
 #include <map>
 #include <sstream>
@@ -211,7 +214,7 @@ TEST(Segmentation, WrittenBackItKeepsTheGridNamesColoursAndVoxels)
     EXPECT_EQ(different, 0u);
 }
 
-TEST(Segmentation, AVolumeWrittenBackCoversTheScansWholeGridAndLabelsWithoutSegmentsGetNames)
+TEST(Segmentation, AVolumeWrittenBackCoversTheScansWholeGridAndLabelsWithoutSegmentsGetNamesAndColours)
 {
     // The liver's voxels of label 127 only: the scan's whole grid is written, so that the file lays
     // over the scan in Slicer with no registration.
@@ -224,8 +227,32 @@ TEST(Segmentation, AVolumeWrittenBackCoversTheScansWholeGridAndLabelsWithoutSegm
     EXPECT_EQ(back.fields.at("sizes"), "438 353 165");
     EXPECT_EQ(back.pairs.at("Segment0_Name"), "label 127");
     EXPECT_EQ(back.pairs.at("Segment0_LabelValue"), "127");
+    // Coloured as Slicer colours label 127 (salivary glands, 70 163 117): the one palette.
+    std::istringstream color(back.pairs.at("Segment0_Color"));
+    Eigen::Vector3d rgb;
+    color >> rgb.x() >> rgb.y() >> rgb.z();
+    EXPECT_TRUE(rgb.isApprox(Eigen::Vector3d(70, 163, 117) / 255.0, 1e-5)) << back.pairs.at("Segment0_Color");
     std::size_t count = 0;
     for (const int v : back.voxels) count += v == 127;
     EXPECT_EQ(count, 314086u);
     expect_refused([&] { write_label_map(labels, dir.path("x.mha")); }, dir.path("x.mha"), "a label map is written as");
+}
+
+TEST(LabelPalette, IsSlicersGenericAnatomyTableAndGivesEveryLabelAColourOfIt)
+{
+    // Rows of data/palette/GenericAnatomyColors.txt as Slicer has them.
+    EXPECT_TRUE(vox::label_color(1).isApprox(Eigen::Vector3d(128, 174, 128) / 255.0)); // tissue
+    EXPECT_TRUE(vox::label_color(2).isApprox(Eigen::Vector3d(241, 214, 145) / 255.0)); // bone
+    EXPECT_TRUE(vox::label_color(14).isApprox(Eigen::Vector3d(250, 250, 210) / 255.0)); // white matter
+    EXPECT_TRUE(vox::label_color(309).isApprox(Eigen::Vector3d(205, 205, 100) / 255.0)); // cyst, the last
+    EXPECT_TRUE(vox::label_color(0).isApprox(vox::label_color(1)));                      // unlabelled: tissue
+    // Beyond the table: one of its colours, the same every time, neighbours told apart.
+    std::set<std::array<double, 3>> table;
+    for (std::int32_t l = 1; l <= 309; ++l) table.insert({vox::label_color(l).x(), vox::label_color(l).y(), vox::label_color(l).z()});
+    for (const std::int32_t l : {310, 311, 1000, -5, 65535}) {
+        const Eigen::Vector3d c = vox::label_color(l);
+        EXPECT_TRUE(table.count({c.x(), c.y(), c.z()})) << l;
+        EXPECT_EQ(c, vox::label_color(l));
+    }
+    EXPECT_NE(vox::label_color(310), vox::label_color(311));
 }
