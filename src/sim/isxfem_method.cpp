@@ -7,7 +7,7 @@
 #include "core/stopwatch.hpp"
 #include "core/union_find.hpp"
 #include "sim/dbg_simulation.hpp"
-#include "fem/hex_model.hpp"
+#include "fem/element_shapes.hpp"
 
 #include <cstdint>
 #include <cstdio>
