@@ -731,9 +731,12 @@ int ImplicitSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double
             for (const BlockWeight& t : p.terms) contacts.push_back(t.block);
         m_preconditioner->set_contact_blocks(std::move(contacts));
         m_preconditioner->update(m_matrix_current ? &m_matrix : nullptr, m_fixed, m_node_rotation);
-        if (m_preconditioner->failed()) { // e.g. a factor of a singular K: nothing holds the object
-            m_fallback_note = std::string(m_preconditioner->name()) +
-                              " preconditioner failed (singular matrix: is the object held?); using Jacobi";
+        if (m_preconditioner->failed()) {
+            const FactorFailure failure = m_preconditioner->failure();
+            const auto node = static_cast<std::size_t>(failure.dof / 3);
+            const bool known = failure.dof >= 0 && node < m_x.size();
+            const bool held = std::any_of(m_fixed.begin(), m_fixed.end(), [](unsigned char f) { return f != 0; });
+            m_fallback_note = fem::fallback_note(m_preconditioner->name(), failure, known ? &m_x[node] : nullptr, m_options.quasi_static, held);
             m_preconditioner.reset();
         }
     }

@@ -3,6 +3,8 @@
 // each new system matrix, then z = P r for residuals r. Held degrees of freedom have identity rows
 // and columns in the matrix and zero residuals; P must keep them zero.
 
+#include "fem/factor_failure.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <Eigen/Sparse>
@@ -54,6 +56,9 @@ public:
     [[nodiscard]] virtual const char* name() const = 0;
     /// True when the last update could not build the preconditioner (a singular matrix).
     [[nodiscard]] virtual bool failed() const { return false; }
+    /// Why it failed: the matrix was not positive definite, or nearly singular; the dof where the
+    /// failure showed (-1: not known). The solver names the node and the likely cause.
+    [[nodiscard]] virtual FactorFailure failure() const { return {}; }
 };
 
 } // namespace vox::fem

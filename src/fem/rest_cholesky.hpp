@@ -116,6 +116,7 @@ public:
 
     /// Whether the last factorisation failed (a singular matrix: the solver falls back to Jacobi).
     [[nodiscard]] bool failed() const override { return m_failed; }
+    [[nodiscard]] FactorFailure failure() const override { return m_failed ? m_current->factor.failure() : FactorFailure{}; }
     /// Factorisations taken so far, in the frame and in the background (a discarded one included).
     [[nodiscard]] int factorizations() const { return m_factorizations; }
     /// Of those, the ones taken in the background.

@@ -74,7 +74,22 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     cholmod_factorize(&view, m_cholmod->factor, &c);
     const cholmod_factor* l = m_cholmod->factor;
     lock.unlock();
-    if (c.status == CHOLMOD_NOT_POSDEF || !l->is_super || !l->is_ll) return false;
+    m_failure = {};
+    if (c.status == CHOLMOD_NOT_POSDEF || !l->is_super || !l->is_ll) {
+        // CHOLMOD stops at the column (factor order) whose pivot was not positive: its `minor`.
+        const auto* perm = static_cast<const int*>(l->Perm);
+        const int dof = l->minor < l->n && perm ? perm[l->minor] : -1;
+        // A singular matrix (a piece nothing holds, no mass) fails as often by a pivot rounded to
+        // zero or below as by a tiny one. Shifted by 1e-8 of its largest diagonal entry a positive
+        // semi-definite matrix factors; an indefinite one does not.
+        double beta[2] = {1e-8 * a.diagonal().cwiseAbs().maxCoeff(), 0.0};
+        lock.lock();
+        cholmod_factorize_p(&view, beta, nullptr, 0, m_cholmod->factor, &c);
+        const bool semidefinite = c.status == CHOLMOD_OK && m_cholmod->factor->is_super;
+        lock.unlock();
+        m_failure = {true, !semidefinite, dof, 0.0};
+        return false;
+    }
     // The float copy, and the pivots (the squared diagonal of L) for the singularity check.
     auto copy = [](const void* p, std::size_t n, std::vector<int>& out) {
         const int* q = static_cast<const int*>(p);
@@ -90,10 +105,12 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
     const double* x = static_cast<const double*>(l->x);
     m_values.assign(x, x + l->xsize);
     double smallest = INFINITY, largest = 0.0;
+    int smallest_row = -1;
     for (std::size_t k = 0; k + 1 < m_super.size(); ++k) {
         const int nc = m_super[k + 1] - m_super[k], nr = m_pi[k + 1] - m_pi[k];
         for (int j = 0; j < nc; ++j) {
             const double d = x[m_px[k] + j * nr + j];
+            if (d * d < smallest) smallest_row = m_super[k] + j;
             smallest = std::min(smallest, d * d);
             largest = std::max(largest, d * d);
         }
@@ -103,7 +120,9 @@ bool SupernodalFactor::factor(const Eigen::SparseMatrix<double>& a, bool new_pat
         schedule(std::min<std::size_t>(solve_threads, 8));
         m_schedule_stale = false;
     }
-    return smallest > 1e-10 * largest;
+    if (smallest > 1e-10 * largest) return true;
+    m_failure = {true, false, smallest_row >= 0 ? m_perm[static_cast<std::size_t>(smallest_row)] : -1, smallest / largest};
+    return false;
 }
 
 void SupernodalFactor::schedule(std::size_t groups)

@@ -11,6 +11,8 @@
 // going down, the top is solved first and the subtrees only read from it. (On the Is-XFEM bench's
 // factor, 2.1 M entries, this is what most of a CG iteration cost: numbers in the README.)
 
+#include "fem/factor_failure.hpp"
+
 #include <Eigen/SparseCore>
 
 #include <functional>
@@ -34,6 +36,8 @@ public:
     /// other's solve_threads(). Runs on the calling thread alone (no TBB algorithms; CHOLMOD and
     /// BLAS are not to be called from two threads at once).
     bool factor(const Eigen::SparseMatrix<double>& a, bool new_pattern, std::size_t solve_threads = SupernodalFactor::solve_threads());
+    /// Why the last factor() returned false (failed is false after a success).
+    [[nodiscard]] const FactorFailure& failure() const { return m_failure; }
     /// Threads the calling thread's solves may use: its task arena's, within TBB's global limit.
     [[nodiscard]] static std::size_t solve_threads();
     /// x = A^-1 x, in single precision.
@@ -77,6 +81,7 @@ private:
     std::vector<int> m_super, m_pi, m_px, m_s, m_perm; ///< CHOLMOD's supernodal layout
     std::vector<int> m_inverse_perm;                    ///< dof -> factor row
     std::vector<int> m_column_super, m_parent;         ///< factor row -> its supernode; supernode -> parent (-1: a root)
+    FactorFailure m_failure;
     bool m_postordered = false;                        ///< a child's number below its parent's (CHOLMOD's)
     double m_factor_flops = 0.0;
     std::vector<std::vector<int>> m_groups; ///< per group, its supernodes in ascending order

@@ -103,9 +103,17 @@ int XfemSolver::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double& re
     if (factor) {
         m_operator.block_rotations(m_block_rotation);
         m_preconditioner->update(&m_operator.matrix(), m_fixed, m_block_rotation);
-        if (m_preconditioner->failed()) { // a (nearly) singular system: Jacobi carries on until the next cut
+        if (m_preconditioner->failed()) { // Jacobi carries on until the next cut
             m_preconditioner_failed = true;
-            m_fallback_note = std::string(m_preconditioner->name()) + " preconditioner failed (a nearly singular system); Jacobi took over";
+            const fem::FactorFailure failure = m_preconditioner->failure();
+            // An enriched block's dofs are a jump, not a place: its node is named.
+            const Eigen::Vector3d* where = nullptr;
+            if (failure.dof >= 0) {
+                auto block = static_cast<std::uint32_t>(failure.dof / 3);
+                if (block >= m_model.node_count()) block = m_model.enriched_node(block);
+                where = &m_x[block];
+            }
+            m_fallback_note = fem::fallback_note(m_preconditioner->name(), failure, where, false, true);
         }
     }
     auto precondition = [&](const Eigen::VectorXd& res, Eigen::VectorXd& out) {

@@ -1,10 +1,12 @@
 // The supernodal preconditioning factor: on a 3D grid Laplacian plus a mass term it solves to
 // single precision (against a double simplicial factor), whatever the matrix's values after the
-// first analysis; a singular matrix (no mass, nothing held) is refused. The solves split over
-// threads give the same answer as on one.
+// first analysis; a singular matrix (no mass, nothing held) is refused, and a failure names its
+// dof and the note a solver gives says only what the system shows. The solves split over threads
+// give the same answer as on one.
 
 #include "fem/supernodal_factor.hpp"
 
+#include "fem/factor_failure.hpp"
 #include "fem/grid_laplacian.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -35,6 +37,11 @@ TEST(SupernodalFactor, RefusesASingularMatrix)
 {
     vox::fem::SupernodalFactor f;
     EXPECT_FALSE(f.factor(grid_laplacian(6, 0.0), true)); // constants are in its null space
+    EXPECT_TRUE(f.failure().failed);
+    EXPECT_FALSE(f.failure().not_positive_definite); // singular, not indefinite
+    EXPECT_LT(f.failure().pivot_ratio, 1e-10);
+    EXPECT_GE(f.failure().dof, 0);
+    EXPECT_LT(f.failure().dof, 216);
     // The same pattern with values that factor: the analysis is kept, and the solves are planned
     // for it now.
     const Eigen::SparseMatrix<double> a = grid_laplacian(6, 0.5);
@@ -43,6 +50,22 @@ TEST(SupernodalFactor, RefusesASingularMatrix)
     Eigen::VectorXd x = b;
     f.solve(x);
     EXPECT_LT((a * x - b).norm() / b.norm(), 1e-4);
+    EXPECT_FALSE(f.failure().failed);
+}
+
+TEST(SupernodalFactor, NamesTheDofWhosePivotIsNotPositive)
+{
+    // One negative diagonal entry in an otherwise positive definite matrix: eliminating other
+    // rows only lowers its pivot (the off-diagonals are negative), so the factorisation stops
+    // there, whatever order the analysis chose.
+    Eigen::SparseMatrix<double> a = grid_laplacian(8, 0.5);
+    const int bad = 301;
+    a.coeffRef(bad, bad) = -2.0;
+    vox::fem::SupernodalFactor f;
+    EXPECT_FALSE(f.factor(a, true));
+    EXPECT_TRUE(f.failure().failed);
+    EXPECT_TRUE(f.failure().not_positive_definite);
+    EXPECT_EQ(f.failure().dof, bad);
 }
 
 TEST(SupernodalFactor, SolvesOnSeveralThreadsAsOnOne)
@@ -72,4 +95,22 @@ TEST(SupernodalFactor, SolvesOnSeveralThreadsAsOnOne)
         });
     }
     EXPECT_LT((solved[1] - solved[0]).norm() / solved[0].norm(), 1e-6); // only the float sums' order differs
+}
+
+TEST(SupernodalFactor, TheFallbackNoteSaysWhatFailedWhereAndOnlyTheCauseTheSystemShows)
+{
+    using vox::fem::fallback_note;
+    const Eigen::Vector3d at(0.0123, -0.004, 0.1);
+    const vox::fem::FactorFailure indefinite{true, true, 7, 0.0};
+    EXPECT_EQ(fallback_note("warped Cholesky", indefinite, &at, false, true),
+              "warped Cholesky preconditioner failed: the step's matrix is not positive definite at the node at (12.3, -4.0, 100.0) mm; "
+              "using Jacobi");
+    const vox::fem::FactorFailure singular{true, false, 7, 3e-14};
+    const std::string free = fallback_note("warped Cholesky", singular, nullptr, true, false);
+    EXPECT_EQ(free, "warped Cholesky preconditioner failed: the step's matrix is nearly singular (smallest pivot 3.0e-14 of the largest) "
+                    "(nothing holds the object); using Jacobi");
+    EXPECT_NE(fallback_note("c", singular, nullptr, true, true).find("(a piece that nothing holds?)"), std::string::npos);
+    // With mass, M/h^2 keeps the matrix regular whatever holds the object: no hold is suggested.
+    EXPECT_EQ(fallback_note("c", singular, nullptr, false, false).find("holds"), std::string::npos);
+    EXPECT_EQ(fallback_note("c", {true, false, -1, 0.0}, nullptr, false, true), "c preconditioner failed: the step's matrix is singular; using Jacobi");
 }
