@@ -286,3 +286,64 @@ TEST(DicomReader, AScannerExportBesideOtherSeriesAndADamagedDicomdirReadsAsPydic
     }
     EXPECT_EQ(different, 0);
 }
+
+namespace {
+const std::string k_ge_rounded = VOX_SOURCE_DIR "/tests/data/dicom_ge_rounded";
+} // namespace
+
+TEST(DicomReader, ARealSeriesWithRoundedPositionsReadsOnItsEvenGridAsPydicomReadsIt)
+{
+    // A GE scanner's oblique MR series (tests/data/README.md) whose positions it rounded to 0.1 mm:
+    // gaps of 6.958 - 7.071 mm. It lists as importable and reads with pydicom's voxels, on the
+    // even grid whose step is the positions' mean gap.
+    const std::vector<DicomSeries> listed = list_dicom_series(k_ge_rounded);
+    ASSERT_EQ(listed.size(), 1u);
+    EXPECT_EQ(listed[0].problem, "");
+    EXPECT_EQ(listed[0].size, (std::array<std::int64_t, 3>{256, 256, 20}));
+    const Volume v = read_dicom(k_ge_rounded);
+    ASSERT_EQ(v.dims, (std::array<std::int64_t, 3>{256, 256, 20}));
+
+    const ScratchDir scratch;
+    const std::string out = scratch.path("values.txt");
+    const std::string script =
+        "import glob, sys, numpy as np, pydicom\n"
+        "s = [pydicom.dcmread(f) for f in glob.glob(sys.argv[1] + '/*.dcm')]\n"
+        "o = np.array(s[0].ImageOrientationPatient, float)\n"
+        "n = np.cross(o[:3], o[3:])\n"
+        "s.sort(key=lambda d: n @ np.array(d.ImagePositionPatient, float))\n"
+        "along = [n @ np.array(d.ImagePositionPatient, float) for d in s]\n"
+        "with open(sys.argv[2], 'w') as f:\n"
+        "    f.write('%r %r\\n' % ((along[-1] - along[0]) / (len(s) - 1), min(np.diff(along)) / max(np.diff(along))))\n"
+        "    for d in s:\n"
+        "        v = d.pixel_array * float(getattr(d, 'RescaleSlope', 1)) + float(getattr(d, 'RescaleIntercept', 0))\n"
+        "        f.write(' '.join(str(float(x)) for x in v.ravel()) + '\\n')\n";
+    (void)scratch.write("read.py", script);
+    ASSERT_EQ(vox::test::run_python(scratch.path("read.py"), {k_ge_rounded, out}), 0);
+    std::ifstream in(out);
+    double mean_gap = 0.0, gap_ratio = 0.0;
+    in >> mean_gap >> gap_ratio;
+    EXPECT_LT(gap_ratio, 0.985) << "the gaps are uneven beyond 1 %: what this series is here for";
+    EXPECT_NEAR((v.index_to_world.block<3, 1>(0, 2).norm()), mean_gap, 0.02);
+    std::int64_t different = 0;
+    for (std::int64_t i = 0; i < v.voxel_count(); ++i) {
+        double value = 0.0;
+        ASSERT_TRUE(static_cast<bool>(in >> value)) << "voxel " << i;
+        if (value != v.scaled(i)) ++different;
+    }
+    EXPECT_EQ(different, 0);
+}
+
+TEST(DicomReader, ARealSeriesWithASliceTakenOutIsStillRefused)
+{
+    // The same rounded series without its tenth slice: a real gap of 14 mm, not rounding.
+    const ScratchDir scratch;
+    const std::string dir = scratch.path("gap");
+    std::filesystem::create_directories(dir);
+    for (const auto& f : std::filesystem::directory_iterator(k_ge_rounded))
+        if (f.path().extension() == ".dcm" && f.path().filename() != "brain_010.dcm")
+            std::filesystem::copy_file(f.path(), std::filesystem::path(dir) / f.path().filename());
+    expect_refused([&] { (void)read_dicom(dir); }, dir, "has uneven slice spacing: 1");
+    const std::vector<DicomSeries> listed = list_dicom_series(dir); // listed, with the reason
+    ASSERT_EQ(listed.size(), 1u);
+    EXPECT_NE(listed[0].problem.find("(a missing slice?"), std::string::npos) << listed[0].problem;
+}
