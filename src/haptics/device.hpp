@@ -28,6 +28,14 @@ struct DeviceLimits {
     Eigen::Vector3d workspace_max_mm = Eigen::Vector3d::Constant(1e9);
 };
 
+/// What a force-feedback device reports of itself, for `voxsculpt devices`.
+struct ForceDeviceInfo {
+    std::string model;
+    std::string serial;
+    double max_force_n = 0.0;
+    std::string problem; ///< why no device could be opened ("" when one was)
+};
+
 class Device {
 public:
     virtual ~Device() = default;
@@ -37,6 +45,18 @@ public:
     virtual bool read(double t_s, DeviceState& state) noexcept = 0;
     /// Force (N) and torque (N m) to render; ignored by devices without force output.
     virtual void send(const Eigen::Vector3d& /*force_n*/, const Eigen::Vector3d& /*torque_nm*/) noexcept {}
+    /// What keeps the device from working now, in the vendor's words (a cable pulled): a static
+    /// string, null while it works. The force sent meanwhile is zero and the state is held.
+    [[nodiscard]] virtual const char* fault() const noexcept { return nullptr; }
+
+    /// A tick of a servo loop the device's vendor runs itself (OpenHaptics' scheduler).
+    using ServoTick = void (*)(void* user) noexcept;
+    /// Devices whose vendor runs the 1 kHz servo thread call `tick(user)` from it once a
+    /// millisecond (reads and sends are valid only there) and return true; the haptic loop then
+    /// starts no thread of its own. False (the default): the loop's own thread polls the device.
+    virtual bool run_servo(ServoTick /*tick*/, void* /*user*/) { return false; }
+    /// Stops what run_servo() started; no tick runs after it returns.
+    virtual void stop_servo() {}
 };
 
 } // namespace vox::haptics

@@ -57,12 +57,40 @@ void HapticLoop::start()
 {
     if (m_running.exchange(true)) return;
     m_recorded = 0;
+    m_start = m_previous = std::chrono::steady_clock::now();
+    // A device whose vendor runs the servo thread ticks the loop from it: one clock for all.
+    for (Served& c : m_channels)
+        if (c.device->run_servo(&HapticLoop::servo_tick, this)) {
+            m_servo = c.device;
+            return;
+        }
     m_thread = std::thread([this] { run(); });
+}
+
+void HapticLoop::servo_tick(void* self) noexcept
+{
+    auto* loop = static_cast<HapticLoop*>(self);
+    const auto now = std::chrono::steady_clock::now();
+    loop->tick(std::chrono::duration<double>(now - loop->m_start).count());
+    loop->record(now);
+}
+
+void HapticLoop::record(std::chrono::steady_clock::time_point now) noexcept
+{
+    if (m_recorded < m_timings.force_us.size()) {
+        m_timings.period_error_ms[m_recorded] = std::abs(std::chrono::duration<double, std::milli>(now - m_previous).count() - 1.0);
+        m_timings.force_us[m_recorded] = m_last_force_us;
+        m_timings.work_us[m_recorded] = m_last_work_us;
+        ++m_recorded;
+    }
+    m_previous = now;
 }
 
 void HapticLoop::stop()
 {
     if (!m_running.exchange(false)) return;
+    if (m_servo) m_servo->stop_servo();
+    m_servo = nullptr;
     if (m_thread.joinable()) m_thread.join();
     m_timings.period_error_ms.resize(m_recorded);
     m_timings.force_us.resize(m_recorded);
@@ -76,23 +104,15 @@ void HapticLoop::run()
     m_timings.realtime_priority = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
     using clock = std::chrono::steady_clock;
     const auto period = std::chrono::microseconds(1000);
-    const auto start = clock::now();
-    auto deadline = start + period, previous = start;
+    auto deadline = m_start + period;
     while (m_running.load(std::memory_order_relaxed)) {
         // Sleep until shortly before the deadline, then spin: sleeping alone wakes up late.
         std::this_thread::sleep_until(deadline - std::chrono::microseconds(150));
         while (clock::now() < deadline) {
         }
         const auto now = clock::now();
-        tick(std::chrono::duration<double>(now - start).count());
-        if (m_recorded < m_timings.force_us.size()) {
-            m_timings.period_error_ms[m_recorded] =
-                std::abs(std::chrono::duration<double, std::milli>(now - previous).count() - 1.0);
-            m_timings.force_us[m_recorded] = m_last_force_us;
-            m_timings.work_us[m_recorded] = m_last_work_us;
-            ++m_recorded;
-        }
-        previous = now;
+        tick(std::chrono::duration<double>(now - m_start).count());
+        record(now);
         deadline += period;
         if (deadline < now) deadline = now + period; // fell behind by a whole period: do not burst
     }

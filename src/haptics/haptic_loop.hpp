@@ -4,7 +4,8 @@
 // session (two hands, two tools): one thread, one deadline, the devices in turn. Two ways to drive it:
 //  - live: its own thread on absolute deadlines (sleep until shortly before the deadline, spin the
 //    rest; real-time priority where the system allows it), timing every period and every tick's
-//    force computation (all devices) into preallocated buffers;
+//    force computation (all devices) into preallocated buffers; or, when a device's vendor runs
+//    its own servo thread (OpenHaptics' scheduler), ticked from that thread, timed the same way;
 //  - lockstep: tick(t) called by the simulation thread a fixed number of times per step, in
 //    simulated time, so headless runs and replays are deterministic.
 // A tick reads every device and sends every force first; then each channel may prepare the next
@@ -17,6 +18,7 @@
 #include "haptics/force_safety.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <thread>
 #include <vector>
@@ -61,8 +63,8 @@ public:
     /// the first.
     Eigen::Vector3d tick(double t_s) noexcept;
 
-    void start();        ///< live mode: starts the 1 kHz thread
-    void stop();         ///< joins it
+    void start();        ///< live mode: starts the 1 kHz thread, or a device's own servo ticks it
+    void stop();         ///< joins the thread (or stops the servo)
     /// The live thread's timings so far (call after stop()).
     [[nodiscard]] const LoopTimings& timings() const { return m_timings; }
     [[nodiscard]] std::size_t device_count() const { return m_channels.size(); }
@@ -83,6 +85,10 @@ private:
         Eigen::Vector3d force = Eigen::Vector3d::Zero();
     };
     void run();
+    /// A tick from a device's own servo thread (Device::run_servo).
+    static void servo_tick(void* self) noexcept;
+    /// Keeps this tick's timings (live mode), `now` its start.
+    void record(std::chrono::steady_clock::time_point now) noexcept;
 
     std::vector<Served> m_channels;
     LoopTimings m_timings;
@@ -90,6 +96,8 @@ private:
     double m_last_force_us = 0.0, m_last_work_us = 0.0;
     std::atomic<bool> m_running{false};
     std::thread m_thread;
+    Device* m_servo = nullptr; ///< the device whose servo thread ticks the loop (live mode), if any
+    std::chrono::steady_clock::time_point m_start, m_previous;
 };
 
 } // namespace vox::haptics

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -251,12 +252,26 @@ TEST(Cli, CcdCheckPrintsTheScoreLine)
 
 TEST(Cli, DevicesListsOrExplains)
 {
-    // Never a silent empty list: either device lines or the reason there are none.
+    // Never a silent empty list: for each kind, either device lines or the reason there are none.
+    ::unsetenv("VOX_LIBHD");
+    ::unsetenv("VOX_LIBDHD");
     const auto r = run_voxsculpt("devices");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const bool listed = r.out.find(':') == 4; // "vvvv:pppp ..."
+    ASSERT_EQ(r.out.rfind("HID controllers", 0), 0u) << r.out;
+    const bool listed = std::regex_search(r.out, std::regex("\n  [0-9a-f]{4}:[0-9a-f]{4} "));
     EXPECT_TRUE(listed || r.out.find("no HID devices") != std::string::npos || r.out.find("udev rule") != std::string::npos)
         << r.out;
+    // Neither vendor's runtime is installed here.
+    EXPECT_NE(r.out.find("  none: libHD.so not found (searched by the dynamic loader"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  none: libdhd.so not found (searched by the dynamic loader"), std::string::npos) << r.out;
+
+    // With the fake runtimes on the loader's path: the devices they report.
+    ::setenv("LD_LIBRARY_PATH", VOX_FAKE_VENDOR_DIR, 1);
+    const auto found = run_voxsculpt("devices");
+    ::unsetenv("LD_LIBRARY_PATH");
+    ASSERT_EQ(found.exit_code, 0) << found.err;
+    EXPECT_NE(found.out.find("  Touch (fake), serial 41295300123, maximum force 3.30 N"), std::string::npos) << found.out;
+    EXPECT_NE(found.out.find("  omega.6 (fake), serial 1207, maximum force 12.00 N"), std::string::npos) << found.out;
 }
 
 TEST(Cli, QuietPrintsNothingOnSuccess)

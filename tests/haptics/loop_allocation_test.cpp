@@ -1,10 +1,13 @@
 // The 1 kHz path never allocates: a lockstep loop ticking a scripted device through free space,
 // a press into a surface snapshot, a jab that the tool's mesh sweep stops at the surface and a
-// pull back, counted by this test program's own operator new (plain and aligned). Eigen's own
+// pull back, and the OpenHaptics and Force Dimension backends through the tests' fake vendor
+// libraries, counted by this test program's own operator new (plain and aligned). Eigen's own
 // heap use goes to malloc and is not counted; the loop uses fixed-size Eigen types only.
 
 #include "haptics/coupled_tool.hpp"
+#include "haptics/forcedimension_device.hpp"
 #include "haptics/haptic_loop.hpp"
+#include "haptics/openhaptics_device.hpp"
 #include "haptics/virtual_device.hpp"
 #include "surface_snapshots.hpp"
 
@@ -121,4 +124,31 @@ TEST(HapticLoop, OneLoopServesTwoDevicesEachWithItsOwnSafetyWithoutAllocating)
     EXPECT_GT(left.proxy().position.x(), -9.0);
     EXPECT_LT(left.proxy().position.x(), -7.0); // each proxy followed its own device
     EXPECT_GT(right.proxy().position.x(), 7.0);
+}
+
+TEST(HapticLoop, TheVendorBackendsTickWithoutAllocating)
+{
+    // Both force-feedback backends (through the tests' fake vendor libraries) served by one loop
+    // in lockstep, through a fault of the Force Dimension device and its return.
+    ::setenv("VOX_LIBHD", VOX_FAKE_VENDOR_DIR "/libHD.so", 1);
+    ::setenv("VOX_LIBDHD", VOX_FAKE_VENDOR_DIR "/libdhd.so", 1);
+    ::setenv("FAKE_DHD_FAULT", "100 150", 1);
+    haptics::OpenHapticsDevice touch;
+    haptics::ForceDimensionDevice omega;
+    const haptics::ForceModel push = [](const haptics::DeviceState& s, double& age) {
+        age = 0.0;
+        return Eigen::Vector3d(0.0, 0.0, -0.01 * s.position_mm.z() - 1.0);
+    };
+    std::vector<haptics::HapticChannel> channels;
+    channels.push_back({&touch, push, haptics::SafetySettings{}, {}});
+    channels.push_back({&omega, push, haptics::SafetySettings{}, {}});
+    haptics::HapticLoop loop(std::move(channels), 0);
+    loop.tick(0.0);
+    g_allocations = 0;
+    g_counting = true;
+    for (int k = 1; k <= 300; ++k) loop.tick(1e-3 * k);
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0);
+    EXPECT_EQ(omega.fault(), nullptr);
+    EXPECT_GT(loop.force(0).norm(), 0.1);
 }
