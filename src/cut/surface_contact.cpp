@@ -3,6 +3,8 @@
 #include "grid/hex8.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <unordered_map>
 
 namespace vox::cut {
@@ -121,6 +123,16 @@ void gather_on_nodes(const ModelSurface& surface, const std::vector<std::uint32_
 
 } // namespace
 
+VertexWeights vertex_weights(const Eigen::Vector3d& local)
+{
+    VertexWeights out;
+    double total = 0.0;
+    for (int c = 0; c < 8; ++c) total += std::abs(out.force[static_cast<std::size_t>(c)] = grid::hex8_shape(c, local));
+    for (std::size_t c = 0; c < 8; ++c) out.stiffness[c] = std::abs(out.force[c]) * total;
+    return out;
+}
+
+
 SurfaceContact touch_surface(const ModelSurface& surface, const std::vector<Eigen::Vector3d>& node_positions,
                              const contact::PlacedShape& tool, const contact::ContactParameters& parameters,
                              const contact::PlacedShape* from)
@@ -213,14 +225,14 @@ SurfaceContact touch_obstacle(const ModelSurface& surface, const std::vector<Eig
         out.pairs.push_back(std::move(pair));
         if (c.friction_stiffness_n_per_mm.isZero()) continue;
         const fem::HexElement& el = model.elements()[surface.vertex_element(v)];
-        for (int corner = 0; corner < 8; ++corner) {
-            const double w = grid::hex8_shape(corner, surface.vertex_local(v));
-            if (w == 0.0) continue;
+        const VertexWeights w = vertex_weights(surface.vertex_local(v));
+        for (std::size_t corner = 0; corner < 8; ++corner) {
+            if (w.force[corner] == 0.0) continue;
             const std::uint32_t node = el.dof_node[corner];
             auto [it, added] = node_index.emplace(node, out.nodes.size());
             if (added) out.nodes.push_back({node, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()});
-            out.nodes[it->second].force_n += w * c.across_force_n();
-            out.nodes[it->second].stiffness_n_per_m += w * 1e3 * c.friction_stiffness_n_per_mm;
+            out.nodes[it->second].force_n += w.force[corner] * c.across_force_n();
+            out.nodes[it->second].stiffness_n_per_m += w.stiffness[corner] * 1e3 * c.friction_stiffness_n_per_mm;
         }
     }
     return out;
@@ -248,14 +260,14 @@ std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const S
         if (v >= vertices.size() || vertices[v].users == 0 || vertices[v].key != contact.keys[c.point]) continue;
         const std::uint32_t e = surface.vertex_element(v);
         const Eigen::Matrix3d k = 1e3 * c.stiffness_matrix_n_per_mm(); // N/m
-        for (int corner = 0; corner < 8; ++corner) {
-            const double w = grid::hex8_shape(corner, surface.vertex_local(v));
-            if (w == 0.0) continue;
+        const VertexWeights w = vertex_weights(surface.vertex_local(v));
+        for (std::size_t corner = 0; corner < 8; ++corner) {
+            if (w.force[corner] == 0.0) continue;
             const std::uint32_t node = model.elements()[e].dof_node[corner];
             auto [it, added] = node_index.emplace(node, out.size());
             if (added) out.push_back({node, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()});
-            out[it->second].force_n += w * c.force_n;
-            out[it->second].stiffness_n_per_m += w * k;
+            out[it->second].force_n += w.force[corner] * c.force_n;
+            out[it->second].stiffness_n_per_m += w.stiffness[corner] * k;
         }
     }
     return out;

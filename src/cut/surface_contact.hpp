@@ -9,6 +9,7 @@
 #include "cut/model_surface.hpp"
 #include "fem/implicit_solver.hpp"
 
+#include <array>
 #include <vector>
 
 namespace vox::cut {
@@ -50,10 +51,28 @@ struct SurfaceContact {
 /// surface point as a pair contact's side: fem/pair_contact.hpp).
 void add_vertex_terms(const ModelSurface& surface, std::uint32_t v, double weight, std::vector<fem::BlockWeight>& terms);
 
+/// A surface vertex's trilinear weights on its element's corners, and the weights its stiffness is
+/// lumped onto them by. Marching cubes may place a vertex up to half a voxel outside its element's
+/// cell (between a voxel of the cell and one of the next), where some weights are slightly
+/// negative. A force is shared by the weights (it acts at the vertex, exactly); a stiffness lumped
+/// by them would be negative on those corners, and on a corner node little else holds it made the
+/// step's matrix indefinite (a brain pressed by a probe at level 4: the warped Cholesky factor
+/// failed at such a node 10 mm above the surface, CG stalled and the node ran off to 1.9 m). The
+/// stiffness is lumped by |w_i| sum_j |w_j| instead: a diagonal that bounds the exact rank-one
+/// term w w^T from above (diagonally dominant), so positive semidefinite, and equal to w_i where
+/// no weight is negative (they sum to 1).
+struct VertexWeights {
+    std::array<double, 8> force{};     ///< trilinear, hex8 corner order
+    std::array<double, 8> stiffness{}; ///< |w_i| sum_j |w_j|
+};
+/// The weights of a point at `local` (its element's cell coordinates, [0, 1]^3 inside).
+[[nodiscard]] VertexWeights vertex_weights(const Eigen::Vector3d& local);
+
 /// The contact's forces gathered on the nodes of `surface`'s model: each point's force shared by
-/// the corners of its element with the trilinear weights, the penalty stiffness lumped the same
-/// way. After a cut has rebuilt the model, this carries a contact over to the new nodes; points
-/// whose surface vertex the cut replaced are dropped (the next frame finds the new ones).
+/// the corners of its element with the trilinear weights, the penalty stiffness lumped by the
+/// stiffness weights above. After a cut has rebuilt the model, this carries a contact over to the
+/// new nodes; points whose surface vertex the cut replaced are dropped (the next frame finds the
+/// new ones).
 [[nodiscard]] std::vector<fem::NodeContact> node_contacts(const ModelSurface& surface, const SurfaceContact& contact);
 
 /// Fills `out` with the surface points within `box` (world mm) of the surface deformed by
