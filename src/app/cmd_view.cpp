@@ -31,9 +31,10 @@ void add_view_command(CLI::App& app)
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--screenshot", args->options.screenshot, "With --exit-after: write the last picture to this PNG file");
     cmd->add_option("--device", args->options.devices,
-                    "What drives a tool: auto (a 6-DoF controller if one can be opened, else the mouse; default), mouse, hid, or script "
-                    "(the tool follows its script). Once per device, each with its --tool")
-        ->check(CLI::IsMember({"auto", "mouse", "hid", "script"}));
+                    "What drives a tool: auto (a 6-DoF controller if one can be opened, else the mouse; default), mouse, hid, "
+                    "openhaptics or forcedimension (force-feedback devices, docs/devices.md), or script (the tool follows its script). "
+                    "Once per device, each with its --tool")
+        ->check(CLI::IsMember({"auto", "mouse", "hid", "openhaptics", "forcedimension", "script"}));
     cmd->add_option("--tool", args->options.tools,
                     "The tool a device drives, once per --device in the same order (default, one device: the scene's first tool; TAB moves it)");
     cmd->add_option("--solver", args->options.solver, "Simulate with this method instead of the scene's solver.type: dbg, isxfem or shape_matching")

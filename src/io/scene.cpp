@@ -661,6 +661,15 @@ ToolSpec read_tool(JsonReader r, const std::vector<ToolSpec>& declared, SolverTy
     t.wet_rate_per_s = r.optional("wet_rate_per_s", t.wet_rate_per_s, half_open_range(0.0, 1e3));
     t.burr_speed_rpm = r.optional("burr_speed_rpm", t.burr_speed_rpm, half_open_range(0.0, 1e6));
     t.drill_rate_mm3_per_n_rev = r.optional("drill_rate_mm3_per_n_rev", t.drill_rate_mm3_per_n_rev, half_open_range(0.0, 1.0));
+    if (const std::optional<JsonNode> node = r.optional_node("device_frame")) {
+        JsonReader f(*node);
+        DeviceFrameSpec frame;
+        if (const std::optional<JsonNode> origin = f.optional_node("origin_mm")) frame.origin_mm = finite_vector(*origin);
+        if (const std::optional<JsonNode> turn = f.optional_node("rotation_wxyz")) frame.rotation = unit_quaternion(*turn);
+        frame.scale = f.optional("scale", frame.scale, half_open_range(0.0, 100.0));
+        f.finish("for a device frame");
+        t.device_frame = frame;
+    }
     if (const std::optional<JsonNode> node = r.optional_node("haptic_subdivision")) {
         t.haptic_subdivision = r.optional("haptic_subdivision", t.haptic_subdivision, closed_range(-1, 3));
         // The patch's layer sits on the surface it was built on: a cut or a burr changes that

@@ -304,6 +304,13 @@ enum class CutMode {
 /// contact (5 N/mm per cm^2), so the proxy is where the script puts it until the material holds it.
 constexpr double k_script_coupling_n_per_mm = 100.0;
 
+/// A tool's `"device_frame"` (ToolSpec::device_frame).
+struct DeviceFrameSpec {
+    Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+    double scale = 1.0; ///< scene mm per device mm, in (0, 100]
+};
+
 /// A tool the script (or a haptic device) moves. Lengths in the tool's own frame, mm.
 ///
 /// Contact model (docs/scene-format.md, "tools"): the shape below is the inner (cutting) shape;
@@ -355,6 +362,11 @@ struct ToolSpec {
     /// what drives it (the script, a device), N/mm, in (0, 1e6]. Absent: a script-driven tool's
     /// is k_script_coupling_n_per_mm, a device's the device's own (contact/proxy.hpp).
     std::optional<double> coupling_stiffness_n_per_mm;
+    /// Where a force-feedback device's own frame lies in the scene (`"device_frame"`): scene =
+    /// origin + scale x rotation x device position. Absent: the device's origin at the tool's
+    /// first script position (else above the object, as the viewer places a tool), its axes the
+    /// scene's, scale 1 (haptics/framed_device.hpp).
+    std::optional<DeviceFrameSpec> device_frame;
     /// Haptic subdivision at the contact (contact/contact_patch.hpp): the Loop subdivisions, 0 to
     /// 3, of the surface patch the haptic loop presses, which gives under the tool between
     /// frames as the FEM would; -1 (the default): no patch, the snapshot stays rigid between

@@ -3,8 +3,11 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "haptics/coupled_tool.hpp"
+#include "haptics/forcedimension_device.hpp"
+#include "haptics/framed_device.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/hid_devices.hpp"
+#include "haptics/openhaptics_device.hpp"
 #include "haptics/pointer_device.hpp"
 #include "haptics/spacemouse_device.hpp"
 #include "io/scene.hpp"
@@ -146,7 +149,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             log::info("no HID devices ({}); the mouse drives the tool", e.what());
         }
     }
-    bool mouse_taken = false;
+    bool mouse_taken = false, openhaptics_taken = false;
+    int forcedimension_taken = 0;
     for (std::size_t d = 0; d < driven.size(); ++d) {
         const std::string& kind = options.devices[d];
         const io::ToolPose& at = starts[d];
@@ -159,6 +163,20 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             const haptics::HidDevice c = controllers.front();
             controllers.erase(controllers.begin());
             owned.push_back(std::make_unique<haptics::SpaceMouseDevice>(c.path, c.product, at.position_mm, at.orientation));
+        } else if (kind == "openhaptics" || kind == "forcedimension") {
+            // An absolute device: its frame placed in the scene (the tool's "device_frame", else
+            // its origin where the tool starts), its first button a clutch.
+            if (kind == "openhaptics") {
+                if (openhaptics_taken) throw InputError("--device openhaptics: one OpenHaptics device (the default one) can be used");
+                openhaptics_taken = true;
+                owned.push_back(std::make_unique<haptics::OpenHapticsDevice>());
+            } else {
+                owned.push_back(std::make_unique<haptics::ForceDimensionDevice>(forcedimension_taken++));
+            }
+            haptics::DeviceFrame frame{at.position_mm, Eigen::Quaterniond::Identity(), 1.0};
+            if (const auto& f = scene.tools[driven[d]].device_frame) frame = {f->origin_mm, f->rotation, f->scale};
+            haptics::Device& vendor = *owned.back();
+            owned.push_back(std::make_unique<haptics::FramedDevice>(vendor, frame));
         } else { // the mouse
             if (mouse_taken) throw InputError("--device: the mouse can drive one tool only (device " + std::to_string(d + 1) + ")");
             mouse_taken = true;

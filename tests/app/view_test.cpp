@@ -9,6 +9,9 @@
 #include <stb/stb_image.h>
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <sys/wait.h>
 #include <memory>
 
 using namespace vox::test;
@@ -47,4 +50,28 @@ TEST(View, WithoutADisplayItSaysSoAndExits)
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("no window"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("xvfb-run"), std::string::npos) << r.err;
+}
+
+TEST(View, AForceFeedbackDeviceDrivesTheToolThroughItsVendorsLibrary)
+{
+    // The tests' fake libdhd.so (docs/devices.md): an omega that moves down 2 mm/s from where the
+    // tool starts. The viewer opens it, places its frame at the tool, and runs to the end.
+    if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) GTEST_SKIP() << "xvfb-run is not installed (scripts/install-deps.sh installs it)";
+    ScratchDir dir;
+    const std::string scene = quote(std::string(VOX_SOURCE_DIR) + "/data/scenes/wet_push.json");
+    const std::string env = "VOX_LIBDHD=" + quote(VOX_FAKE_VENDOR_DIR "/libdhd.so") + " FAKE_DHD_PATH='0 0 0 0 0 -0.002' ";
+    const std::string command = env + "xvfb-run -a -s '-screen 0 1280x1024x24' " + quote(VOX_VOXSCULPT_EXE) + " view " + scene +
+                                " --device forcedimension --size 320x240 --exit-after 2 > " + quote(dir.path("log.txt")) + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+    std::ifstream in(dir.path("log.txt"));
+    const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(log.find("is driven by: Force Dimension omega.6 (fake)"), std::string::npos) << log;
+
+    // Without the library: one line naming it, exit 2.
+    const std::string missing = "VOX_LIBHD=/nonexistent/libHD.so xvfb-run -a -s '-screen 0 1280x1024x24' " + quote(VOX_VOXSCULPT_EXE) +
+                                " view " + scene + " --device openhaptics --exit-after 1 > " + quote(dir.path("missing.txt")) + " 2>&1";
+    EXPECT_EQ(WEXITSTATUS(std::system(missing.c_str())), 2);
+    std::ifstream m(dir.path("missing.txt"));
+    const std::string said((std::istreambuf_iterator<char>(m)), std::istreambuf_iterator<char>());
+    EXPECT_NE(said.find("/nonexistent/libHD.so not found (from VOX_LIBHD)"), std::string::npos) << said;
 }

@@ -676,7 +676,10 @@ TEST(SceneParse, BadToolContactKeysNameTheKeyPath)
     EXPECT_EQ(with_key("cut_pressure", 1e4),
               "s.json: tools[1].cut_pressure: unknown key for a blade tool (known keys: name, shape, size_mm, action, "
               "cut_mode, push_margin_mm, contact_stiffness_n_per_mm, coupling_stiffness_n_per_mm, cut_pressure_pa, wet_rate_per_s, burr_speed_rpm, "
-              "drill_rate_mm3_per_n_rev, haptic_subdivision, two_phase)");
+              "drill_rate_mm3_per_n_rev, device_frame, haptic_subdivision, two_phase)");
+    EXPECT_EQ(with_key("device_frame", {{"scale", 0}}), "s.json: tools[1].device_frame.scale: must be in (0, 100], got 0");
+    EXPECT_EQ(with_key("device_frame", {{"origin", {0, 0, 0}}}).rfind("s.json: tools[1].device_frame.origin: unknown key for a device frame", 0), 0u);
+    EXPECT_EQ(with_key("device_frame", {{"rotation_wxyz", {0, 0, 0, 0}}}).rfind("s.json: tools[1].device_frame.rotation_wxyz: the quaternion's norm 0", 0), 0u);
     EXPECT_EQ(with_key("haptic_subdivision", 4).rfind("s.json: tools[1].haptic_subdivision: must be in [-1, 3]", 0), 0u);
     // (A blade cuts by default.)
     EXPECT_EQ(with_key("haptic_subdivision", 1).rfind("s.json: tools[1].haptic_subdivision: haptic subdivision is for tools that push or wet", 0),
@@ -1032,3 +1035,20 @@ TEST(SceneMalformed, UnknownKeyIsRefusedAtEveryNestingLevel)
 }
 
 } // namespace
+
+TEST(SceneParse, ADeviceFrameIsReadWithItsDefaults)
+{
+    json tools = json::array({{{"name", "probe"}, {"shape", "sphere"}, {"radius_mm", 4},
+                               {"device_frame", {{"origin_mm", {10, 20, 30}}, {"rotation_wxyz", {0, 0, 0, 2}}, {"scale", 2.5}}}},
+                              {{"name", "other"}, {"shape", "sphere"}, {"radius_mm", 4}, {"device_frame", json::object()}},
+                              {{"name", "none"}, {"shape", "sphere"}, {"radius_mm", 4}}});
+    const Scene s = parse_scene(scene_with_tools(tools), "/tmp", "s.json");
+    ASSERT_TRUE(s.tools[0].device_frame.has_value());
+    EXPECT_EQ(s.tools[0].device_frame->origin_mm, Eigen::Vector3d(10, 20, 30));
+    EXPECT_TRUE(s.tools[0].device_frame->rotation.isApprox(Eigen::Quaterniond(0, 0, 0, 1), 1e-15)); // normalised
+    EXPECT_EQ(s.tools[0].device_frame->scale, 2.5);
+    ASSERT_TRUE(s.tools[1].device_frame.has_value());
+    EXPECT_EQ(s.tools[1].device_frame->origin_mm, Eigen::Vector3d::Zero());
+    EXPECT_EQ(s.tools[1].device_frame->scale, 1.0);
+    EXPECT_FALSE(s.tools[2].device_frame.has_value());
+}
