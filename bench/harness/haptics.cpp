@@ -26,6 +26,9 @@
 #include "haptics/coupled_tool.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/triple_buffer.hpp"
+#include "haptics/forcedimension_device.hpp"
+#include "haptics/framed_device.hpp"
+#include "haptics/openhaptics_device.hpp"
 #include "haptics/virtual_device.hpp"
 #include "io/scene_object.hpp"
 
@@ -119,19 +122,28 @@ struct HandPose {
 /// One device and its tool: the haptic thread's side (device, coupling) and what the threads share.
 struct Hand {
     std::size_t tool = 0;
-    haptics::VirtualDevice device;
+    std::unique_ptr<haptics::Device> vendor; ///< a force-feedback device the hand holds instead of a script (--device)
+    std::unique_ptr<haptics::Device> device; ///< what the loop reads: the script, or the vendor's device placed in the scene
     haptics::CoupledTool coupled;
     haptics::TripleBuffer<contact::SurfacePoints> snapshots; ///< simulation -> haptics
     haptics::TripleBuffer<HandPose> poses;                   ///< haptics -> simulation
     HandPose pose;                                           ///< simulation side: the last pose read
     std::atomic<bool> passing{false};                        ///< simulation -> haptics: the tool cuts through
     Hand(std::size_t t, std::vector<haptics::KeyFrame> frames, const contact::ToolShape& shape, const io::ToolSpec& spec, std::size_t capacity)
-        : tool(t), device(std::move(frames)),
+        : tool(t), device(std::make_unique<haptics::VirtualDevice>(std::move(frames))),
           coupled(shape, contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm}, haptics::CouplingSettings{}, capacity),
           snapshots(contact::SurfacePoints(capacity))
     {
     }
 };
+
+/// The safety stage of a device: clamped to its own maximum force where it declares one.
+haptics::SafetySettings safety_for(const haptics::Device& device)
+{
+    haptics::SafetySettings s;
+    if (device.limits().force_output && device.limits().max_force_n > 0.0) s.max_force_n = device.limits().max_force_n;
+    return s;
+}
 
 } // namespace
 
@@ -162,6 +174,14 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     sim::FrameLoop frame_loop(scene, *method, tools);
     std::vector<std::unique_ptr<Hand>> hands;
     hands.push_back(std::make_unique<Hand>(0, presses(seconds), tools.shape(0), scene.tools[0], snapshot_capacity));
+    if (options.device != "script") { // the knife in the hand on a force-feedback device, its centre where the script starts
+        Hand& knife = *hands.front();
+        if (options.device == "openhaptics") knife.vendor = std::make_unique<haptics::OpenHapticsDevice>();
+        else knife.vendor = std::make_unique<haptics::ForceDimensionDevice>();
+        haptics::DeviceState start;
+        knife.device->read(0.0, start);
+        knife.device = std::make_unique<haptics::FramedDevice>(*knife.vendor, haptics::DeviceFrame{start.position_mm, start.orientation, 1.0});
+    }
     if (devices > 1) hands.push_back(std::make_unique<Hand>(1, finger_presses(seconds), tools.shape(1), scene.tools[1], snapshot_capacity));
 
     using clock = std::chrono::steady_clock;
@@ -183,7 +203,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     for (std::size_t i = 0; i < hands.size(); ++i) {
         Hand* hand = hands[i].get();
         const bool knife = i == 0;
-        channels.push_back({&hand->device,
+        channels.push_back({hand->device.get(),
                             [&, hand, knife](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
                                 // The snapshot the last tick's prepare took (and measured the contact on).
                                 const contact::SurfacePoints& surface = hand->snapshots.read_slot();
@@ -205,13 +225,13 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                                 hand->poses.publish();
                                 return f;
                             },
-                            haptics::SafetySettings{},
+                            safety_for(*hand->device),
                             [hand](const haptics::DeviceState& s) { hand->coupled.prepare(s, hand->snapshots.latest(), 1e-3); }});
     }
     haptics::HapticLoop loop(std::move(channels), capacity);
 
-    log::info("bench haptics: 1 kHz loop for {} s, {} device(s), against a cutting simulation ({}, {}){}", seconds, hands.size(), scene.source,
-              io::solver_type_name(method_type), lockstep ? ", lockstep" : "");
+    log::info("bench haptics: 1 kHz loop for {} s, {} device(s) (the knife's: {}), against a cutting simulation ({}, {}){}", seconds, hands.size(),
+              hands.front()->device->name(), scene.source, io::solver_type_name(method_type), lockstep ? ", lockstep" : "");
     if (!lockstep) loop.start();
     std::vector<double> lockstep_force_us, lockstep_work_us;
     int frames = 0, cutting_frames = 0;
@@ -219,7 +239,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
     for (const std::unique_ptr<Hand>& hand : hands) { // the devices' first poses, until the loop reports
         hand->pose.proxy = hand->coupled.proxy();
         haptics::DeviceState first;
-        hand->device.read(0.0, first);
+        hand->device->read(0.0, first);
         hand->pose.proxy.position = hand->pose.driver = first.position_mm;
     }
     while (lockstep ? frames * scene.solver.dt_s < seconds : now_s() < seconds) {

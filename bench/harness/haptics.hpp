@@ -3,6 +3,8 @@
 
 #include "io/scene.hpp"
 
+#include <string>
+
 namespace vox::bench {
 
 struct HapticsBenchOptions {
@@ -15,6 +17,10 @@ struct HapticsBenchOptions {
     /// The finger's `haptic_subdivision` (contact/contact_patch.hpp): -1 (off, the default of
     /// every tool) or a level 0 - 3, to time its patch.
     int finger_subdivision = -1;
+    /// What holds the knife: "script" (a scripted device pressing it, the default), or a
+    /// force-feedback device, "openhaptics" or "forcedimension" (docs/devices.md), its centre
+    /// placed where the script starts. Not with lockstep.
+    std::string device = "script";
 };
 
 /// Runs the 1 kHz loop beside the press-and-cut simulation and prints its timing table.

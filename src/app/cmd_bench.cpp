@@ -63,11 +63,17 @@ void add_bench_command(CLI::App& app)
     haptics->add_option("--haptic-subdivision", *finger_subdivision,
                         "With --devices 2: the finger's haptic_subdivision, -1 (off, default) or 0 - 3, to time its contact patch")
         ->check(CLI::Range(-1, 3));
-    haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep, finger_subdivision] {
+    auto knife_device = std::make_shared<std::string>("script");
+    haptics->add_option("--device", *knife_device,
+                        "What holds the knife: script (default), or a force-feedback device, openhaptics or forcedimension (docs/devices.md)")
+        ->check(CLI::IsMember({"script", "openhaptics", "forcedimension"}));
+    haptics->callback([seconds, isxfem, haptics_solver, devices, lockstep, finger_subdivision, knife_device] {
         if (*finger_subdivision >= 0 && *devices < 2)
             throw CLI::ValidationError("--haptic-subdivision", "times the finger's contact patch, and the finger is the second device: add --devices 2");
+        if (*lockstep && *knife_device != "script")
+            throw CLI::ValidationError("--lockstep", "ticks in simulated time, which a hand on a device does not keep: leave out --device");
         run_haptics_bench({*seconds, *isxfem ? io::SolverType::isxfem : io::solver_type_named(*haptics_solver), *devices, *lockstep,
-                           *finger_subdivision});
+                           *finger_subdivision, *knife_device});
     });
 
     auto glide_out = std::make_shared<std::string>("out");
