@@ -55,6 +55,57 @@ std::string pydicom_samples()
     return dir;
 }
 
+/// What pydicom reads of the series `uid` in `dir` (searched with its sub-folders; "": every
+/// DICOM image there): its slices sorted along their normal, the first one's position, the mean
+/// gap between positions along the normal, the smallest gap over the largest, and every voxel's
+/// value after the rescale (slope 1 and intercept 0 where a file has none), slice after slice.
+struct PydicomSeries {
+    Eigen::Vector3d first_position = Eigen::Vector3d::Zero();
+    double mean_gap_mm = 0.0;
+    double gap_ratio = 0.0;
+    std::vector<double> values;
+};
+
+PydicomSeries read_with_pydicom(const std::string& dir, const std::string& uid)
+{
+    const ScratchDir scratch;
+    const std::string out = scratch.path("values.txt");
+    const std::string script =
+        "import glob, sys, numpy as np, pydicom\n"
+        "s = []\n"
+        "for f in glob.glob(sys.argv[1] + '/**/*', recursive=True):\n"
+        "    try: d = pydicom.dcmread(f)\n"
+        "    except Exception: continue\n"
+        "    if 'PixelData' in d and sys.argv[2] in ('', getattr(d, 'SeriesInstanceUID', '')): s.append(d)\n"
+        "o = np.array(s[0].ImageOrientationPatient, float)\n"
+        "n = np.cross(o[:3], o[3:])\n"
+        "s.sort(key=lambda d: n @ np.array(d.ImagePositionPatient, float))\n"
+        "along = np.array([n @ np.array(d.ImagePositionPatient, float) for d in s])\n"
+        "gaps = np.diff(along)\n"
+        "with open(sys.argv[3], 'w') as f:\n"
+        "    f.write(' '.join(str(float(x)) for x in s[0].ImagePositionPatient) + '\\n')\n"
+        "    f.write('%r %r\\n' % ((along[-1] - along[0]) / (len(s) - 1), gaps.min() / gaps.max()))\n"
+        "    for d in s:\n"
+        "        v = d.pixel_array * float(getattr(d, 'RescaleSlope', 1)) + float(getattr(d, 'RescaleIntercept', 0))\n"
+        "        f.write(' '.join(str(float(x)) for x in v.ravel()) + '\\n')\n";
+    (void)scratch.write("read.py", script);
+    EXPECT_EQ(vox::test::run_python(scratch.path("read.py"), {dir, uid, out}), 0);
+    PydicomSeries r;
+    std::ifstream in(out);
+    in >> r.first_position.x() >> r.first_position.y() >> r.first_position.z() >> r.mean_gap_mm >> r.gap_ratio;
+    for (double value = 0.0; in >> value;) r.values.push_back(value);
+    return r;
+}
+
+/// Voxels of `v` whose scaled value differs from pydicom's (all of them when the counts differ).
+std::int64_t differences(const Volume& v, const PydicomSeries& p)
+{
+    if (static_cast<std::int64_t>(p.values.size()) != v.voxel_count()) return v.voxel_count();
+    std::int64_t different = 0;
+    for (std::int64_t i = 0; i < v.voxel_count(); ++i) different += p.values[static_cast<std::size_t>(i)] != v.scaled(i);
+    return different;
+}
+
 /// Every voxel's scaled value equal, slices [0, slices) of `expected` against `got`.
 void expect_same_values(const Volume& expected, const Volume& got, std::int64_t slices)
 {
@@ -255,36 +306,9 @@ TEST(DicomReader, AScannerExportBesideOtherSeriesAndADamagedDicomdirReadsAsPydic
     const Volume v = read_dicom(dir, uid);
     ASSERT_EQ(v.dims, (std::array<std::int64_t, 3>{16, 16, 5}));
 
-    const ScratchDir scratch;
-    const std::string out = scratch.path("hu.txt");
-    const std::string script =
-        "import glob, sys, numpy as np, pydicom\n"
-        "s = []\n"
-        "for f in glob.glob(sys.argv[1] + '/**/*', recursive=True):\n"
-        "    try: d = pydicom.dcmread(f)\n"
-        "    except Exception: continue\n"
-        "    if getattr(d, 'SeriesInstanceUID', '') == sys.argv[2]: s.append(d)\n"
-        "o = np.array(s[0].ImageOrientationPatient, float)\n"
-        "n = np.cross(o[:3], o[3:])\n"
-        "s.sort(key=lambda d: n @ np.array(d.ImagePositionPatient, float))\n"
-        "with open(sys.argv[3], 'w') as f:\n"
-        "    f.write(' '.join(str(float(x)) for x in s[0].ImagePositionPatient) + '\\n')\n"
-        "    for d in s:\n"
-        "        hu = d.pixel_array * float(d.RescaleSlope) + float(d.RescaleIntercept)\n"
-        "        f.write(' '.join(str(float(x)) for x in hu.ravel()) + '\\n')\n";
-    (void)scratch.write("read.py", script);
-    ASSERT_EQ(vox::test::run_python(scratch.path("read.py"), {dir, uid, out}), 0);
-    std::ifstream in(out);
-    Eigen::Vector3d origin;
-    in >> origin.x() >> origin.y() >> origin.z();
-    EXPECT_TRUE((v.index_to_world.topRightCorner<3, 1>().isApprox(origin, 1e-9)));
-    std::int64_t different = 0;
-    for (std::int64_t i = 0; i < v.voxel_count(); ++i) {
-        double hu = 0.0;
-        ASSERT_TRUE(static_cast<bool>(in >> hu)) << "voxel " << i;
-        if (hu != v.scaled(i)) ++different;
-    }
-    EXPECT_EQ(different, 0);
+    const PydicomSeries p = read_with_pydicom(dir, uid);
+    EXPECT_TRUE((v.index_to_world.topRightCorner<3, 1>().isApprox(p.first_position, 1e-9)));
+    EXPECT_EQ(differences(v, p), 0);
 }
 
 namespace {
@@ -303,34 +327,10 @@ TEST(DicomReader, ARealSeriesWithRoundedPositionsReadsOnItsEvenGridAsPydicomRead
     const Volume v = read_dicom(k_ge_rounded);
     ASSERT_EQ(v.dims, (std::array<std::int64_t, 3>{256, 256, 20}));
 
-    const ScratchDir scratch;
-    const std::string out = scratch.path("values.txt");
-    const std::string script =
-        "import glob, sys, numpy as np, pydicom\n"
-        "s = [pydicom.dcmread(f) for f in glob.glob(sys.argv[1] + '/*.dcm')]\n"
-        "o = np.array(s[0].ImageOrientationPatient, float)\n"
-        "n = np.cross(o[:3], o[3:])\n"
-        "s.sort(key=lambda d: n @ np.array(d.ImagePositionPatient, float))\n"
-        "along = [n @ np.array(d.ImagePositionPatient, float) for d in s]\n"
-        "with open(sys.argv[2], 'w') as f:\n"
-        "    f.write('%r %r\\n' % ((along[-1] - along[0]) / (len(s) - 1), min(np.diff(along)) / max(np.diff(along))))\n"
-        "    for d in s:\n"
-        "        v = d.pixel_array * float(getattr(d, 'RescaleSlope', 1)) + float(getattr(d, 'RescaleIntercept', 0))\n"
-        "        f.write(' '.join(str(float(x)) for x in v.ravel()) + '\\n')\n";
-    (void)scratch.write("read.py", script);
-    ASSERT_EQ(vox::test::run_python(scratch.path("read.py"), {k_ge_rounded, out}), 0);
-    std::ifstream in(out);
-    double mean_gap = 0.0, gap_ratio = 0.0;
-    in >> mean_gap >> gap_ratio;
-    EXPECT_LT(gap_ratio, 0.985) << "the gaps are uneven beyond 1 %: what this series is here for";
-    EXPECT_NEAR((v.index_to_world.block<3, 1>(0, 2).norm()), mean_gap, 0.02);
-    std::int64_t different = 0;
-    for (std::int64_t i = 0; i < v.voxel_count(); ++i) {
-        double value = 0.0;
-        ASSERT_TRUE(static_cast<bool>(in >> value)) << "voxel " << i;
-        if (value != v.scaled(i)) ++different;
-    }
-    EXPECT_EQ(different, 0);
+    const PydicomSeries p = read_with_pydicom(k_ge_rounded, "");
+    EXPECT_LT(p.gap_ratio, 0.985) << "the gaps are uneven beyond 1 %: what this series is here for";
+    EXPECT_NEAR((v.index_to_world.block<3, 1>(0, 2).norm()), p.mean_gap_mm, 0.02);
+    EXPECT_EQ(differences(v, p), 0);
 }
 
 TEST(DicomReader, ARealSeriesWithASliceTakenOutIsStillRefused)
