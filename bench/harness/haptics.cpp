@@ -137,14 +137,6 @@ struct Hand {
     }
 };
 
-/// The safety stage of a device: clamped to its own maximum force where it declares one.
-haptics::SafetySettings safety_for(const haptics::Device& device)
-{
-    haptics::SafetySettings s;
-    if (device.limits().force_output && device.limits().max_force_n > 0.0) s.max_force_n = device.limits().max_force_n;
-    return s;
-}
-
 } // namespace
 
 void run_haptics_bench(const HapticsBenchOptions& options)
@@ -225,7 +217,7 @@ void run_haptics_bench(const HapticsBenchOptions& options)
                                 hand->poses.publish();
                                 return f;
                             },
-                            safety_for(*hand->device),
+                            haptics::safety_for(hand->device->limits()),
                             [hand](const haptics::DeviceState& s) { hand->coupled.prepare(s, hand->snapshots.latest(), 1e-3); }});
     }
     haptics::HapticLoop loop(std::move(channels), capacity);

@@ -7,6 +7,8 @@
 //  - when the contact snapshot the force came from is older than the stale limit (50 ms), the
 //    force fades linearly to zero over the fade interval, and stays zero until a fresh snapshot.
 
+#include "haptics/device.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -21,6 +23,14 @@ struct SafetySettings {
     double stale_s = 0.05;      ///< snapshot age beyond which the force fades
     double fade_s = 0.05;       ///< how long the fade takes
 };
+
+/// A device's safety settings: the defaults, clamped to its own maximum force where it declares one.
+[[nodiscard]] inline SafetySettings safety_for(const DeviceLimits& limits)
+{
+    SafetySettings s;
+    if (limits.force_output && limits.max_force_n > 0.0) s.max_force_n = limits.max_force_n;
+    return s;
+}
 
 class ForceSafety {
 public:

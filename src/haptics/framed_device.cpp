@@ -8,6 +8,11 @@ FramedDevice::FramedDevice(Device& inner, const DeviceFrame& frame, std::uint32_
     m_frame.rotation.normalize();
 }
 
+Eigen::Vector3d FramedDevice::to_scene(const Eigen::Vector3d& device_mm) const noexcept
+{
+    return m_frame.origin_mm + m_frame.scale * (m_frame.rotation * device_mm);
+}
+
 bool FramedDevice::read(double t_s, DeviceState& state) noexcept
 {
     DeviceState hand = state; // where the inner device leaves it on a failed read
@@ -17,7 +22,7 @@ bool FramedDevice::read(double t_s, DeviceState& state) noexcept
     if (clutch && !m_clutched) { // the tool stays where the last reading put it (the first: where this one would)
         m_held = state;
         if (!m_started) {
-            m_held.position_mm = m_frame.origin_mm + m_frame.scale * (m_frame.rotation * hand.position_mm);
+            m_held.position_mm = to_scene(hand.position_mm);
             m_held.orientation = hand_turn;
         }
     }
@@ -35,7 +40,7 @@ bool FramedDevice::read(double t_s, DeviceState& state) noexcept
         state.orientation = m_held.orientation;
         return true;
     }
-    state.position_mm = m_frame.origin_mm + m_frame.scale * (m_frame.rotation * hand.position_mm);
+    state.position_mm = to_scene(hand.position_mm);
     state.orientation = (m_turn * hand_turn).normalized();
     return true;
 }

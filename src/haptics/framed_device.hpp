@@ -36,6 +36,9 @@ public:
     [[nodiscard]] const DeviceFrame& frame() const noexcept { return m_frame; }
 
 private:
+    /// A point of the device's frame in the scene's.
+    [[nodiscard]] Eigen::Vector3d to_scene(const Eigen::Vector3d& device_mm) const noexcept;
+
     Device& m_inner;
     DeviceFrame m_frame;
     std::uint32_t m_clutch_mask;

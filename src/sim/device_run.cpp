@@ -89,9 +89,7 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const Devi
     std::vector<haptics::HapticChannel> channels;
     for (const std::unique_ptr<Hand>& owned : m_hands) {
         Hand* hand = owned.get();
-        haptics::SafetySettings safety;
-        const haptics::DeviceLimits& limits = hand->device->limits();
-        if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
+        const haptics::SafetySettings safety = haptics::safety_for(hand->device->limits());
         channels.push_back({hand->device.get(),
                             [this, hand](const haptics::DeviceState& state, double& age) {
                                 age = state.t_s - hand->snapshot.t_s;

@@ -206,9 +206,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     auto tool_of = [&](std::size_t d) { return single ? requests.active.load(std::memory_order_relaxed) : static_cast<int>(driven[d]); };
     std::vector<haptics::HapticChannel> served;
     for (std::size_t d = 0; d < driven.size(); ++d) {
-        haptics::SafetySettings safety;
-        const haptics::DeviceLimits& limits = devices[d]->limits();
-        if (limits.force_output && limits.max_force_n > 0.0) safety.max_force_n = limits.max_force_n;
+        const haptics::SafetySettings safety = haptics::safety_for(devices[d]->limits());
         const bool mouse = devices[d] == &pointer;
         served.push_back({devices[d],
                           [&, d, mouse](const haptics::DeviceState& s, double& age) -> Eigen::Vector3d {
