@@ -389,7 +389,6 @@ StepFigures DbgMethod::step()
     out.inverted_elements = shapes.inverted;
     out.max_stretch = shapes.max_stretch;
     out.most_stretched_mm = {1e3 * shapes.most_stretched_m.x(), 1e3 * shapes.most_stretched_m.y(), 1e3 * shapes.most_stretched_m.z()};
-    out.max_displacement_mm = s.max_displacement_m * 1e3;
     out.energy_projected = s.energy_projected;
     out.recovered = s.converged && (s.newton_iterations > 0 || s.substeps > 0);
     out.preconditioner_fallback = newly_failed(m_sim->solver().fallback_note(), m_fallback_reported);

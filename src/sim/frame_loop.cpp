@@ -7,6 +7,7 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace vox::sim {
@@ -38,6 +39,10 @@ FrameStats FrameLoop::next()
     }
     out.tools = m_tools.frame(*m_method, out.t_s, dt);
     if (!out.tools.hold_object) out.step = m_method->step(); // held: a two-phase cut is being marked
+    // The surface's displacement, not the nodes': a corner of a nearly empty element lies up to a
+    // cell outside the material, and its motion says nothing of the object's.
+    for (const Eigen::Vector3d& d : m_method->surface_displacements_mm())
+        out.step.max_displacement_mm = std::max(out.step.max_displacement_mm, d.norm());
     const StepFigures& s = out.step;
     if (!std::isfinite(s.kinetic_energy_j) || (s.elastic_energy_j && !std::isfinite(*s.elastic_energy_j)) || !std::isfinite(s.max_stretch))
         throw Diverged(m_scene.source + ": the simulation diverged at frame " + std::to_string(m_frame) +

@@ -46,7 +46,9 @@ struct StepFigures {
     int substeps = 0;
     double kinetic_energy_j = 0.0;
     std::optional<double> elastic_energy_j; ///< empty where the method does not measure it
-    double max_displacement_mm = 0.0;       ///< of any node from rest
+    /// The largest displacement of the object's surface from rest (FrameLoop measures it the same
+    /// way for every method): the material's, not that of an element corner lying outside it.
+    double max_displacement_mm = 0.0;
     /// Elements inverted after the step (hexahedra: the deformation gradient at the material
     /// centroid; uncut tetrahedra: the signed volume of their nodes); 0 for a healthy run.
     std::size_t inverted_elements = 0;
