@@ -3,16 +3,19 @@
 #include "core/atomic_file.hpp"
 #include "core/child_process.hpp"
 #include "core/error.hpp"
-#include "core/log.hpp"
 #include "core/memory_limit.hpp"
 #include "grid/voxel_limits.hpp"
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
-#include <iostream>
 #include <mutex>
 #include <sstream>
 
@@ -177,6 +180,11 @@ double read_seconds_allowed(std::uint64_t bytes) { return 3.0 + 0.1 * static_cas
 /// A reader's own message made fit for one line: a corrupt file can put its garbage into it
 /// (OpenVDB names the unknown map type it read), so control and non-ASCII bytes become '?',
 /// runs of white space one space, and it stops after 160 characters.
+/// The start of the refusal of a file without a label grid.
+const std::string k_no_label_grid = "holds no int32 label grid (found ";
+/// The start of the refusal of a grid whose transform OpenVDB cannot turn into a matrix.
+const std::string k_unusable_transform = "its grid transform is unusable (";
+
 std::string one_line(const std::string& text)
 {
     std::string out;
@@ -193,23 +201,49 @@ std::string one_line(const std::string& text)
     return out;
 }
 
-/// Reads the file in a child process first: OpenVDB's reader trusts the counts in a file, so a
-/// corrupt one can crash it, spin for ever or allocate gigabytes. Only when the child read it
-/// cleanly, within the memory limit and in time, does this process read the same bytes.
-void check_in_child(std::istringstream& in, const std::string& name, std::uint64_t bytes)
+/// The label grid of `in` (a .vdb's bytes), read in a child process and handed back written
+/// again by OpenVDB's own writer. OpenVDB's reader trusts the counts in a file, so a corrupt one
+/// can crash it, spin for ever, allocate gigabytes, or overrun a buffer that only a later free
+/// notices (a file with 7 bytes inserted read "cleanly", then aborted this process with "corrupted
+/// size vs. prev_size" long after). So this process never reads the file itself: only what
+/// OpenVDB wrote, from a grid the child read cleanly, within the memory limit and in time.
+std::string label_grid_read_in_child(std::istringstream& in, const std::string& name, std::uint64_t bytes)
 {
+    const int fd = memfd_create("voxsculpt-vdb", MFD_CLOEXEC);
+    if (fd < 0) throw file_error(name, std::string("cannot be read: memfd_create: ") + std::strerror(errno));
+    struct Closer {
+        int fd;
+        ~Closer() { close(fd); }
+    } closer{fd};
     const ChildLimits limits{memory_limit_bytes(), read_seconds_allowed(bytes), true};
     const ChildOutcome outcome = run_in_child(
         [&] {
             openvdb::io::Stream stream(in);
-            const openvdb::Int32Grid::Ptr grid = label_grid_of(*stream.getGrids());
-            if (grid) static_cast<void>(grid->activeVoxelCount()); // walks every node of the tree
+            const openvdb::GridPtrVecPtr grids = stream.getGrids();
+            const openvdb::Int32Grid::Ptr grid = label_grid_of(*grids);
+            if (!grid) throw std::runtime_error(k_no_label_grid + std::to_string(grids->size()) + " grid(s) of other types)");
+            static_cast<void>(grid->activeVoxelCount()); // walks every node of the tree
+            try { // a transform OpenVDB stored but cannot turn into a matrix (a zero scale) cannot be written either
+                static_cast<void>(from_vdb_transform(grid->transform()));
+            } catch (const openvdb::Exception& e) {
+                throw std::runtime_error(k_unusable_transform + std::string(e.what()) + ")");
+            }
+            std::ostringstream out;
+            openvdb::io::Stream(out).write(openvdb::GridCPtrVec{grid});
+            const std::string written = out.str();
+            for (std::size_t at = 0; at < written.size();) {
+                const ssize_t n = write(fd, written.data() + at, written.size() - at);
+                if (n <= 0) throw std::runtime_error(std::string("cannot hand the grid back: ") + std::strerror(errno));
+                at += static_cast<std::size_t>(n);
+            }
         },
         limits);
     const std::string corrupt = "not a readable OpenVDB file: ";
     switch (outcome.kind) {
-    case ChildOutcome::Kind::ok: return;
+    case ChildOutcome::Kind::ok: break;
     case ChildOutcome::Kind::failed:
+        if (outcome.message.rfind(k_no_label_grid, 0) == 0 || outcome.message.rfind(k_unusable_transform, 0) == 0)
+            throw file_error(name, one_line(outcome.message));
         throw file_error(name, "not a readable OpenVDB file (" + one_line(outcome.message) + ")");
     case ChildOutcome::Kind::out_of_memory:
         throw file_error(name, corrupt + "reading it needs more than the memory limit of " +
@@ -222,6 +256,15 @@ void check_in_child(std::istringstream& in, const std::string& name, std::uint64
         throw file_error(name, corrupt + "OpenVDB's reader crashed on it (" + signal_name(outcome.signal) +
                                    "; the file is corrupt)");
     }
+    const off_t size = lseek(fd, 0, SEEK_END);
+    if (size < 0 || lseek(fd, 0, SEEK_SET) != 0) throw file_error(name, std::string("cannot be read: ") + std::strerror(errno));
+    std::string clean(static_cast<std::size_t>(size), '\0');
+    for (std::size_t at = 0; at < clean.size();) {
+        const ssize_t n = read(fd, clean.data() + at, clean.size() - at);
+        if (n <= 0) throw file_error(name, std::string("cannot be read: ") + std::strerror(errno));
+        at += static_cast<std::size_t>(n);
+    }
+    return clean;
 }
 
 } // namespace
@@ -241,39 +284,21 @@ LabelGrid LabelGrid::load(const std::filesystem::path& path)
         file.read(bytes.data(), static_cast<std::streamsize>(size));
         if (!file || static_cast<std::uint64_t>(file.gcount()) != size) throw file_error(name, "cannot read it");
     }
-    // One copy of the bytes serves both reads, so the file cannot change between them.
     std::istringstream in(std::move(bytes));
-    check_in_child(in, name, size);
-    in.clear();
-    in.seekg(0);
+    std::istringstream clean(label_grid_read_in_child(in, name, size));
     openvdb::GridPtrVecPtr grids;
-    // OpenVDB's reader writes its warnings ("multi-buffer trees are no longer supported") to
-    // std::cerr itself; they go to the debug log instead, so a refusal stays one line.
-    std::ostringstream warnings;
-    std::streambuf* const cerr_buffer = std::cerr.rdbuf(warnings.rdbuf());
     try {
-        openvdb::io::Stream stream(in);
+        openvdb::io::Stream stream(clean);
         grids = stream.getGrids();
-    } catch (const std::exception& e) {
-        std::cerr.rdbuf(cerr_buffer);
+    } catch (const std::exception& e) { // not expected: OpenVDB reading what it wrote itself
         throw file_error(name, "not a readable OpenVDB file (" + one_line(e.what()) + ")");
     }
-    std::cerr.rdbuf(cerr_buffer);
-    std::string said = warnings.str();
-    std::replace(said.begin(), said.end(), '\n', ' ');
-    if (!said.empty()) log::debug("{}: OpenVDB: {}", name, said);
     openvdb::Int32Grid::Ptr found = label_grid_of(*grids);
-    if (!found) throw file_error(name, "holds no int32 label grid (found " + std::to_string(grids->size()) + " grid(s) of other types)");
+    if (!found) throw file_error(name, "holds no int32 label grid after all (an error of OpenVDB's reader or writer)");
     if (!found->transform().isLinear()) throw file_error(name, "the grid's transform is not affine");
     found->setName("labels");
-    // A transform OpenVDB stored but cannot turn into a matrix (a zero scale), or one no scan has:
-    // refused as a scan's would be (io/volume.cpp). Found by fuzzing.
-    Eigen::Matrix4d t;
-    try {
-        t = from_vdb_transform(found->transform());
-    } catch (const openvdb::Exception& e) {
-        throw file_error(name, std::string("its grid transform is unusable (") + e.what() + ")");
-    }
+    // A transform no scan has: refused as a scan's would be (io/volume.cpp). Found by fuzzing.
+    const Eigen::Matrix4d t = from_vdb_transform(found->transform()); // the child checked that it converts
     const Eigen::Vector3d spacing = t.topLeftCorner<3, 3>().colwise().norm();
     if (!t.allFinite() || !(spacing.minCoeff() >= k_min_voxel_mm) || !(t.topRightCorner<3, 1>().cwiseAbs().maxCoeff() <= k_max_world_mm))
         throw file_error(name, "its grid transform is not a scan's: voxel sizes below 0.0001 mm, an origin beyond 1e6 mm or a "

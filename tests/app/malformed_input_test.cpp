@@ -65,6 +65,7 @@ TEST(MalformedInput, FuzzFindingsAnswerInSecondsWithinTheMemoryLimit)
         {"vdb_hang_memory_a.vdb", "--max-memory-mb 512 info FILE", "memory limit of 512 MiB"},
         {"vdb_hang_memory_b.vdb", "--max-memory-mb 512 import FILE -o OUT/out.vdb", "memory limit of 512 MiB"},
         {"vdb_hang_spin.vdb", "--max-memory-mb 512 import FILE -o OUT/out.vdb", "did not finish within 3 s"},
+        {"vdb_heap_corruption.vdb", "--max-memory-mb 512 import FILE -o OUT/out.vdb", "not a readable OpenVDB file"},
         {"nii_gz_vox_offset_past_end.nii.gz", "import FILE -o OUT/out.vdb", "truncated"},
         {"nrrd_gzip_trailer_cut.nrrd", "info FILE", "ends before its checksum"},
         {"nrrd_huge_origin.nrrd", "info FILE", "beyond the 1e6 mm (1 km) limit"},

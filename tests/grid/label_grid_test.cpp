@@ -85,7 +85,8 @@ TEST(LabelGrid, LoadRefusesMissingAndForeignFiles)
 TEST(LabelGrid, CorruptFilesAreReadInAChildAndRefusedNamingTheFile)
 {
     // Fuzzing found these: OpenVDB's reader crashed on the first, grew to gigabytes on the next
-    // two and spun for ever on the last. Read in a child process, each is one message.
+    // two, spun for ever on the fourth and overran the heap on the fifth. Read in a child
+    // process, each is one message.
     const std::uint64_t saved = vox::memory_limit_bytes();
     vox::set_memory_limit_bytes(std::uint64_t{512} << 20);
     const std::vector<std::pair<std::string, std::string>> expected = {
@@ -95,6 +96,9 @@ TEST(LabelGrid, CorruptFilesAreReadInAChildAndRefusedNamingTheFile)
         {"vdb_hang_memory_a.vdb", "reading it needs more than the memory limit of 512 MiB"},
         {"vdb_hang_memory_b.vdb", "reading it needs more than the memory limit of 512 MiB"},
         {"vdb_hang_spin.vdb", "OpenVDB's reader did not finish within 3 s"},
+        // Read "cleanly" by the child once, then aborted this process ("corrupted size vs.
+        // prev_size") when it read the file itself: it now reads only what OpenVDB wrote.
+        {"vdb_heap_corruption.vdb", "not a readable OpenVDB file"},
         {"vdb_singular_transform.vdb", "its grid transform is unusable"}, // the vdb fuzz target's
     };
     for (const auto& [name, reason] : expected) {
