@@ -30,11 +30,14 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <optional>
+#include <thread>
 
 namespace vox::app {
 
@@ -88,9 +91,11 @@ void add_run_command(CLI::App& app)
     cmd->add_option("--frames", args->frames, "Number of frames (default: the script's duration / dt_s, else 100)")
         ->check(CLI::PositiveNumber);
     cmd->add_option("--out", args->out, "Output folder (default: the scene's output.dir)");
-    cmd->add_option("--device", args->devices, "Drive a tool by a device through the haptic loop (lockstep, 1 ms ticks): "
-                                                "\"script\" follows the tool's script. Once per device, each with its --tool")
-        ->check(CLI::IsMember({"script"}))
+    cmd->add_option("--device", args->devices,
+                    "Drive a tool by a device through the haptic loop: \"script\" follows the tool's script (lockstep, 1 ms ticks); "
+                    "\"openhaptics\" or \"forcedimension\", a force-feedback device through its vendor's library (real time: the loop at "
+                    "1 kHz of wall clock, frames paced to it; docs/devices.md). Once per device, each with its --tool")
+        ->check(CLI::IsMember({"script", "openhaptics", "forcedimension"}))
         ->allow_extra_args(false);
     cmd->add_option("--replay", args->replay, "Drive the tools by replaying this recording, every device in it (docs/recording-format.md)");
     cmd->add_option("--record", args->record, "Record every device and the force sent to it at every tick to this file");
@@ -128,20 +133,25 @@ void add_run_command(CLI::App& app)
         if (!args->resume.empty() && !std::filesystem::is_regular_file(args->resume)) // before the object is loaded
             throw file_error(args->resume, "no such file (--resume takes a session journal)");
 
-        auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
-        const sim::OpenedMethod opened = sim::open_method(scene, labels);
-        sim::Method& method = *opened.method;
+        // The devices first: one that cannot be opened is said before the object loads.
         sim::ToolPolicy tools(scene);
         std::unique_ptr<sim::DeviceRun> device;
         if (!args->devices.empty() || !args->replay.empty()) {
             sim::DeviceOptions o;
+            o.devices = args->devices;
             o.tools = args->tools;
             if (!args->replay.empty()) o.replay = args->replay;
             device = std::make_unique<sim::DeviceRun>(scene, tools, o);
             for (std::size_t i = 0; i < device->device_count(); ++i)
-                log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, lockstep)", scene.tools[device->tool(i)].name,
-                          device->device_name(i));
+                log::info("tool \"{}\" driven by the {} device through a virtual coupling (1 kHz, {})", scene.tools[device->tool(i)].name,
+                          device->device_name(i), device->live() ? "real time" : "lockstep");
         }
+        // A live run: the simulation keeps to one core, the haptic loop has the other.
+        std::optional<tbb::global_control> one_thread;
+        if (device && device->live()) one_thread.emplace(tbb::global_control::max_allowed_parallelism, 1);
+        auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+        const sim::OpenedMethod opened = sim::open_method(scene, labels);
+        sim::Method& method = *opened.method;
         std::unique_ptr<ScenePictures> pictures;
         if (args->render_every > 0) {
             pictures = std::make_unique<ScenePictures>(picture_options);
@@ -201,7 +211,17 @@ void add_run_command(CLI::App& app)
         };
         if (vtu_every > 0 && first_frame == 1) write_fem_mesh(0, 0.0);
         Progress progress("simulating", static_cast<std::uint64_t>(frames));
+        // A live run's frames keep to wall time: a frame that ends early waits; a late one does not
+        // (the haptic loop goes on at 1 kHz meanwhile, on the snapshot it has).
+        const auto wall_start = std::chrono::steady_clock::now();
+        int late_frames = 0;
         for (int f = first_frame; f <= frames; ++f) {
+            if (device && device->live()) {
+                const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                  std::chrono::duration<double>((f - first_frame) * dt));
+                if (std::chrono::steady_clock::now() > due + std::chrono::duration<double>(dt)) ++late_frames;
+                std::this_thread::sleep_until(due);
+            }
             const sim::FrameStats frame = loop.next();
             record.add(frame, method);
             if (journal && frame.level_change) // a journal holds one level's motion: a new one, with the cuts so far
@@ -220,6 +240,13 @@ void add_run_command(CLI::App& app)
             progress.update(static_cast<std::uint64_t>(f));
         }
         progress.finish();
+        if (device) device->finish(method);
+        const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+        const double simulated_s = (frames - first_frame + 1) * dt;
+        if (late_frames > 0)
+            log::warn("the simulation ran slower than real time: {:.2f} s simulated in {:.2f} s ({} of {} frames started more than a "
+                      "frame late; a coarser level, or \"levels\": \"auto\" with a budget, keeps up)",
+                      simulated_s, wall_s, late_frames, frames - first_frame + 1);
         if (journal) journal->end_stroke(method, loop.frames(), loop.frames() * dt); // the stroke under way at the end
         record.finish(method);
         for (const auto& [tool, touched] : record.tools_given_no_patch())
@@ -258,9 +285,17 @@ void add_run_command(CLI::App& app)
             for (std::size_t i = 0; i < device->device_count(); ++i) {
                 const std::string name = i == 0 ? "forces" : "forces_" + std::to_string(i + 1);
                 sim::write_forces(dir, device->forces(i), "force on the device, " + scene.tools[device->tool(i)].name, name);
-                devices.push_back({{"device", device->device_name(i)}, {"tool", scene.tools[device->tool(i)].name}, {"forces", name + ".csv"}});
+                devices.push_back({{"device", device->device_name(i)},
+                                   {"tool", scene.tools[device->tool(i)].name},
+                                   {"forces", name + ".csv"},
+                                   {"faults", device->faults(i)}});
             }
             record.document()["devices"] = std::move(devices);
+            if (device->live()) {
+                record.document()["haptic_loop"] = device->loop_figures();
+                record.document()["haptic_loop"]["late_frames"] = late_frames;
+                record.document()["haptic_loop"]["real_time_factor"] = simulated_s / std::max(wall_s, 1e-9);
+            }
             if (!args->record.empty()) haptics::write_recording(args->record, device->recording());
         } else if (!tool_forces.empty()) {
             sim::write_forces(dir, tool_forces, "contact force on the tool");

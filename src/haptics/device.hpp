@@ -48,6 +48,10 @@ public:
     /// What keeps the device from working now, in the vendor's words (a cable pulled): a static
     /// string, null while it works. The force sent meanwhile is zero and the state is held.
     [[nodiscard]] virtual const char* fault() const noexcept { return nullptr; }
+    /// Called outside the 1 kHz loop (by the simulation thread, once a frame) while fault() is
+    /// set: a device that needs it is closed and opened again (a cable plugged back in), without
+    /// the loop ever waiting for it. Nothing for devices that come back by themselves.
+    virtual void recover() {}
 
     /// A tick of a servo loop the device's vendor runs itself (OpenHaptics' scheduler).
     using ServoTick = void (*)(void* user) noexcept;

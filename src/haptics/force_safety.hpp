@@ -3,7 +3,8 @@
 // locks, logs or throws. In order:
 //  - a non-finite force (NaN, infinity) becomes zero and is counted;
 //  - the force is scaled down to the device's maximum;
-//  - during the start-up interval the force ramps in linearly from zero (no jolt at power-on);
+//  - during the start-up interval the force ramps in linearly from zero (no jolt at power-on),
+//    and again after the device comes back from a fault (the hand has moved meanwhile);
 //  - when the contact snapshot the force came from is older than the stale limit (50 ms), the
 //    force fades linearly to zero over the fade interval, and stays zero until a fresh snapshot.
 
@@ -51,7 +52,7 @@ public:
             f *= m_s.max_force_n / norm;
         }
         double gain = 1.0;
-        if (m_s.ramp_s > 0.0) gain = std::clamp(now_s / m_s.ramp_s, 0.0, 1.0);
+        if (m_s.ramp_s > 0.0) gain = std::clamp((now_s - m_ramp_from_s) / m_s.ramp_s, 0.0, 1.0);
         if (!(snapshot_age_s <= m_s.stale_s)) { // NaN ages count as stale
             const double over = snapshot_age_s - m_s.stale_s;
             gain *= (m_s.fade_s > 0.0 && std::isfinite(over)) ? std::clamp(1.0 - over / m_s.fade_s, 0.0, 1.0) : 0.0;
@@ -59,11 +60,15 @@ public:
         return gain * f;
     }
 
+    /// The device is faulted at `now_s`: once it answers again, the force ramps in from zero.
+    void hold_off(double now_s) noexcept { m_ramp_from_s = now_s; }
+
     [[nodiscard]] std::uint64_t non_finite_count() const noexcept { return m_non_finite; }
     [[nodiscard]] std::uint64_t clamped_count() const noexcept { return m_clamped; }
 
 private:
     SafetySettings m_s;
+    double m_ramp_from_s = 0.0;
     std::uint64_t m_non_finite = 0, m_clamped = 0;
 };
 

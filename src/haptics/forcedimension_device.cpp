@@ -29,6 +29,7 @@ ForceDimensionDevice::ForceDimensionDevice(int index) : m_library("libdhd.so", "
     if (count < 0) throw InputError(who + ": cannot count the devices: " + last_error());
     if (count == 0) throw InputError(who + ": no device (is it plugged in and powered, and may this user open it?)");
     if (index >= count) throw InputError(who + ": device " + std::to_string(index) + " asked for, " + std::to_string(count) + " found");
+    m_index = index;
     const int id = m_api.open_id(static_cast<char>(index));
     if (id < 0) throw InputError(who + ": cannot open device " + std::to_string(index) + ": " + last_error());
     m_id = static_cast<char>(id);
@@ -62,13 +63,23 @@ const char* ForceDimensionDevice::last_error() const noexcept
 
 bool ForceDimensionDevice::read(double t_s, DeviceState& state) noexcept
 {
+    const int link = m_link.load(std::memory_order_acquire);
+    if (link == stand_off_asked) { // recover() is to reopen the device: no call from here until it has
+        m_link.store(standing_off, std::memory_order_release);
+        return false;
+    }
+    if (link == standing_off) return false;
     double x = 0.0, y = 0.0, z = 0.0, r[3][3] = {};
     // Returns below 0 are errors (1 is the SDK's time guard: a valid reading).
     if (m_api.get_position(&x, &y, &z, m_id) < 0 || m_api.get_orientation_frame(r, m_id) < 0) {
         m_fault.store(last_error(), std::memory_order_relaxed);
+        int expected = ok;
+        m_link.compare_exchange_strong(expected, faulted, std::memory_order_acq_rel);
         return false;
     }
     m_fault.store(nullptr, std::memory_order_relaxed);
+    int expected = faulted;
+    m_link.compare_exchange_strong(expected, ok, std::memory_order_acq_rel); // it came back by itself
     state.t_s = t_s;
     state.position_mm = 1e3 * Eigen::Vector3d(x, y, z);
     Eigen::Matrix3d m;
@@ -80,12 +91,50 @@ bool ForceDimensionDevice::read(double t_s, DeviceState& state) noexcept
 
 void ForceDimensionDevice::send(const Eigen::Vector3d& force_n, const Eigen::Vector3d& torque_nm) noexcept
 {
+    const int link = m_link.load(std::memory_order_acquire);
+    if (link != ok && link != faulted) return; // standing off for recover()
     const bool faulted = m_fault.load(std::memory_order_relaxed) != nullptr;
     const Eigen::Vector3d f = faulted ? Eigen::Vector3d::Zero() : force_n;
     const Eigen::Vector3d t = faulted ? Eigen::Vector3d::Zero() : torque_nm;
     const int result = m_api.set_force_and_torque ? m_api.set_force_and_torque(f.x(), f.y(), f.z(), t.x(), t.y(), t.z(), m_id)
                                                   : m_api.set_force(f.x(), f.y(), f.z(), m_id);
-    if (result < 0) m_fault.store(last_error(), std::memory_order_relaxed);
+    if (result < 0) {
+        m_fault.store(last_error(), std::memory_order_relaxed);
+        int expected = ok;
+        m_link.compare_exchange_strong(expected, faulted, std::memory_order_acq_rel);
+    }
+}
+
+void ForceDimensionDevice::recover()
+{
+    using namespace std::chrono_literals;
+    const auto now = std::chrono::steady_clock::now();
+    int link = m_link.load(std::memory_order_acquire);
+    if (link == ok) {
+        m_fault_since = {};
+        return;
+    }
+    if (link == faulted) { // a moment's error passes by itself; one that lasts needs the device reopened
+        if (m_fault_since == std::chrono::steady_clock::time_point{}) m_fault_since = now;
+        if (now - m_fault_since >= 500ms) m_link.compare_exchange_strong(link, stand_off_asked, std::memory_order_acq_rel);
+        return;
+    }
+    if (link != standing_off || now < m_next_try) return;
+    m_next_try = now + 500ms;
+    m_api.close(m_id);
+    const int id = m_api.open_id(static_cast<char>(m_index));
+    if (id < 0) {
+        m_fault.store(last_error(), std::memory_order_relaxed);
+        return;
+    }
+    if (m_api.enable_force(1, static_cast<char>(id)) < 0) {
+        m_fault.store(last_error(), std::memory_order_relaxed);
+        m_api.close(static_cast<char>(id));
+        return;
+    }
+    m_id = static_cast<char>(id);
+    m_fault_since = {};
+    m_link.store(ok, std::memory_order_release); // the fault clears at the loop's next good reading
 }
 
 std::vector<ForceDeviceInfo> ForceDimensionDevice::probe()

@@ -9,6 +9,7 @@
 #include "haptics/vendor_library.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ public:
     bool read(double t_s, DeviceState& state) noexcept override;
     void send(const Eigen::Vector3d& force_n, const Eigen::Vector3d& torque_nm) noexcept override;
     [[nodiscard]] const char* fault() const noexcept override { return m_fault.load(std::memory_order_relaxed); }
+    /// A device faulted for half a second (unplugged, switched off) is closed and opened again,
+    /// every half second until it answers; the loop makes no DHD call meanwhile.
+    void recover() override;
 
     /// Every device the library finds, or one entry saying why there is none.
     static std::vector<ForceDeviceInfo> probe();
@@ -55,6 +59,13 @@ private:
         dhd::ErrorGetLastStr error_get_last_str; ///< optional
         dhd::ErrorGetStr error_get_str;          ///< optional
     } m_api;
+    /// Who may call the DHD API for the device: the loop (ok, or faulted and still polling),
+    /// or, once the loop has stood off, recover() reopening it. The loop's acquire of ok makes
+    /// the id recover() wrote visible.
+    enum Link : int { ok, faulted, stand_off_asked, standing_off };
+    std::atomic<int> m_link{ok};
+    std::chrono::steady_clock::time_point m_fault_since, m_next_try; ///< recover()'s own
+    int m_index = 0;
     char m_id = dhd::k_default_device;
     ForceDeviceInfo m_info;
     DeviceLimits m_limits;

@@ -1,9 +1,17 @@
 #include "haptics/framed_device.hpp"
 
+#include <utility>
+
 namespace vox::haptics {
 
 FramedDevice::FramedDevice(Device& inner, const DeviceFrame& frame, std::uint32_t clutch_mask)
     : m_inner(inner), m_frame(frame), m_clutch_mask(clutch_mask)
+{
+    m_frame.rotation.normalize();
+}
+
+FramedDevice::FramedDevice(std::unique_ptr<Device> inner, const DeviceFrame& frame, std::uint32_t clutch_mask)
+    : m_owned(std::move(inner)), m_inner(*m_owned), m_frame(frame), m_clutch_mask(clutch_mask)
 {
     m_frame.rotation.normalize();
 }

@@ -9,6 +9,8 @@
 
 #include "haptics/device.hpp"
 
+#include <memory>
+
 namespace vox::haptics {
 
 struct DeviceFrame {
@@ -21,12 +23,15 @@ class FramedDevice final : public Device {
 public:
     /// `clutch_mask`: the buttons that clutch (default the first; 0: none). `inner` must outlive this.
     FramedDevice(Device& inner, const DeviceFrame& frame, std::uint32_t clutch_mask = 1u);
+    /// The same, owning `inner`.
+    FramedDevice(std::unique_ptr<Device> inner, const DeviceFrame& frame, std::uint32_t clutch_mask = 1u);
 
     [[nodiscard]] std::string name() const override { return m_inner.name(); }
     [[nodiscard]] const DeviceLimits& limits() const override { return m_inner.limits(); }
     bool read(double t_s, DeviceState& state) noexcept override;
     void send(const Eigen::Vector3d& force_n, const Eigen::Vector3d& torque_nm) noexcept override;
     [[nodiscard]] const char* fault() const noexcept override { return m_inner.fault(); }
+    void recover() override { m_inner.recover(); }
     bool run_servo(ServoTick tick, void* user) override { return m_inner.run_servo(tick, user); }
     void stop_servo() override { m_inner.stop_servo(); }
 
@@ -39,6 +44,7 @@ private:
     /// A point of the device's frame in the scene's.
     [[nodiscard]] Eigen::Vector3d to_scene(const Eigen::Vector3d& device_mm) const noexcept;
 
+    std::unique_ptr<Device> m_owned; ///< the inner device, when this one owns it
     Device& m_inner;
     DeviceFrame m_frame;
     std::uint32_t m_clutch_mask;

@@ -18,7 +18,7 @@ HapticLoop::HapticLoop(std::vector<HapticChannel> channels, std::size_t capacity
 }
 
 HapticLoop::HapticLoop(Device& device, ForceModel model, const SafetySettings& safety, std::size_t capacity)
-    : HapticLoop(std::vector<HapticChannel>{{&device, std::move(model), safety}}, capacity)
+    : HapticLoop(std::vector<HapticChannel>{{&device, std::move(model), safety, {}}}, capacity)
 {
 }
 
@@ -28,8 +28,10 @@ Eigen::Vector3d HapticLoop::tick(double t_s) noexcept
 {
     using clock = std::chrono::steady_clock;
     const auto begin = clock::now();
+    m_last_t_s = t_s;
     for (Served& c : m_channels) {
         c.device->read(t_s, c.state);
+        if (c.device->fault()) c.safety.hold_off(t_s); // no jolt when it comes back
         double age = 0.0;
         Eigen::Vector3d f = Eigen::Vector3d::Zero();
         try {

@@ -65,11 +65,15 @@ public:
 
     void start();        ///< live mode: starts the 1 kHz thread, or a device's own servo ticks it
     void stop();         ///< joins the thread (or stops the servo)
+    /// Live mode: started and not stopped.
+    [[nodiscard]] bool running() const { return m_running.load(std::memory_order_relaxed); }
     /// The live thread's timings so far (call after stop()).
     [[nodiscard]] const LoopTimings& timings() const { return m_timings; }
     [[nodiscard]] std::size_t device_count() const { return m_channels.size(); }
     /// The last tick's force time and whole work, us (LoopTimings), in either mode.
     [[nodiscard]] double last_force_us() const { return m_last_force_us; }
+    /// The loop time of the last tick, s (a channel's prepare() may read it).
+    [[nodiscard]] double last_tick_s() const { return m_last_t_s; }
     [[nodiscard]] double last_work_us() const { return m_last_work_us; }
     /// Device i's state read and force sent at the last tick.
     [[nodiscard]] const DeviceState& state(std::size_t i = 0) const { return m_channels[i].state; }
@@ -93,7 +97,7 @@ private:
     std::vector<Served> m_channels;
     LoopTimings m_timings;
     std::size_t m_recorded = 0;
-    double m_last_force_us = 0.0, m_last_work_us = 0.0;
+    double m_last_force_us = 0.0, m_last_work_us = 0.0, m_last_t_s = 0.0;
     std::atomic<bool> m_running{false};
     std::thread m_thread;
     Device* m_servo = nullptr; ///< the device whose servo thread ticks the loop (live mode), if any

@@ -3,13 +3,17 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/sample_stats.hpp"
+#include "haptics/force_devices.hpp"
+#include "haptics/paced_device.hpp"
+#include "io/tool_script.hpp"
 #include "sim/haptic_snapshot.hpp"
-#include "haptics/virtual_device.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <utility>
 
@@ -20,6 +24,8 @@ constexpr double k_tick_s = 1e-3;
 /// Surface points the snapshot can hold: a tool's neighbourhood on a fine scan is a few
 /// thousand; beyond this the snapshot says it was truncated.
 constexpr std::size_t k_snapshot_points = 50000;
+/// Ticks a device's ring holds between two frames: 30 s of a simulation that fell behind.
+constexpr std::size_t k_ring_ticks = 30000;
 
 } // namespace
 
@@ -60,6 +66,14 @@ std::vector<haptics::KeyFrame> script_key_frames(const io::Scene& scene, std::si
     return frames;
 }
 
+haptics::DeviceFrame device_frame(const io::ToolSpec& tool, const Eigen::Vector3d& start_mm)
+{
+    if (tool.device_frame) return {tool.device_frame->origin_mm, tool.device_frame->rotation, tool.device_frame->scale};
+    return {start_mm, Eigen::Quaterniond::Identity(), 1.0};
+}
+
+DeviceRun::Hand::Hand() : snapshots(contact::SurfacePoints(k_snapshot_points)), ticks(k_ring_ticks) {}
+
 DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const DeviceOptions& options) : m_scene(scene)
 {
     if (scene.tools.empty()) throw scene.error("tools", "a device needs a tool to drive; the scene has none");
@@ -73,108 +87,239 @@ DeviceRun::DeviceRun(const io::Scene& scene, const ToolPolicy& tools, const Devi
             const std::string& recorded = ticks.front().tool;
             const std::size_t tool = recorded.empty() ? tool_named(scene, options.tools.empty() ? std::string() : options.tools.front())
                                                       : tool_named(scene, recorded);
-            add_hand(tool, std::make_unique<haptics::ReplayDevice>(std::move(ticks)), tools);
+            add_hand(tool, std::make_unique<haptics::ReplayDevice>(std::move(ticks)), tools, false);
         }
     } else {
-        const std::vector<std::string> names = options.tools.empty() ? std::vector<std::string>{std::string()} : options.tools;
-        for (const std::string& name : names) {
-            const std::size_t tool = tool_named(scene, name);
-            add_hand(tool, std::make_unique<haptics::VirtualDevice>(script_key_frames(scene, tool)), tools);
+        const std::size_t count = std::max<std::size_t>({options.devices.size(), options.tools.size(), 1});
+        const auto kind = [&](std::size_t d) { return d < options.devices.size() ? options.devices[d] : std::string("script"); };
+        std::vector<std::size_t> driven;
+        for (std::size_t d = 0; d < count; ++d) {
+            if (kind(d) != "script" && !haptics::is_force_device(kind(d)))
+                throw InputError("--device " + kind(d) + ": a run takes script, openhaptics or forcedimension");
+            m_live = m_live || haptics::is_force_device(kind(d));
+            driven.push_back(tool_named(scene, d < options.tools.size() ? options.tools[d] : std::string()));
+        }
+        check_device_tools(scene, driven); // before any device is opened
+        std::map<std::string, int> opened; // force-feedback devices, per backend
+        for (std::size_t d = 0; d < count; ++d) {
+            const std::size_t tool = driven[d];
+            if (kind(d) == "script") {
+                std::vector<haptics::KeyFrame> script = script_key_frames(scene, tool);
+                if (m_live) // it keeps to the simulation's time, as the run's frames keep to the wall's
+                    add_hand(tool, std::make_unique<haptics::PacedDevice>(std::move(script), m_simulation_t_s, scene.solver.dt_s), tools, false);
+                else
+                    add_hand(tool, std::make_unique<haptics::VirtualDevice>(std::move(script)), tools, false);
+                continue;
+            }
+            const io::ToolSpec& spec = scene.tools[tool];
+            const io::ToolPose start = io::tool_pose(scene, tool, 0.0);
+            if (!spec.device_frame && !start.placed)
+                throw scene.error("tools", "tool \"" + spec.name + "\" is driven by a force-feedback device, whose frame the tool's \"device_frame\" "
+                                           "or a script entry (its first position) places in the scene; it has neither");
+            add_hand(tool, haptics::open_force_device(kind(d), opened[kind(d)]++, device_frame(spec, start.position_mm)), tools, true);
+            m_hands.back()->pose.pose.position = start.placed ? start.position_mm : spec.device_frame->origin_mm;
         }
     }
-    std::vector<std::size_t> driven;
-    for (const std::unique_ptr<Hand>& hand : m_hands) driven.push_back(hand->tool);
-    check_device_tools(scene, driven);
-    // One loop serves every device, each through its own coupling and safety stage.
+    if (options.replay) {
+        std::vector<std::size_t> driven;
+        for (const std::unique_ptr<Hand>& hand : m_hands) driven.push_back(hand->tool);
+        check_device_tools(scene, driven);
+    }
+    // One loop serves every device, each through its own coupling and safety stage; after each
+    // tick, each leaves its reading, force and proxy for the simulation thread.
     std::vector<haptics::HapticChannel> channels;
-    for (const std::unique_ptr<Hand>& owned : m_hands) {
-        Hand* hand = owned.get();
+    for (std::size_t i = 0; i < m_hands.size(); ++i) {
+        Hand* hand = m_hands[i].get();
         const haptics::SafetySettings safety = haptics::safety_for(hand->device->limits());
         channels.push_back({hand->device.get(),
                             [this, hand](const haptics::DeviceState& state, double& age) {
-                                age = state.t_s - hand->snapshot.t_s;
-                                return hand->coupled->update(state, hand->snapshot, m_tick_s);
+                                const contact::SurfacePoints& surface = hand->snapshots.read_slot();
+                                age = state.t_s - surface.t_s;
+                                return hand->coupled->update(state, surface, m_tick_s);
                             },
                             safety,
-                            [this, hand](const haptics::DeviceState& state) { hand->coupled->prepare(state, hand->snapshot, m_tick_s); }});
+                            [this, hand, i](const haptics::DeviceState& state) {
+                                haptics::CoupledTool& coupled = *hand->coupled;
+                                hand->ticks.push({m_loop->last_tick_s(), state, m_loop->force(i), coupled.proxy().position, coupled.patch_us()});
+                                coupled.prepare(state, hand->snapshots.latest(), m_tick_s);
+                                HandPose& out = hand->poses.write_slot();
+                                out = {coupled.handed_pose(), coupled.driver(), coupled.coupling_stiffness_n_per_mm(), state.buttons,
+                                       coupled.contact().area_mm2 > 0.0, coupled.patch().max_displacement_mm()};
+                                hand->poses.publish();
+                            }});
     }
-    m_loop = std::make_unique<haptics::HapticLoop>(std::move(channels), 0);
+    // A live loop keeps its timings: a tick's work and period, ten minutes of them.
+    m_loop = std::make_unique<haptics::HapticLoop>(std::move(channels), m_live ? 600000 : 0);
 }
 
-void DeviceRun::add_hand(std::size_t tool, std::unique_ptr<haptics::Device> device, const ToolPolicy& tools)
+DeviceRun::~DeviceRun()
+{
+    if (m_loop) m_loop->stop(); // before the devices and what the loop's channels refer to go
+}
+
+void DeviceRun::add_hand(std::size_t tool, std::unique_ptr<haptics::Device> device, const ToolPolicy& tools, bool arms)
 {
     auto hand = std::make_unique<Hand>();
     hand->tool = tool;
     hand->device = std::move(device);
-    hand->snapshot = contact::SurfacePoints(k_snapshot_points);
+    hand->arms = arms;
     const io::ToolSpec& spec = m_scene.tools[tool];
     const haptics::CouplingSettings coupling = device_coupling(spec, hand->device->limits());
     hand->coupled = std::make_unique<haptics::CoupledTool>(tools.shape(tool), contact::ContactParameters{spec.push_margin_mm, spec.contact_stiffness_n_per_mm},
-                                                           coupling, hand->snapshot.capacity());
+                                                           coupling, k_snapshot_points);
+    hand->pose.pose = {&tools.shape(tool), Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
+    hand->pose.coupling_n_per_mm = coupling.stiffness_n_per_mm;
     m_hands.push_back(std::move(hand));
+}
+
+double DeviceRun::live_now_s() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_live_start).count(); }
+
+void DeviceRun::start(const Method& method, double t0_s)
+{
+    m_started = true;
+    if (m_live) { // each proxy goes to its device at the loop's first tick; until then the tool is where its frame starts
+        for (const std::unique_ptr<Hand>& hand : m_hands) hand->pose.driver_mm = hand->pose.pose.position;
+        return;
+    }
+    // Lockstep: each proxy starts at its device; the readings are recorded so a replay starts alike.
+    for (std::size_t i = 0; i < m_hands.size(); ++i) {
+        Hand& hand = *m_hands[i];
+        haptics::DeviceState first;
+        hand.device->read(t0_s, first);
+        hand.coupled->update(first, hand.snapshots.read_slot(), k_tick_s);
+        hand.pose = {hand.coupled->handed_pose(), hand.coupled->driver(), hand.coupled->coupling_stiffness_n_per_mm(), first.buttons, false, 0.0};
+        m_recording.push_back({first, Eigen::Vector3d::Zero(), method.level(), {}, static_cast<int>(i), m_scene.tools[hand.tool].name});
+    }
+}
+
+void DeviceRun::publish_snapshots(Method& method, double t_s)
+{
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        const io::ToolSpec& spec = m_scene.tools[hand->tool];
+        const contact::PlacedShape& pose = hand->pose.pose; // where the simulation has the tool
+        const double margin = spec.push_margin_mm + k_snapshot_margin_mm;
+        Eigen::AlignedBox3d near = pose.world_bounds(margin);
+        if (m_live) // the hand moves on while the simulation steps: the snapshot reaches to where it heads
+            near.extend(contact::PlacedShape{pose.shape, hand->pose.driver_mm, pose.orientation}.world_bounds(margin));
+        contact::SurfacePoints& out = hand->snapshots.write_slot();
+        take_snapshot(method, hand->tool, spec, pose, near, t_s, out);
+        if (out.truncated && !hand->warned_truncated) {
+            log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name, out.capacity());
+            hand->warned_truncated = true;
+        }
+        hand->patch_points = out.patch.free;
+        hand->patch_level = out.patch.level;
+        hand->patch_compliance_mm_per_n = out.patch.compliance_mm_per_n;
+        hand->snapshots.publish();
+        if (!m_live) hand->snapshots.update(); // lockstep: the loop's ticks, on this thread, take it now
+    }
+}
+
+void DeviceRun::take_ticks(const Method& method)
+{
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        hand->patch_us_max = 0.0;
+        if (hand->poses.update()) hand->pose = hand->poses.read_slot();
+    }
+    // Tick by tick, every device in turn (each tick serves them all, so their rings fill alike).
+    std::size_t ready = SIZE_MAX;
+    for (const std::unique_ptr<Hand>& hand : m_hands) ready = std::min(ready, hand->ticks.size());
+    for (std::size_t k = 0; k < ready; ++k) {
+        const std::string change = std::exchange(m_level_change, {});
+        for (std::size_t i = 0; i < m_hands.size(); ++i) {
+            Hand& hand = *m_hands[i];
+            const HandTick& t = hand.ticks.front();
+            m_recording.push_back({t.state, t.force_n, method.level(), change, static_cast<int>(i), m_scene.tools[hand.tool].name});
+            hand.forces.push_back({t.t_s, t.proxy_mm, t.force_n});
+            hand.patch_us_max = std::max(hand.patch_us_max, t.patch_us);
+            hand.ticks.pop();
+        }
+    }
+}
+
+void DeviceRun::watch_faults()
+{
+    for (const std::unique_ptr<Hand>& hand : m_hands) {
+        const char* fault = hand->device->fault();
+        if (fault && fault != hand->fault_said) {
+            if (!hand->fault_said) ++hand->faults;
+            log::warn("{} (tool \"{}\"): {}: no force, the tool held where it was; the run goes on and takes the device up again when it answers",
+                      hand->device->name(), m_scene.tools[hand->tool].name, fault);
+        } else if (!fault && hand->fault_said) {
+            log::info("{} (tool \"{}\") answers again: its force ramps back in", hand->device->name(), m_scene.tools[hand->tool].name);
+        }
+        hand->fault_said = fault;
+        if (fault) hand->device->recover();
+    }
 }
 
 void DeviceRun::frame(Method& method, ToolPolicy& tools, double t0_s, double dt_s)
 {
-    if (!m_started) { // each proxy starts at its device; the readings are recorded so a replay starts alike
-        for (std::size_t i = 0; i < m_hands.size(); ++i) {
-            Hand& hand = *m_hands[i];
-            haptics::DeviceState first;
-            hand.device->read(t0_s, first);
-            hand.coupled->update(first, hand.snapshot, k_tick_s);
-            m_recording.push_back({first, Eigen::Vector3d::Zero(), method.level(), {}, static_cast<int>(i), m_scene.tools[hand.tool].name});
-        }
-        m_started = true;
-    }
-    // The snapshots: the surface around where each tool is, as the simulation has it at the frame's start.
-    for (const std::unique_ptr<Hand>& hand : m_hands) {
-        const io::ToolSpec& spec = m_scene.tools[hand->tool];
-        const contact::PlacedShape pose = hand->coupled->handed_pose(); // where the simulation has the tool
-        take_snapshot(method, hand->tool, spec, pose, pose.world_bounds(spec.push_margin_mm + k_snapshot_margin_mm), t0_s, hand->snapshot);
-        if (hand->snapshot.truncated && !hand->warned_truncated) {
-            log::warn("the surface near tool \"{}\" has more than {} points; the haptic snapshot keeps the first ones", spec.name,
-                      hand->snapshot.capacity());
-            hand->warned_truncated = true;
-        }
-    }
-    for (const std::unique_ptr<Hand>& hand : m_hands) {
-        hand->patch_us_max = 0.0;
+    if (!m_started) start(method, t0_s);
+    for (const std::unique_ptr<Hand>& hand : m_hands)
         hand->coupled->set_passing(tools.passing(hand->tool)); // a tool that cut last frame cuts on through
-    }
-    const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
-    m_tick_s = dt_s / ticks;
-    for (int k = 1; k <= ticks; ++k) {
-        const double t = t0_s + k * dt_s / ticks;
-        m_loop->tick(t);
-        const std::string change = std::exchange(m_level_change, {});
-        for (std::size_t i = 0; i < m_hands.size(); ++i) {
-            Hand& hand = *m_hands[i];
-            const Eigen::Vector3d& f = m_loop->force(i);
-            m_recording.push_back({m_loop->state(i), f, method.level(), change, static_cast<int>(i), m_scene.tools[hand.tool].name});
-            hand.forces.push_back({t, hand.coupled->proxy().position, f});
-            hand.patch_us_max = std::max(hand.patch_us_max, hand.coupled->patch_us());
+    if (m_live) {
+        m_simulation_t_s.store(t0_s, std::memory_order_relaxed);
+        if (!m_loop->running()) {
+            publish_snapshots(method, 0.0);
+            m_live_start = std::chrono::steady_clock::now();
+            m_loop->start();
         }
+        take_ticks(method);
+        publish_snapshots(method, live_now_s()); // around where each tool is now, for the ticks to come
+    } else {
+        // The surface around where each tool is, as the simulation has it at the frame's start.
+        publish_snapshots(method, t0_s);
+        const int ticks = std::max(1, static_cast<int>(std::lround(dt_s / k_tick_s)));
+        m_tick_s = dt_s / ticks;
+        for (int k = 1; k <= ticks; ++k) m_loop->tick(t0_s + k * dt_s / ticks);
+        take_ticks(method);
     }
+    watch_faults();
     for (const std::unique_ptr<Hand>& hand : m_hands) {
-        const contact::PlacedShape pose = hand->coupled->handed_pose();
-        tools.drive(hand->tool, pose.position, pose.orientation, hand->coupled->driver(), hand->coupled->coupling_stiffness_n_per_mm());
+        const HandPose& p = hand->pose;
+        tools.drive(hand->tool, p.pose.position, p.pose.orientation, p.driver_mm, p.coupling_n_per_mm);
+        if (hand->arms) tools.arm(hand->tool, (p.buttons & haptics::k_action_button) != 0);
     }
+}
+
+void DeviceRun::finish(const Method& method)
+{
+    if (!m_live) return;
+    m_loop->stop();
+    take_ticks(method);
+    for (const std::unique_ptr<Hand>& hand : m_hands)
+        if (const std::uint64_t dropped = hand->ticks.dropped())
+            log::warn("{}: {} ticks were not recorded (the simulation fell behind the loop by more than {} s)", hand->device->name(), dropped,
+                      k_ring_ticks / 1000);
+}
+
+nlohmann::json DeviceRun::loop_figures() const
+{
+    const haptics::LoopTimings& t = m_loop->timings();
+    const double seconds = m_hands.empty() || m_hands.front()->forces.empty() ? 0.0 : m_hands.front()->forces.back().t_s;
+    return {{"ticks", t.force_us.size()},
+            {"rate_hz", seconds > 0.0 ? static_cast<double>(t.force_us.size()) / seconds : 0.0},
+            {"period_error_ms_p50", quantile(t.period_error_ms, 0.5)},
+            {"period_error_ms_p99", quantile(t.period_error_ms, 0.99)},
+            {"force_us_p50", quantile(t.force_us, 0.5)},
+            {"force_us_p99", quantile(t.force_us, 0.99)},
+            {"realtime_priority", t.realtime_priority}};
 }
 
 std::vector<PatchFrame> DeviceRun::patches() const
 {
     std::vector<PatchFrame> out;
     for (const std::unique_ptr<Hand>& hand : m_hands) {
-        const contact::PatchLayer& patch = hand->snapshot.patch;
         PatchFrame p;
         p.tool = m_scene.tools[hand->tool].name;
         p.asked = m_scene.tools[hand->tool].haptic_subdivision >= 0;
-        p.touching = hand->coupled->contact().area_mm2 > 0.0;
-        if (patch.free > 0) {
-            p.points = patch.free;
-            p.level = patch.level;
-            p.compliance_mm_per_n = patch.compliance_mm_per_n;
-            p.displacement_mm = hand->coupled->patch().max_displacement_mm();
+        p.touching = hand->pose.touching;
+        if (hand->patch_points > 0) {
+            p.points = hand->patch_points;
+            p.level = hand->patch_level;
+            p.compliance_mm_per_n = hand->patch_compliance_mm_per_n;
+            p.displacement_mm = hand->pose.patch_displacement_mm;
             p.step_us_max = hand->patch_us_max;
         }
         out.push_back(p);

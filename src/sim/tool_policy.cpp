@@ -41,7 +41,7 @@ contact::ToolShape make_tool_shape(const io::ToolSpec& t)
 ToolPolicy::ToolPolicy(const io::Scene& scene)
     : m_scene(scene), m_last_pose(scene.tools.size()), m_episode_cut(scene.tools.size(), false), m_driven(scene.tools.size(), false),
       m_driven_pose(scene.tools.size()), m_driven_driver(scene.tools.size(), Eigen::Vector3d::Zero()),
-      m_driven_coupling(scene.tools.size(), 0.0), m_passing(scene.tools.size(), false), m_movers(scene.tools.size())
+      m_driven_coupling(scene.tools.size(), 0.0), m_passing(scene.tools.size(), false), m_armed(scene.tools.size(), true), m_movers(scene.tools.size())
 {
     m_shapes.reserve(scene.tools.size()); // placed shapes point at them
     for (const io::ToolSpec& t : scene.tools) m_shapes.push_back(make_tool_shape(t));
@@ -119,6 +119,7 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
     Stopwatch clock;
     for (std::size_t k = 0; k < m_scene.tools.size(); ++k) {
         const io::ToolSpec& spec = m_scene.tools[k];
+        const io::ToolAction action = m_armed[k] ? spec.action : io::ToolAction::push; // a device's button may hold it back
         io::ToolPose from = io::tool_pose(m_scene, k, t_s - dt_s), to = io::tool_pose(m_scene, k, t_s);
         if (m_driven[k]) { // a device moves this tool: from where it was at the last frame
             to.placed = true;
@@ -148,7 +149,7 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
         if (!m_passing[k]) {
             const Held held = hold(k, method, spec, placed, t.driver_mm, coupling, moved_on);
             t.load_scale = held.load_scale;
-            if (spec.action == io::ToolAction::cut && held.breaks_in) { // the material gives way: the blade cuts on to its driver
+            if (action == io::ToolAction::cut && held.breaks_in) { // the material gives way: the blade cuts on to its driver
                 placed.position = t.driver_mm;
                 t.load_scale = 1.0;
             }
@@ -175,7 +176,7 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
         order.touching = !c.points.empty();
         const bool breaks_in = c.inner_reaches_surface() && c.pressure_pa >= spec.cut_pressure_pa;
         out.collision_ms += clock.lap();
-        if (spec.action == io::ToolAction::cut) {
+        if (action == io::ToolAction::cut) {
             if (!order.touching) m_episode_cut[k] = false; // let go: the next touch marks a new cut
             order.marking = spec.two_phase && order.touching && !m_episode_cut[k];
             order.cut = breaks_in && (!spec.two_phase || order.marking);
@@ -190,9 +191,9 @@ ToolsFrame ToolPolicy::frame(Method& method, double t_s, double dt_s)
         }
         // A cut episode: from its first cut until the tool leaves the material, the blade goes where
         // its driver is (in its slit, along its cut) and cuts wherever the pressure breaks in.
-        m_passing[k] = spec.action == io::ToolAction::cut && (t.cut || (m_passing[k] && order.touching));
-        if (spec.action == io::ToolAction::wet) method.wet(k, spec.wet_rate_per_s * dt_s);
-        if (spec.action == io::ToolAction::drill && order.touching) {
+        m_passing[k] = action == io::ToolAction::cut && (t.cut || (m_passing[k] && order.touching));
+        if (action == io::ToolAction::wet) method.wet(k, spec.wet_rate_per_s * dt_s);
+        if (action == io::ToolAction::drill && order.touching) {
             // Removal rate = rate constant x pressing force x revolutions per second (Agus et
             // al. 2003; Morris et al. 2006 remove bone voxels at a force- and speed-driven rate).
             // The pressing force is the driver's pull where the bone holds the burr (however

@@ -71,6 +71,10 @@ public:
     [[nodiscard]] bool passing(std::size_t tool) const { return m_passing[tool]; }
     /// The device lets go of `tool`: the script places it again (nowhere, without entries).
     void release(std::size_t tool);
+    /// Whether `tool` does what its action says (cut, drill, wet) or only pushes: a force-feedback
+    /// device's second button switches the action on while it is held. On unless a device says.
+    void arm(std::size_t tool, bool on) { m_armed.at(tool) = on; }
+    [[nodiscard]] bool armed(std::size_t tool) const { return m_armed[tool]; }
     /// Forgets every tool's last pose and contact episode (after the object was restored).
     void reset();
 
@@ -101,6 +105,7 @@ private:
     std::vector<Eigen::Vector3d> m_driven_driver;  ///< the device's position
     std::vector<double> m_driven_coupling;         ///< its spring, N/mm
     std::vector<bool> m_passing;                   ///< the tool is in a cut episode
+    std::vector<bool> m_armed;                     ///< its action is on (else it pushes)
     /// Per tool: its proxy's steps and the surface near it, sampled each frame.
     std::vector<std::unique_ptr<contact::ProxyMover>> m_movers;
     std::vector<contact::SurfacePoints> m_near;

@@ -35,6 +35,7 @@ struct ProxyPose {
     contact::PlacedShape pose;
     Eigen::Vector3d heading = Eigen::Vector3d::Zero(); ///< the driver: the device, or the pointer's target
     double coupling_n_per_mm = 0.0;                     ///< the spring between them
+    std::uint32_t buttons = 0;                          ///< the device's, as read
 };
 
 /// The window's requests to the simulation thread (the keys), each taken once by it.
@@ -73,7 +74,7 @@ struct ViewChannels {
     }
     [[nodiscard]] HandChannel& hand(std::size_t d = 0) { return *hands[d]; }
     std::vector<std::unique_ptr<HandChannel>> hands;
-    /// The simulated time of the last frame: scripted devices follow it (view/paced_device.hpp).
+    /// The simulated time of the last frame: scripted devices follow it (haptics/paced_device.hpp).
     std::atomic<double> simulation_t_s{0.0};
     haptics::TripleBuffer<RenderState> pictures;
     ViewRequests requests;

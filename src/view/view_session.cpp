@@ -3,11 +3,10 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "haptics/coupled_tool.hpp"
-#include "haptics/forcedimension_device.hpp"
-#include "haptics/framed_device.hpp"
+#include "haptics/force_devices.hpp"
 #include "haptics/haptic_loop.hpp"
 #include "haptics/hid_devices.hpp"
-#include "haptics/openhaptics_device.hpp"
+#include "haptics/paced_device.hpp"
 #include "haptics/pointer_device.hpp"
 #include "haptics/spacemouse_device.hpp"
 #include "io/scene.hpp"
@@ -19,7 +18,6 @@
 #include "sim/journal.hpp"
 #include "sim/method_factory.hpp"
 #include "view/scene_pictures.hpp"
-#include "view/paced_device.hpp"
 #include "view/view_channels.hpp"
 #include "view/view_simulation.hpp"
 #include "view/view_window.hpp"
@@ -30,6 +28,7 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -149,13 +148,13 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             log::info("no HID devices ({}); the mouse drives the tool", e.what());
         }
     }
-    bool mouse_taken = false, openhaptics_taken = false;
-    int forcedimension_taken = 0;
+    bool mouse_taken = false;
+    std::map<std::string, int> taken; // force-feedback devices opened, per backend
     for (std::size_t d = 0; d < driven.size(); ++d) {
         const std::string& kind = options.devices[d];
         const io::ToolPose& at = starts[d];
         if (kind == "script") {
-            owned.push_back(std::make_unique<PacedDevice>(sim::script_key_frames(loaded, driven[d]), channels.simulation_t_s, scene.solver.dt_s));
+            owned.push_back(std::make_unique<haptics::PacedDevice>(sim::script_key_frames(loaded, driven[d]), channels.simulation_t_s, scene.solver.dt_s));
         } else if (kind == "hid" || (kind == "auto" && !controllers.empty())) {
             if (controllers.empty())
                 throw InputError("--device hid: no " + std::string(d ? "further " : "") + "6-DoF controller can be opened. " +
@@ -163,20 +162,10 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
             const haptics::HidDevice c = controllers.front();
             controllers.erase(controllers.begin());
             owned.push_back(std::make_unique<haptics::SpaceMouseDevice>(c.path, c.product, at.position_mm, at.orientation));
-        } else if (kind == "openhaptics" || kind == "forcedimension") {
+        } else if (haptics::is_force_device(kind)) {
             // An absolute device: its frame placed in the scene (the tool's "device_frame", else
             // its origin where the tool starts), its first button a clutch.
-            if (kind == "openhaptics") {
-                if (openhaptics_taken) throw InputError("--device openhaptics: one OpenHaptics device (the default one) can be used");
-                openhaptics_taken = true;
-                owned.push_back(std::make_unique<haptics::OpenHapticsDevice>());
-            } else {
-                owned.push_back(std::make_unique<haptics::ForceDimensionDevice>(forcedimension_taken++));
-            }
-            haptics::DeviceFrame frame{at.position_mm, Eigen::Quaterniond::Identity(), 1.0};
-            if (const auto& f = scene.tools[driven[d]].device_frame) frame = {f->origin_mm, f->rotation, f->scale};
-            haptics::Device& vendor = *owned.back();
-            owned.push_back(std::make_unique<haptics::FramedDevice>(vendor, frame));
+            owned.push_back(haptics::open_force_device(kind, taken[kind]++, sim::device_frame(scene.tools[driven[d]], at.position_mm)));
         } else { // the mouse
             if (mouse_taken) throw InputError("--device: the mouse can drive one tool only (device " + std::to_string(d + 1) + ")");
             mouse_taken = true;
@@ -220,7 +209,7 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
                               tool.set_passing(hand.passing.load(std::memory_order_relaxed));
                               const Eigen::Vector3d f = tool.update(s, surface, 1e-3);
                               hand.proxies.write_slot() = {k, tool.handed_pose(), mouse ? pointer.target() : s.position_mm,
-                                                           tool.coupling_stiffness_n_per_mm()};
+                                                           tool.coupling_stiffness_n_per_mm(), s.buttons};
                               hand.proxies.publish();
                               if (d == 0) requests.ticks.fetch_add(1, std::memory_order_relaxed);
                               return f;
@@ -238,7 +227,8 @@ void run_view(const std::string& scene_path, const ViewOptions& options)
     sim_options.smooth = options.smooth;
     sim_options.out_dir = options.out_dir;
     sim_options.hands.clear();
-    for (std::size_t d = 0; d < driven.size(); ++d) sim_options.hands.push_back({driven[d], starts[d].position_mm, options.devices[d]});
+    for (std::size_t d = 0; d < driven.size(); ++d)
+        sim_options.hands.push_back({driven[d], starts[d].position_mm, options.devices[d], devices[d], haptics::is_force_device(options.devices[d])});
     sim_options.scene_file = scene_path;
     sim_options.journal = session_journal;
     sim_options.offered = std::move(offered);

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "haptics/force_devices.hpp"
 #include "io/label_map_writer.hpp"
 #include "io/mesh_writer.hpp"
 #include "sim/dbg_method.hpp"
@@ -144,7 +145,9 @@ bool ViewSimulation::step(double now_s)
         hand.pose = p.pose;
         hand.heading = p.heading;
         hand.coupling_n_per_mm = p.coupling_n_per_mm;
+        if (m_options.hands[d].arms) m_tools.arm(static_cast<std::size_t>(p.tool), (p.buttons & haptics::k_action_button) != 0);
     }
+    watch_faults();
     // A stroke's checkpoint before any of its cuts: the window flags the stroke before it moves
     // the pointer, so a pose read above that belongs to the stroke sees the flag.
     if (r.stroke_started.exchange(false)) m_history.before_stroke(*m_method);
@@ -183,6 +186,25 @@ bool ViewSimulation::step(double now_s)
     if (r.picture_taken.exchange(false)) make_picture();
     r.frames.fetch_add(1, std::memory_order_relaxed);
     return true;
+}
+
+void ViewSimulation::watch_faults()
+{
+    std::string notice;
+    for (const ViewHand& hand : m_options.hands) {
+        if (!hand.watched) continue;
+        const char* fault = hand.watched->fault();
+        if (fault) {
+            notice += (notice.empty() ? "" : "; ") + hand.watched->name() + ": " + fault;
+            hand.watched->recover();
+        }
+    }
+    if (!notice.empty()) notice += ": no force, the tool held where it was until the device answers";
+    if (notice != m_fault_notice) {
+        if (!notice.empty()) log::warn("{}", notice);
+        else log::info("the devices answer again: their force ramps back in");
+    }
+    m_fault_notice = std::move(notice);
 }
 
 void ViewSimulation::save() const
@@ -231,7 +253,8 @@ void ViewSimulation::make_picture()
         for (const auto& [level, count] : per)
             r.model += (level == per.begin()->first ? ": " : ", ") + std::to_string(count) + " at level " + std::to_string(level);
     }
-    r.notice = m_options.offered && m_method->cut_count() == 0
+    r.notice = !m_fault_notice.empty() ? m_fault_notice
+               : m_options.offered && m_method->cut_count() == 0
                    ? "An earlier session with this scene left " + std::to_string(m_options.offered->strokes.size()) +
                          " stroke(s) in its journal: press J to resume them"
                : m_now_s < m_level_notice_until_s ? m_level_notice

@@ -5,6 +5,7 @@
 // the haptic thread and the next picture for the window. It touches the method, the tools and the scene's tool settings alone.
 // step() is one iteration, so a test can drive it without threads or a window.
 
+#include "haptics/device.hpp"
 #include "sim/frame_loop.hpp"
 #include "sim/journal.hpp"
 #include "sim/undo_history.hpp"
@@ -23,6 +24,10 @@ struct ViewHand {
     std::size_t tool = 0;     ///< the tool it starts on (one device: TAB moves it; several: fixed)
     Eigen::Vector3d start_mm = Eigen::Vector3d::Zero(); ///< where its tool is until the haptic thread reports
     std::string device;       ///< its name, for the window's status line
+    /// The device itself, whose faults the window shows and which is asked to come back from
+    /// them (null: none to watch; tests).
+    haptics::Device* watched = nullptr;
+    bool arms = false;        ///< its second button switches the tool's action on while held (force-feedback devices)
 };
 
 struct ViewSimulationOptions {
@@ -72,6 +77,8 @@ private:
     void now_at_level(const std::string& why);
     /// The earlier session's cuts made on the object, when it has none yet.
     void resume_offered();
+    /// Devices that fault: said on screen and in the log, and asked to come back.
+    void watch_faults();
 
     io::Scene& m_scene;
     std::unique_ptr<sim::Method> m_method;
@@ -84,6 +91,7 @@ private:
     sim::StrokeEnds m_stroke_ends; ///< a 6-DoF controller's strokes (no button says when they end)
     int m_level = 1;
     std::string m_level_notice; ///< the last move between levels, shown for a few seconds
+    std::string m_fault_notice; ///< a device that does not answer, shown while it does not
     double m_level_notice_until_s = 0.0;
     double m_now_s = 0.0;
     /// Per device: the tool it drives (-1: none yet), where the haptic thread put it and where

@@ -5,7 +5,11 @@
 //   FAKE_DHD_PATH="x y z vx vy vz"  position (m) at poll 0 and velocity (m/s) per poll of 1 ms
 //   FAKE_DHD_FAULT="a b"        polls a .. b-1 fail with a communication error
 //   FAKE_DHD_BUTTONS_FROM=n     button 0 held from poll n on
-// fake_dhd_forces() gives the test the forces set, one per poll.
+//   FAKE_DHD_BUTTON2="a b"      button 1 held from poll a to b-1
+//   FAKE_DHD_UNPLUG="a n"       at poll a the cable is pulled: every call fails until the device is
+//                               closed and opened again, and the first n openings find no device
+// fake_dhd_forces() gives the test the forces set, one per poll; fake_dhd_opens() how many times
+// a device was opened. Polls count from dhdGetDeviceCount (a reopened device goes on its path).
 
 #include <cstdio>
 #include <cstdlib>
@@ -14,7 +18,9 @@ namespace {
 constexpr int k_max_polls = 200000;
 constexpr int k_comm_error = 4;
 double g_path[6] = {0, 0, 0, 0, 0, 0};
-long g_fault_from = -1, g_fault_to = -1, g_buttons_from = -1;
+long g_fault_from = -1, g_fault_to = -1, g_buttons_from = -1, g_button2_from = -1, g_button2_to = -1;
+long g_unplug_at = -1, g_unplug_openings = 0, g_opens = 0;
+bool g_unplugged = false;
 int g_count = 1;
 long g_poll = 0;
 int g_error = 0;
@@ -35,6 +41,12 @@ int dhdGetDeviceCount()
         std::sscanf(p, "%lf %lf %lf %lf %lf %lf", &g_path[0], &g_path[1], &g_path[2], &g_path[3], &g_path[4], &g_path[5]);
     if (const char* f = std::getenv("FAKE_DHD_FAULT")) std::sscanf(f, "%ld %ld", &g_fault_from, &g_fault_to);
     if (const char* b = std::getenv("FAKE_DHD_BUTTONS_FROM")) g_buttons_from = std::atol(b);
+    if (const char* b = std::getenv("FAKE_DHD_BUTTON2")) std::sscanf(b, "%ld %ld", &g_button2_from, &g_button2_to);
+    if (const char* u = std::getenv("FAKE_DHD_UNPLUG")) std::sscanf(u, "%ld %ld", &g_unplug_at, &g_unplug_openings);
+    g_poll = 0;
+    g_recorded = 0;
+    g_opens = 0;
+    g_unplugged = false;
     return g_count;
 }
 int dhdOpenID(char index)
@@ -43,9 +55,13 @@ int dhdOpenID(char index)
         g_error = 2;
         return -1;
     }
+    if (g_unplugged && g_unplug_openings-- > 0) {
+        g_error = 2;
+        return -1;
+    }
+    g_unplugged = false;
     g_open = true;
-    g_poll = 0;
-    g_recorded = 0;
+    ++g_opens;
     return index;
 }
 int dhdClose(char)
@@ -61,6 +77,11 @@ int dhdGetSerialNumber(unsigned short* serial, char)
 }
 int dhdGetPosition(double* x, double* y, double* z, char)
 {
+    if (g_poll == g_unplug_at && !g_unplugged && g_opens == 1) g_unplugged = true;
+    if (g_unplugged || !g_open) {
+        g_error = k_comm_error;
+        return -1;
+    }
     if (in_fault()) {
         g_error = k_comm_error;
         ++g_poll;
@@ -75,13 +96,24 @@ int dhdGetPosition(double* x, double* y, double* z, char)
 }
 int dhdGetOrientationFrame(double m[3][3], char)
 {
+    if (g_unplugged) {
+        g_error = k_comm_error;
+        return -1;
+    }
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) m[i][j] = i == j ? 1.0 : 0.0;
     return 0;
 }
-unsigned int dhdGetButtonMask(char) { return g_buttons_from >= 0 && g_poll > g_buttons_from ? 1u : 0u; }
+unsigned int dhdGetButtonMask(char)
+{
+    return (g_buttons_from >= 0 && g_poll > g_buttons_from ? 1u : 0u) | (g_poll > g_button2_from && g_poll <= g_button2_to ? 2u : 0u);
+}
 int dhdSetForce(double fx, double fy, double fz, char)
 {
+    if (g_unplugged) {
+        g_error = k_comm_error;
+        return -1;
+    }
     if (g_recorded < k_max_polls) {
         g_forces[g_recorded][0] = g_force ? fx : 0.0;
         g_forces[g_recorded][1] = g_force ? fy : 0.0;
@@ -103,6 +135,9 @@ const char* dhdErrorGetStr(int error)
     if (error == 2) return "no such device (fake)";
     return "no error";
 }
+
+/// How many times a device was opened since dhdGetDeviceCount.
+long fake_dhd_opens() { return g_opens; }
 
 /// The forces set so far (one per poll), up to `max`; returns how many.
 long fake_dhd_forces(double (*out)[3], long max)

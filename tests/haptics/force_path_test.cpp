@@ -1,6 +1,7 @@
 // The haptic loop's safety stage and its lock-free snapshot hand-over, with injected faults.
 
 #include "haptics/force_safety.hpp"
+#include "haptics/tick_ring.hpp"
 #include "haptics/triple_buffer.hpp"
 
 #include <gtest/gtest.h>
@@ -54,6 +55,46 @@ TEST(ForceSafety, RampsInAtStartUp)
     EXPECT_EQ(safety.filter({1, 0, 0}, 0.0, 0.0), Vector3d::Zero());
     EXPECT_NEAR(safety.filter({1, 0, 0}, 0.25, 0.0).x(), 0.25, 1e-12);
     EXPECT_NEAR(safety.filter({1, 0, 0}, 2.0, 0.0).x(), 1.0, 1e-12);
+}
+
+TEST(ForceSafety, RampsInAgainAfterADeviceFault)
+{
+    ForceSafety safety(settings());
+    EXPECT_NEAR(safety.filter({1, 0, 0}, 3.0, 0.0).x(), 1.0, 1e-12);
+    safety.hold_off(4.0); // faulted at 4 s (the loop holds off at every faulted tick)
+    EXPECT_EQ(safety.filter({1, 0, 0}, 4.0, 0.0), Vector3d::Zero());
+    EXPECT_NEAR(safety.filter({1, 0, 0}, 4.5, 0.0).x(), 0.5, 1e-12); // back: half-way up the 1 s ramp
+    EXPECT_NEAR(safety.filter({1, 0, 0}, 5.0, 0.0).x(), 1.0, 1e-12);
+}
+
+TEST(TickRing, HandsOverEveryValueInOrderAndCountsWhatAFullRingDrops)
+{
+    TickRing<int> ring(4);
+    for (int i = 0; i < 6; ++i) ring.push(i);
+    EXPECT_EQ(ring.size(), 4u);
+    EXPECT_EQ(ring.dropped(), 2u);
+    std::vector<int> got;
+    while (ring.size() > 0) {
+        got.push_back(ring.front());
+        ring.pop();
+    }
+    EXPECT_EQ(got, (std::vector<int>{0, 1, 2, 3}));
+    // Across threads: a writer of 100000 values, a reader taking them as they come.
+    TickRing<int> shared(64);
+    std::thread writer([&] {
+        for (int i = 0; i < 100000; ++i)
+            while (!shared.push(i)) std::this_thread::yield();
+    });
+    int expected = 0;
+    bool in_order = true;
+    while (expected < 100000) {
+        if (shared.size() == 0) continue;
+        in_order = in_order && shared.front() == expected;
+        shared.pop();
+        ++expected;
+    }
+    writer.join();
+    EXPECT_TRUE(in_order);
 }
 
 TEST(ForceSafety, FadesOutWhenTheSnapshotIsStale)

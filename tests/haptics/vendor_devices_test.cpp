@@ -189,3 +189,49 @@ TEST(VendorDevices, ForceDimensionPollsInMetresAndAFaultMidSessionZeroesTheForce
         EXPECT_NEAR(f[t][1], faulted ? 0.0 : 12.0 * 0.8, 1e-12) << t;
     }
 }
+
+TEST(VendorDevices, AForceDimensionDeviceUnpluggedMidSessionIsOpenedAgainWhenItReturnsAndItsForceRampsBackIn)
+{
+    ::setenv("VOX_LIBDHD", k_libdhd.c_str(), 1);
+    ::setenv("FAKE_DHD_PATH", "0 0 0 0.01 0 0", 1);
+    ::unsetenv("FAKE_DHD_FAULT");
+    ::setenv("FAKE_DHD_UNPLUG", "50 1", 1); // pulled at poll 50; the first reopening finds no device
+    ForceDimensionDevice device;
+    SafetySettings safety = no_ramp(device.limits().max_force_n);
+    safety.ramp_s = 0.1;
+    HapticLoop loop(device, [](const DeviceState&, double& age) {
+        age = 0.0;
+        return Eigen::Vector3d(0.0, 0.0, 5.0);
+    }, safety);
+    auto opens = reinterpret_cast<long (*)()>(::dlsym(::dlopen(k_libdhd.c_str(), RTLD_NOW | RTLD_NOLOAD), "fake_dhd_opens"));
+    ASSERT_NE(opens, nullptr);
+    // The loop at 1 kHz (ticked here), the simulation's recover() between its "frames" of 10 ticks.
+    const auto start = std::chrono::steady_clock::now();
+    double t = 0.0, faulted_at = -1.0, back_at = -1.0;
+    Eigen::Vector3d held = Eigen::Vector3d::Zero();
+    while (t < 5.0 && back_at < 0.0) {
+        for (int k = 0; k < 10; ++k, t += 1e-3) loop.tick(t);
+        if (device.fault() && faulted_at < 0.0) {
+            faulted_at = t;
+            held = loop.state().position_mm;
+        }
+        if (faulted_at >= 0.0 && !device.fault()) back_at = t;
+        device.recover();
+        std::this_thread::sleep_until(start + std::chrono::duration<double>(t));
+    }
+    ASSERT_GE(faulted_at, 0.0) << "the cable was pulled";
+    EXPECT_STREQ(device.fault(), nullptr);
+    ASSERT_GE(back_at, 0.0) << "taken up again";
+    // Half a second of fault before the first reopening, which finds nothing; the next one, half
+    // a second later, opens it.
+    EXPECT_GE(back_at - faulted_at, 0.9);
+    EXPECT_LT(back_at - faulted_at, 1.5);
+    EXPECT_EQ(opens(), 2);
+    EXPECT_NEAR(held.x(), 0.49, 1e-9) << "held at the last good poll (49 ms at 10 mm/s)";
+    // Back: the force ramps in from zero over the safety stage's ramp, not at once.
+    const Eigen::Vector3d first = loop.force();
+    EXPECT_LT(first.z(), 5.0 * 0.15);
+    for (int k = 0; k < 150; ++k, t += 1e-3) loop.tick(t);
+    EXPECT_NEAR(loop.force().z(), 5.0, 1e-12);
+    ::unsetenv("FAKE_DHD_UNPLUG");
+}

@@ -9,7 +9,7 @@
 #include "sim/journal.hpp"
 #include "sim/level_governor.hpp"
 #include "test_support.hpp"
-#include "view/paced_device.hpp"
+#include "haptics/paced_device.hpp"
 #include "view/view_simulation.hpp"
 
 #include <gtest/gtest.h>
@@ -234,7 +234,7 @@ TEST(ViewSimulationHands, TwoDevicesEachDriveTheirOwnToolAndGetTheSurfaceNearIt)
 TEST(PacedDevice, FollowsItsScriptInSimulatedTimeRunningOnAtMostOneFrame)
 {
     std::atomic<double> simulated{0.0};
-    PacedDevice device({{0.0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity()}, {1.0, Eigen::Vector3d(10, 0, 0), Eigen::Quaterniond::Identity()}},
+    haptics::PacedDevice device({{0.0, Eigen::Vector3d(0, 0, 0), Eigen::Quaterniond::Identity()}, {1.0, Eigen::Vector3d(10, 0, 0), Eigen::Quaterniond::Identity()}},
                        simulated, 0.01);
     haptics::DeviceState s;
     device.read(5.0, s); // the loop's clock is not the simulation's
