@@ -9,6 +9,7 @@
 #include "sim/journal.hpp"
 #include "sim/level_governor.hpp"
 #include "test_support.hpp"
+#include "haptics/force_devices.hpp"
 #include "haptics/paced_device.hpp"
 #include "view/view_simulation.hpp"
 
@@ -229,6 +230,70 @@ TEST(ViewSimulationHands, TwoDevicesEachDriveTheirOwnToolAndGetTheSurfaceNearIt)
         for (std::size_t i = 0; i < snapshot.count; ++i) EXPECT_LT(std::abs(snapshot.positions_mm[i].x() - x), 20.0) << "hand " << d;
     }
     EXPECT_NEAR(channels.simulation_t_s.load(), 0.6, 1e-9);
+}
+
+/// A force-feedback device as the viewer's simulation sees it: a fault it can be told to have,
+/// and how often it was asked to come back.
+class FaultyDevice final : public haptics::Device {
+public:
+    [[nodiscard]] std::string name() const override { return "omega.6"; }
+    [[nodiscard]] const haptics::DeviceLimits& limits() const override { return m_limits; }
+    bool read(double, haptics::DeviceState&) noexcept override { return false; }
+    [[nodiscard]] const char* fault() const noexcept override { return m_fault; }
+    void recover() override { ++recovers; }
+    const char* m_fault = nullptr;
+    int recovers = 0;
+
+private:
+    haptics::DeviceLimits m_limits;
+};
+
+TEST(ViewSimulationHands, TheSecondButtonSwitchesTheActionOnAndAFaultIsShownUntilTheDeviceAnswers)
+{
+    io::Scene scene = io::load_scene(VOX_SOURCE_DIR "/data/scenes/bar_cut_isxfem.json");
+    io::use_method(scene, io::SolverType::dbg);
+    scene.script.clear();
+    auto labels = std::make_shared<const grid::LabelGrid>(io::load_scene_object(scene));
+    FaultyDevice device;
+    ViewSimulationOptions options;
+    options.grid_levels = 3;
+    options.hands = {ViewHand{0, Eigen::Vector3d(50.3, 5, 30), "forcedimension", &device, true}};
+    const Eigen::Quaterniond turned(0.7071068, 0, 0, 0.7071068);
+    // The blade down through the bar, its second button up or held throughout, on a bar of its own.
+    for (const std::uint32_t buttons : {0u, haptics::k_action_button}) {
+        sim::ToolPolicy tools(scene);
+        ViewChannels channels(20000);
+        ViewSimulation simulation(scene, std::make_unique<sim::DbgMethod>(scene, labels, 2, 3), tools, channels, options);
+        const std::size_t dofs = simulation.method().dof_count();
+        for (int f = 0; f < 30; ++f) {
+            channels.hand().proxies.write_slot() = {0, {&tools.shape(0), Eigen::Vector3d(50.3, 5, 20.5 - 1.2 * f), turned},
+                                                    Eigen::Vector3d(50.3, 5, 19.3 - 1.2 * f), 0.5, buttons};
+            channels.hand().proxies.publish();
+            ASSERT_TRUE(simulation.step(0.01 * f));
+        }
+        EXPECT_EQ(tools.armed(0), buttons != 0u);
+        if (buttons == 0u) {
+            EXPECT_EQ(simulation.method().dof_count(), dofs) << "no cut with the button up";
+            continue;
+        }
+        EXPECT_GT(simulation.method().dof_count(), dofs) << "held, the blade cuts";
+
+        // A cable pulled: said on screen, the device asked to come back each frame, until it answers.
+        device.m_fault = "communication error (fake)";
+        ASSERT_TRUE(simulation.step(2.0));
+        channels.requests.picture_taken = true;
+        ASSERT_TRUE(simulation.step(2.01));
+        ASSERT_TRUE(channels.pictures.update());
+        EXPECT_NE(channels.pictures.read_slot().notice.find("omega.6: communication error (fake): no force"), std::string::npos)
+            << channels.pictures.read_slot().notice;
+        EXPECT_EQ(device.recovers, 2);
+        device.m_fault = nullptr;
+        channels.requests.picture_taken = true;
+        ASSERT_TRUE(simulation.step(2.02));
+        ASSERT_TRUE(channels.pictures.update());
+        EXPECT_EQ(channels.pictures.read_slot().notice, "");
+        EXPECT_EQ(device.recovers, 2);
+    }
 }
 
 TEST(PacedDevice, FollowsItsScriptInSimulatedTimeRunningOnAtMostOneFrame)
