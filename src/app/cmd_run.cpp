@@ -243,7 +243,7 @@ void add_run_command(CLI::App& app)
         if (device) device->finish(method);
         const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
         const double simulated_s = (frames - first_frame + 1) * dt;
-        if (late_frames > 0)
+        if (late_frames > (frames - first_frame + 1) / 20) // a few late frames are not worth a word
             log::warn("the simulation ran slower than real time: {:.2f} s simulated in {:.2f} s ({} of {} frames started more than a "
                       "frame late; a coarser level, or \"levels\": \"auto\" with a budget, keeps up)",
                       simulated_s, wall_s, late_frames, frames - first_frame + 1);
